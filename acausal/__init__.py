@@ -1,0 +1,22 @@
+"""acausal: equation-based (Modelica-style) simulation of mechanisms.
+
+Pipeline, one module per stage: :mod:`.flatten` -> :mod:`.aliases` ->
+:mod:`.structure` -> :mod:`.causalize` -> :mod:`.codegen` (all driven by
+:mod:`.compile`) -> :mod:`.simulate` -> :mod:`.result`.
+"""
+from sympy import Eq, Piecewise, cos, exp, sin, sqrt  # noqa: F401  (for model files)
+
+from .component import Component, Model
+from .compile import CompiledModel, compile_model
+from .connectors import Flange, Port, RotFlange
+from .declare import Assertion, Discrete, Event, Parameter, Start, Variable, guess
+from .errors import (AcausalError, ChatteringError, InitializationError, ModelError,
+                     ParameterError, SolverError, StructuralError)
+from .symbols import der, time
+
+__all__ = [
+    "Component", "Model", "CompiledModel", "compile_model", "Flange", "RotFlange", "Port",
+    "Parameter", "Variable", "Discrete", "Event", "Assertion", "Start", "guess", "der",
+    "time", "Eq", "AcausalError", "ModelError", "ParameterError", "StructuralError",
+    "InitializationError", "SolverError", "ChatteringError",
+]

@@ -1,0 +1,189 @@
+"""Stage 4: from the index-reduced graph to the DAE that IDA solves.
+
+States are the variable nodes whose derivative is not a dummy. The other
+nodes are algebraic. Equations are sorted into blocks (matching + Tarjan's
+strongly connected components, via scipy); a scalar block that is linear in
+its unknown with a constant coefficient is solved explicitly and substituted
+(trivial tearing), so the residual handed to IDA is as small as a hand-written
+one. What remains: residuals ``F(t, y, y', p, d) = 0`` over ``y`` = states +
+algebraic unknowns of implicit blocks.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sps
+from scipy.sparse.csgraph import connected_components, maximum_bipartite_matching
+import sympy as sp
+
+from .errors import StructuralError
+
+
+@dataclass
+class DAE:
+    y: list            # symbols held in y (states first, then algebraic)
+    yp: list           # symbol standing for yp[i] (None for algebraic slots)
+    n_states: int
+    residuals: list    # sympy expressions, one per y slot
+    origins: list      # Equation object (or description) per residual
+    explicit: dict     # eliminated algebraic symbol -> expression of y/yp symbols
+
+
+def build_dae(g, dummies, params):
+    """``params``: the set of parameter symbols (constant coefficients)."""
+    nv = len(g.vsym)
+    states = [j for j in range(nv) if g.vder[j] != -1 and g.vder[j] not in dummies]
+    deriv_of_state = {g.vder[j]: j for j in states}
+    # y slots: states first, then every other node that is not the plain
+    # derivative of a state (those live in yp).
+    y_nodes = list(states)
+    aux_eqs, yp_sym = [], {}
+    for j in states:
+        d = g.vder[j]
+        if d in states:  # a state whose derivative is also a state: link by an equation
+            sym = sp.Symbol(f"__yp__{g.vsym[j].name}")
+            yp_sym[j] = sym
+            aux_eqs.append((sym - g.vsym[d], f"derivative link der({g.vsym[j].name})"))
+        else:
+            yp_sym[j] = g.vsym[d]
+    alg_nodes = [j for j in range(nv) if j not in set(states) and j not in deriv_of_state]
+    # the index-1 system keeps every equation and every derivative of it
+    # (the dummy derivatives are its extra algebraic unknowns)
+    eqs = [(g.eexpr[i], g.eorig[i]) for i in range(len(g.eexpr))]
+    eqs += aux_eqs
+    unknowns = [yp_sym[j] for j in states] + [g.vsym[j] for j in alg_nodes]
+    if len(eqs) != len(unknowns):
+        raise StructuralError(f"internal: index-1 system has {len(eqs)} equations for "
+                              f"{len(unknowns)} unknowns after state selection")
+    blocks = _blt(eqs, unknowns)
+    explicit, residuals, origins, implicit_alg = {}, {}, {}, []
+    yp_set = set(yp_sym.values())
+    for block in blocks:
+        if len(block) == 1:
+            (ei, ui), = block
+            expr = _subs(eqs[ei][0], explicit)
+            u = unknowns[ui]
+            sol = _solve_linear(expr, u, params)
+            if sol is not None and u not in yp_set:
+                explicit[u] = sol
+                continue
+            residuals[ui] = expr
+            origins[ui] = eqs[ei][1]
+            if u not in yp_set:
+                implicit_alg.append(u)
+            continue
+        exprs = [_subs(eqs[ei][0], explicit) for ei, _ in block]
+        us = [unknowns[ui] for _, ui in block]
+        sol = _solve_linear_block(exprs, us, params)
+        if sol is not None:
+            for (ei, ui), u, v in zip(block, us, sol):
+                if u in yp_set:
+                    residuals[ui] = u - v
+                    origins[ui] = eqs[ei][1]
+                else:
+                    explicit[u] = v
+            continue
+        for ei, ui in block:
+            residuals[ui] = _subs(eqs[ei][0], explicit)
+            origins[ui] = eqs[ei][1]
+            if unknowns[ui] not in yp_set:
+                implicit_alg.append(unknowns[ui])
+    # order residuals to y slots: state i <-> unknown i (its derivative),
+    # algebraic slots follow
+    y = [g.vsym[j] for j in states] + implicit_alg
+    yp = [yp_sym[j] for j in states] + [None] * len(implicit_alg)
+    idx = {u: k for k, u in enumerate(unknowns)}
+    res, org = [], []
+    for k in range(len(states)):
+        res.append(residuals[k] if k in residuals else None)
+        org.append(origins.get(k))
+    for u in implicit_alg:
+        res.append(residuals[idx[u]])
+        org.append(origins[idx[u]])
+    # states whose derivative was solved explicitly are not possible (yp are
+    # never made explicit), so every state row has a residual
+    return DAE(y, yp, len(states), res, org, explicit)
+
+
+def _subs(expr, explicit):
+    if not explicit:
+        return expr
+    hit = {s: explicit[s] for s in expr.free_symbols if s in explicit}
+    return expr.xreplace(hit) if hit else expr
+
+
+def _solve_linear(expr, u, params):
+    """u = -rest/coeff when expr is linear in u with a coefficient made of
+    numbers and parameters only (never zero in a valid model)."""
+    coeff = sp.diff(expr, u)
+    if coeff == 0 or coeff.has(u) or not coeff.free_symbols <= params:
+        return None
+    rest = expr.xreplace({u: 0})
+    return -rest / coeff
+
+
+def _solve_linear_block(exprs, us, params, max_size=12):
+    """Solve a block of equations linear in its unknowns, with constant
+    (parameter) coefficients, symbolically; None when it is not such a block."""
+    if len(us) > max_size:
+        return None
+    try:
+        A, b = sp.linear_eq_to_matrix(exprs, us)
+    except (sp.PolynomialError, ValueError, TypeError):
+        return None
+    if not all(a.free_symbols <= params for a in A):
+        return None
+    if any(set(us) & bi.free_symbols for bi in b):
+        return None
+    try:
+        x = A.LUsolve(b)
+    except (ValueError, ZeroDivisionError):
+        return None
+    return [sp.cancel(xi) if xi.count_ops() < 200 else xi for xi in x]
+
+
+def _blt(eqs, unknowns):
+    """Blocks [(eq index, unknown index), ...] in an order where each block
+    only needs unknowns of earlier blocks."""
+    index = {u: k for k, u in enumerate(unknowns)}
+    rows, cols = [], []
+    for i, (expr, _) in enumerate(eqs):
+        for s in expr.free_symbols:
+            k = index.get(s)
+            if k is not None:
+                rows.append(i)
+                cols.append(k)
+    n = len(eqs)
+    m = sps.csr_matrix((np.ones(len(rows)), (rows, cols)), shape=(n, n))
+    match = maximum_bipartite_matching(m, perm_type="column")
+    if (match == -1).any():
+        bad = [eqs[i][1] for i in np.flatnonzero(match == -1)]
+        raise StructuralError("the index-reduced system is singular (no unknown left for): "
+                              + "; ".join(getattr(b, "describe", lambda: str(b))() for b in bad),
+                              excess=bad)
+    # dependency graph on equations: i depends on the equation matched to each unknown in it
+    eq_of_unknown = {int(match[i]): i for i in range(n)}
+    drows, dcols = [], []
+    for i, k in zip(rows, cols):
+        j = eq_of_unknown[k]
+        if j != i:
+            drows.append(i)
+            dcols.append(j)
+    dep = sps.csr_matrix((np.ones(len(drows)), (drows, dcols)), shape=(n, n))
+    ncomp, labels = connected_components(dep, directed=True, connection="strong")
+    comps = [[] for _ in range(ncomp)]
+    for i in range(n):
+        comps[labels[i]].append(i)
+    # topological order of the condensation (Kahn)
+    cdeps = [set() for _ in range(ncomp)]
+    for i, j in zip(drows, dcols):
+        if labels[i] != labels[j]:
+            cdeps[labels[i]].add(labels[j])
+    order, done = [], set()
+    pending = list(range(ncomp))
+    while pending:
+        nxt = [c for c in pending if cdeps[c] <= done]
+        for c in nxt:
+            order.append(c)
+            done.add(c)
+        pending = [c for c in pending if c not in done]
+    return [[(i, int(match[i])) for i in comps[c]] for c in order]

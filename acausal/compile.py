@@ -1,0 +1,183 @@
+"""The pipeline from a model to generated callbacks, run once per model
+structure: flatten -> aliases -> structure check -> Pantelides -> dummy
+derivatives -> causalize -> codegen. The result, :class:`CompiledModel`,
+simulates any number of parameter sets without re-generating anything.
+"""
+import time as _time
+from dataclasses import dataclass
+
+import numpy as np
+import sympy as sp
+
+from .aliases import eliminate_aliases
+from .causalize import build_dae
+from .codegen import generate
+from .errors import ModelError, ParameterError
+from .flatten import flatten
+from .structure import Graph, check_structure, dummy_derivatives, pantelides
+from .symbols import base_and_order, der, time
+
+
+@dataclass
+class ParamEntry:
+    name: str
+    default: float
+    unit: str
+    desc: str
+    decl: object
+    owner: str
+
+
+class CompiledModel:
+    """A model turned into solver callbacks. Use :meth:`simulate`."""
+
+    def __init__(self, model):
+        t0 = _time.perf_counter()
+        self.model = model
+        flat = self.flat = flatten(model)
+        red = self.reduced = eliminate_aliases(flat)
+        check_structure(red.equations, red.unknowns, flat)
+        self.params = [ParamEntry(i.symbol.name, float(i.value), i.decl.unit, i.decl.desc,
+                                  i.decl, i.owner)
+                       for i in flat.params.values()
+                       if not i.decl.structural and not i.bound]
+        self.structural = {i.symbol.name: i.value for i in flat.params.values()
+                           if i.decl.structural}
+        self.bound = {i.symbol.name: i.value for i in flat.params.values()
+                      if not i.decl.structural and i.bound}
+        self.param_syms = [sp.Symbol(p.name) for p in self.params]
+        self.discretes = list(flat.discretes.values())
+        self.disc_syms = [d.symbol for d in self.discretes]
+        g = self.graph = Graph(red.equations, red.unknowns)
+        pantelides(g)
+        values = self._start_values()
+        fixed = {v.symbol for v in flat.variables.values() if v.start.fixed}
+        dummies = dummy_derivatives(g, values, lambda s: base_and_order(s)[0] in fixed)
+        self.dae = build_dae(g, dummies, set(self.param_syms))
+        self._subs = dict(red.param_subs)
+        self._alias = red.subs
+        self.var_names = list(flat.variables)
+        observed = [self.resolve(flat.variables[n].symbol) for n in self.var_names]
+        self.events = list(flat.events)
+        self.assertions = list(flat.assertions)
+        self.stop_events = []
+        roots = [self.resolve(e.expr) for e in self.events] + \
+                [self.resolve(a.expr) for a in self.assertions]
+        self.source, self._make = generate(self.dae, self.param_syms, self.disc_syms,
+                                           roots, observed)
+        self.n_roots = len(roots)
+        self.compile_s = _time.perf_counter() - t0
+
+    # -- symbol resolution -------------------------------------------------
+    def resolve(self, expr):
+        """Rewrite an expression of model symbols in terms of the DAE's y and
+        y' symbols, free parameters, discrete values and time."""
+        e = sp.sympify(expr)
+        if self._subs:
+            e = e.xreplace(self._subs)
+        e = e.xreplace(self._alias)
+        if self.dae.explicit:
+            e = e.xreplace(self.dae.explicit)
+        known = set(self.dae.y) | {s for s in self.dae.yp if s is not None} | \
+            set(self.param_syms) | set(self.disc_syms) | {time}
+        bad = [s for s in e.free_symbols if s not in known]
+        if bad:
+            raise ModelError(f"{expr} cannot be evaluated: {bad[0].name} is not available "
+                             "(a derivative the model never needs, or an unknown name)")
+        return e
+
+    def _start_values(self):
+        vals = {}
+        for info in self.flat.params.values():
+            if not info.decl.structural:
+                vals[info.symbol] = info.value
+        for info in self.flat.variables.values():
+            v = info.start.value
+            vals[info.symbol] = v
+        for d in self.flat.discretes.values():
+            vals[d.symbol] = d.start.value
+        for k, v in list(vals.items()):
+            if isinstance(v, sp.Basic) and not v.is_number:
+                vals[k] = v.xreplace(vals)
+        out = {}
+        for k, v in vals.items():
+            try:
+                out[k] = float(sp.sympify(v).xreplace(vals))
+            except TypeError:
+                out[k] = 0.0
+        for s in list(self.graph.vsym):
+            out.setdefault(s, 0.0)
+        out[time] = 0.0
+        return out
+
+    # -- runtime helpers -------------------------------------------------------
+    def param_index(self, name):
+        for i, p in enumerate(self.params):
+            if p.name == name:
+                return i
+        if name in self.bound:
+            raise ParameterError(f"parameter {name} is bound to {self.bound[name]}; "
+                                 "set the parameters it depends on instead")
+        if name in self.structural:
+            raise ParameterError(f"parameter {name} is structural (it changes the equations); "
+                                 "set it in the model file")
+        raise ParameterError(f"the model has no parameter {name!r}")
+
+    def param_vector(self, overrides=None):
+        """Free parameter values with ``overrides`` (name -> value) applied and
+        checked against each parameter's bounds."""
+        p = np.array([e.default for e in self.params], dtype=float)
+        for name, value in (overrides or {}).items():
+            i = self.param_index(name)
+            e = self.params[i]
+            value = float(value)
+            e.decl.check_bounds(value, name)
+            p[i] = value
+        return p
+
+    def _eval_start(self, value, p):
+        if isinstance(value, sp.Basic) and not value.is_number:
+            e = value.xreplace(self._subs).xreplace(dict(zip(self.param_syms, p)))
+            return float(e)
+        return float(value)
+
+    def fixed_starts(self, p):
+        """(index in var_names, value, name) of every fixed start value."""
+        out = []
+        for k, name in enumerate(self.var_names):
+            st = self.flat.variables[name].start
+            if st.fixed:
+                out.append((k, self._eval_start(st.value, p), name))
+        return out
+
+    def guess_vector(self, p):
+        """Initial guess of y from the start values of the variables."""
+        y = np.zeros(len(self.dae.y))
+        for i, s in enumerate(self.dae.y):
+            base, k = base_and_order(s)
+            info = self.flat.variables.get(base.name)
+            if k == 0 and info is not None:
+                y[i] = self._eval_start(info.start.value, p)
+        return y
+
+    def state_guess_order(self):
+        """State slots in the order their guesses are imposed when the fixed
+        starts leave degrees of freedom (declared non-zero starts first)."""
+        ns = self.dae.n_states
+        guess = self.guess_vector(self.param_vector())
+        return sorted(range(ns), key=lambda i: (guess[i] == 0.0, i))
+
+    def discrete_start(self):
+        return [float(d.start.value) for d in self.discretes]
+
+    def callbacks(self, p, d):
+        return self._make(list(map(float, p)), list(map(float, d)))
+
+    def simulate(self, **kw):
+        from .simulate import simulate
+        return simulate(self, **kw)
+
+
+def compile_model(model):
+    """Compile ``model`` (flatten, reduce, generate)."""
+    return CompiledModel(model)

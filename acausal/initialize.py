@@ -1,0 +1,144 @@
+"""Consistent initial conditions.
+
+At the start, the unknowns are every ``y`` and the derivatives ``y'`` of the
+states; the equations are the residuals plus one equation per *fixed* start
+value. When fixed starts do not pin every degree of freedom, guesses of
+states are added (chosen where they raise the rank of the Jacobian). The
+system is solved by least squares; fixed starts that contradict each other
+or the model raise :class:`InitializationError` naming them — they are never
+silently changed. After an event only the algebraic unknowns and ``y'`` are
+recomputed, the states are kept.
+"""
+import numpy as np
+import scipy.linalg
+from scipy.optimize import least_squares
+
+from .errors import InitializationError
+
+
+def _jacobians(cb, t, y, yp, n):
+    Jy = np.zeros((n, n))
+    Jyp = np.zeros((n, n))
+    cb[3](t, y, yp, Jy, Jyp)
+    return Jy, Jyp
+
+
+def initial_point(cm, p, d, cb, t0):
+    """Return (y0, yp0) consistent with the model and its fixed starts."""
+    dae = cm.dae
+    n, ns = len(dae.y), dae.n_states
+    fixed = cm.fixed_starts(p)           # list of (var index, value, name)
+    y0 = cm.guess_vector(p)
+    res_fn, observe = cb[0], cb[4]
+    r = np.zeros(n)
+
+    def split(z):
+        y = z[:n]
+        yp = np.zeros(n)
+        yp[:ns] = z[n:]
+        return y, yp
+
+    def residual(z, guess_rows):
+        y, yp = split(z)
+        res_fn(t0, y, yp, r)
+        o = observe(t0, y, yp)
+        f = [o[k] - v for k, v, _ in fixed]
+        gz = [z[k] - z0[k] for k in guess_rows]
+        return np.concatenate([r, f, gz])
+
+    def jac(z, guess_rows):
+        y, yp = split(z)
+        Jy, Jyp = _jacobians(cb, t0, y, yp, n)
+        top = np.hstack([Jy, Jyp[:, :ns]])
+        rows = [top]
+        if fixed:
+            eps = 1e-7 * (1 + np.abs(z))
+            base = np.array([observe(t0, y, yp)[k] for k, _, _ in fixed])
+            Jf = np.zeros((len(fixed), len(z)))
+            for j in range(len(z)):
+                z2 = z.copy()
+                z2[j] += eps[j]
+                yy, yyp = split(z2)
+                o = observe(t0, yy, yyp)
+                Jf[:, j] = (np.array([o[k] for k, _, _ in fixed]) - base) / eps[j]
+            rows.append(Jf)
+        if guess_rows:
+            G = np.zeros((len(guess_rows), len(z)))
+            for a, k in enumerate(guess_rows):
+                G[a, k] = 1.0
+            rows.append(G)
+        return np.vstack(rows)
+
+    z0 = np.concatenate([y0, np.zeros(ns)])
+    guess_rows = _choose_guesses(jac(z0, []), ns, cm.state_guess_order())
+    sol = least_squares(residual, z0, jac=jac, args=(guess_rows,), method="trf",
+                        xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=200,
+                        x_scale="jac")
+    z = sol.x
+    y, yp = split(z)
+    _check(cm, residual(z, []), jac(z, []), z, fixed, n)
+    return y, yp
+
+
+def _choose_guesses(J, ns, order):
+    """Indices of state slots whose guess must be imposed so that the
+    Jacobian has full column rank."""
+    m = J.shape[1]
+    rank = np.linalg.matrix_rank(J) if J.size else 0
+    chosen = []
+    for k in order:
+        if rank >= m:
+            break
+        row = np.zeros((1, m))
+        row[0, k] = 1.0
+        J2 = np.vstack([J, row])
+        r2 = np.linalg.matrix_rank(J2)
+        if r2 > rank:
+            J, rank = J2, r2
+            chosen.append(k)
+    return chosen
+
+
+def _check(cm, full, J, z, fixed, n):
+    scale = np.abs(J) @ (np.abs(z) + 1e-12) + 1e-12
+    bad = np.abs(full) > 1e-7 * scale + 1e-10
+    if not bad.any():
+        return
+    names = [name for a, (_, _, name) in enumerate(fixed) if bad[n + a]]
+    if names:
+        detail = ", ".join(f"{nm} = {v:g}" for (_, v, nm) in fixed if nm in names)
+        raise InitializationError(
+            "inconsistent fixed start values: " + detail + " cannot all hold together with "
+            "the model's equations (largest violation "
+            f"{np.max(np.abs(full[n:])):.3g}); make some of them guesses "
+            "(Start(value, fixed=False)) or correct them")
+    rows = [k for k in range(n) if bad[k]]
+    origin = cm.dae.origins[rows[0]]
+    what = origin.describe() if hasattr(origin, "describe") else str(origin)
+    raise InitializationError(f"no consistent initial point found: {what} "
+                              f"is violated by {full[rows[0]]:.3g}")
+
+
+def reinitialize(cm, cb, t, y, yp):
+    """After an event: keep the states, recompute algebraic unknowns and y'."""
+    dae = cm.dae
+    n, ns = len(dae.y), dae.n_states
+    r = np.zeros(n)
+    y = np.array(y, dtype=float)
+    yp = np.array(yp, dtype=float)
+    z = np.concatenate([y[ns:], yp[:ns]])
+    for _ in range(50):
+        cb[0](t, y, yp, r)
+        Jy, Jyp = _jacobians(cb, t, y, yp, n)
+        J = np.hstack([Jy[:, ns:], Jyp[:, :ns]])
+        try:
+            dz = scipy.linalg.solve(J, -r)
+        except (scipy.linalg.LinAlgError, ValueError):
+            dz = np.linalg.lstsq(J, -r, rcond=None)[0]
+        z = z + dz
+        y[ns:] = z[:n - ns]
+        yp[:ns] = z[n - ns:]
+        if np.all(np.abs(dz) <= 1e-12 * (1 + np.abs(z))):
+            break
+    cb[0](t, y, yp, r)
+    return y, yp

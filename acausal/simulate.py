@@ -1,0 +1,268 @@
+"""Stage 6: the hybrid simulation loop around SUNDIALS IDA (scikit-sundae).
+
+IDA integrates until a root function crosses zero. Then the owning
+component's event action changes discrete values (a contact mode, a stick/
+slip mode), the algebraic unknowns and derivatives are recomputed
+consistently, events flagged ``recheck`` are iterated to a fixed point, and
+integration restarts. Output: requested times, plus both sides of every
+event. A burst of events in a tiny window stops the run with a
+:class:`ChatteringError` naming the component.
+"""
+import time as _time
+
+import numpy as np
+from sksundae.ida import IDA
+
+from .errors import ChatteringError, SolverError
+from .initialize import initial_point, reinitialize
+from .result import Result
+
+CHATTER_COUNT = 100     # this many events ...
+CHATTER_SPAN = 1e-9     # ... within this fraction of the time span is chattering
+MAX_ITER = 20           # event iterations at one instant
+
+
+class EventState:
+    """What an event action sees: ``state[symbol]`` reads a variable, a
+    discrete value or a parameter at the event; ``state[discrete] = v`` sets a
+    discrete value."""
+
+    def __init__(self, cm, p, d, t, obs):
+        self.cm, self.p, self.d, self.t, self._obs = cm, p, d, t, obs
+        self.changed = False
+
+    def _find(self, sym):
+        name = getattr(sym, "name", sym)
+        for j, dsc in enumerate(self.cm.discretes):
+            if dsc.symbol.name == name:
+                return "d", j
+        if name in self._index():
+            return "v", self._index()[name]
+        for j, prm in enumerate(self.cm.params):
+            if prm.name == name:
+                return "p", j
+        raise KeyError(f"event action asked for {name!r}, which is not in the model")
+
+    def _index(self):
+        idx = getattr(self, "_idx", None)
+        if idx is None:
+            idx = self._idx = {n: k for k, n in enumerate(self.cm.var_names)}
+        return idx
+
+    def __getitem__(self, sym):
+        kind, j = self._find(sym)
+        return {"d": self.d, "v": self._obs, "p": self.p}[kind][j]
+
+    def __setitem__(self, sym, value):
+        kind, j = self._find(sym)
+        if kind != "d":
+            raise KeyError(f"event actions may only set discrete values, not {sym}")
+        if self.d[j] != value:
+            self.d[j] = float(value)
+            self.changed = True
+
+
+def _output_times(t0, t_end, output_step, output_times):
+    if output_times is not None:
+        ts = np.asarray(sorted(output_times), dtype=float)
+        return ts[(ts >= t0) & (ts <= t_end)]
+    step = output_step or (t_end - t0) / 500.0
+    n = int(np.floor((t_end - t0) / step + 1e-9))
+    ts = t0 + step * np.arange(n + 1)
+    if ts[-1] < t_end - 1e-12 * max(1.0, abs(t_end)):
+        ts = np.append(ts, t_end)
+    return ts
+
+
+class _Run:
+    def __init__(self, cm, p, t0, t_end, rtol, atol, max_step, max_steps):
+        self.cm, self.p = cm, np.asarray(p, float)
+        self.t0, self.t_end = t0, t_end
+        self.opts = dict(rtol=rtol, atol=atol, max_step=max_step or 0.0,
+                         max_num_steps=max_steps)
+        self.T, self.Y, self.YP, self.D = [], [], [], []
+        self.events, self.event_log = [], []
+        self.nfev = self.njev = self.steps = 0
+        ev = cm.events
+        self.directions = [e.direction for e in ev] + [-1] * len(cm.assertions)
+
+    def record(self, t, y, yp, d):
+        self.T.append(float(t))
+        self.Y.append(np.array(y, float))
+        self.YP.append(np.array(yp, float))
+        self.D.append(list(d))
+
+    def solver(self, cb):
+        kw = dict(self.opts)
+        alg = list(range(self.cm.dae.n_states, len(self.cm.dae.y)))
+        if alg:
+            kw["algebraic_idx"] = alg
+        if self.cm.n_roots:
+            def roots(t, y, yp, g, _f=cb[2]):
+                _f(t, y, yp, g)
+            roots.terminal = [True] * self.cm.n_roots
+            roots.direction = list(self.directions)
+            kw.update(eventsfn=roots, num_events=self.cm.n_roots)
+        return IDA(cb[0], jacfn=cb[1], **kw)
+
+    def result(self, status="ok", message=""):
+        stats = dict(nfev=self.nfev, njev=self.njev, steps=self.steps,
+                     events=len(self.events))
+        return Result(self.cm, self.p, self.T, self.Y, self.YP, self.D, list(self.events),
+                      stats, status, message)
+
+
+def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_step=None,
+             output_times=None, max_step=None, max_steps=100000):
+    """Simulate a :class:`CompiledModel` from ``t0`` to ``t_end`` (or until a
+    terminal event). ``params`` overrides parameter values by dotted path."""
+    wall0 = _time.perf_counter()
+    p = cm.param_vector(params)
+    d = cm.discrete_start()
+    run = _Run(cm, p, t0, t_end, rtol, atol, max_step, max_steps)
+    cb = cm.callbacks(p, d)
+    y, yp = initial_point(cm, p, d, cb, t0)
+    y, yp, d, cb, stop = _event_iteration(run, cb, t0, y, yp, d, initial=True)
+    tout = _output_times(t0, t_end, output_step, output_times)
+    k = int(np.searchsorted(tout, t0, side="right"))
+    run.record(t0, y, yp, d)
+    t = t0
+    try:
+        while not stop and t < t_end:
+            ida = run.solver(cb)
+            ida.init_step(t, y, yp)
+            nfev0, njev0, t_step = 0, 0, t
+            while True:
+                r = ida.step(t_end, method="onestep", tstop=t_end)
+                if r.status < 0:
+                    run.nfev += r.nfev
+                    raise _failure(run, cm, r, cb)
+                if r.t > t_step:  # a ONE_STEP call right after an interpolated
+                    run.steps += 1  # output returns without stepping
+                    t_step = r.t
+                while k < len(tout) and tout[k] < r.t:
+                    ri = ida.step(float(tout[k]), method="normal")
+                    run.record(ri.t, ri.y, ri.yp, d)
+                    k += 1
+                nfev0, njev0 = r.nfev, r.njev
+                if r.status == 2:
+                    break
+                if k < len(tout) and tout[k] == r.t:
+                    k += 1
+                if r.t >= t_end:
+                    break
+            run.nfev += nfev0
+            run.njev += njev0
+            t, y, yp = float(r.t), np.array(r.y), np.array(r.yp)
+            run.record(t, y, yp, d)
+            if r.status != 2:
+                break
+            fired = [i for i, s in enumerate(r.i_events[-1]) if s != 0]
+            y, yp, d, cb, stop = _handle(run, cb, t, y, yp, d, fired)
+            if not stop or run.T[-1] != t or run.D[-1] != list(d):
+                run.record(t, y, yp, d)
+            while k < len(tout) and tout[k] <= t:
+                k += 1
+    except SolverError as exc:
+        exc.result = exc.result or run.result("failed", str(exc))
+        exc.result.stats["wall_s"] = _time.perf_counter() - wall0
+        raise
+    res = run.result()
+    res.stats["wall_s"] = _time.perf_counter() - wall0
+    res.stats["compile_s"] = cm.compile_s
+    return res
+
+
+def _handle(run, cb, t, y, yp, d, fired):
+    cm = run.cm
+    n_ev = len(cm.events)
+    d = list(d)
+    obs = cb[4](t, y, yp)
+    state = EventState(cm, run.p, d, t, obs)
+    stop = False
+    for i in fired:
+        if i >= n_ev:
+            a = cm.assertions[i - n_ev]
+            raise SolverError(f"{a.owner}: {a.message} (at t = {t:.6g} s)", t=t,
+                              component=a.owner, result=run.result("failed", a.message))
+        ev = cm.events[i]
+        _log_event(run, t, ev)
+        if ev.action is not None:
+            ev.action(state)
+        if ev.terminal:
+            stop = True
+    if state.changed:
+        cb = cm.callbacks(run.p, d)
+        y, yp = reinitialize(cm, cb, t, y, yp)
+        y, yp, d, cb, stop2 = _event_iteration(run, cb, t, y, yp, d)
+        stop = stop or stop2
+    return y, yp, d, cb, stop
+
+
+def _event_iteration(run, cb, t, y, yp, d, initial=False):
+    """Fire ``recheck`` events whose condition is violated at this instant."""
+    cm = run.cm
+    checks = [i for i, e in enumerate(cm.events) if e.recheck]
+    if not checks:
+        return y, yp, d, cb, False
+    g = np.zeros(cm.n_roots)
+    for _ in range(MAX_ITER):
+        cb[2](t, y, yp, g)
+        obs = cb[4](t, y, yp)
+        state = EventState(cm, run.p, list(d), t, obs)
+        for i in checks:
+            ev = cm.events[i]
+            if (ev.direction < 0 and g[i] < 0) or (ev.direction > 0 and g[i] > 0):
+                _log_event(run, t, ev)
+                if ev.action is not None:
+                    ev.action(state)
+        if not state.changed:
+            return y, yp, d, cb, False
+        d = state.d
+        cb = cm.callbacks(run.p, d)
+        y, yp = reinitialize(cm, cb, t, y, yp)
+    raise ChatteringError(f"event iteration did not settle at t = {t:.6g} s "
+                          f"({MAX_ITER} mode changes at one instant) in "
+                          + ", ".join(sorted({cm.events[i].owner for i in checks})), t=t)
+
+
+def _log_event(run, t, ev):
+    run.events.append((t, ev.name))
+    run.event_log.append((t, ev.owner))
+    if len(run.event_log) >= CHATTER_COUNT:
+        t_first = run.event_log[-CHATTER_COUNT][0]
+        span = CHATTER_SPAN * max(run.t_end - run.t0, 1e-300)
+        if t - t_first <= span:
+            owners = sorted({o for _, o in run.event_log[-CHATTER_COUNT:]})
+            raise ChatteringError(
+                f"chattering: {CHATTER_COUNT} events between t = {t_first:.9g} and "
+                f"{t:.9g} s in {', '.join(owners)}; the mode logic does not settle", t=t,
+                component=owners[0], result=run.result("failed", "chattering"))
+
+
+def _failure(run, cm, r, cb):
+    """A SolverError naming the component whose equation is worst off."""
+    t = float(r.t)
+    n = len(cm.dae.y)
+    res = np.zeros(n)
+    comp = None
+    try:
+        cb[0](t, np.array(r.y), np.array(r.yp), res)
+        bad = ~np.isfinite(res)
+        k = int(np.argmax(bad)) if bad.any() else int(np.argmax(np.abs(res)))
+        org = cm.dae.origins[k]
+        comp = getattr(org, "origin", None)
+    except Exception:  # the residual itself may fail at the bad point
+        pass
+    nonfinite = [nm for nm, v in zip(cm.var_names, _safe_obs(cb, t, r)) if not np.isfinite(v)]
+    where = f" in {comp}" if comp else ""
+    extra = f"; non-finite values: {', '.join(nonfinite[:5])}" if nonfinite else ""
+    return SolverError(f"IDA failed at t = {t:.9g} s{where}: {r.message}{extra}", t=t,
+                       component=comp, result=run.result("failed", r.message))
+
+
+def _safe_obs(cb, t, r):
+    try:
+        return cb[4](t, np.array(r.y), np.array(r.yp))
+    except Exception:
+        return []

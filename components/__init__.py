@@ -1,0 +1,1 @@
+"""The mechanical component library. Sign convention: :mod:`acausal.connectors`."""
