@@ -1,0 +1,92 @@
+"""Records of a dataset: experiments, traces, instrument, and the error type."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+
+
+class DataError(ValueError):
+    """A problem in a data file, located by ``file``, ``line`` and ``column``.
+
+    The message reads ``file:LINE: column 'NAME': reason``; parts that are
+    unknown (``None``) are left out.
+    """
+
+    def __init__(self, reason, file=None, line=None, column=None):
+        self.reason, self.file, self.line, self.column = reason, file, line, column
+        where = "" if file is None else str(file)
+        where += "" if line is None else f":{line}"
+        col = "" if column is None else f"column '{column}': "
+        super().__init__(f"{where}: {col}{reason}" if where else col + reason)
+
+    def __reduce__(self):  # keep the attributes when pickled (e.g. by dask)
+        return type(self), (self.reason, self.file, self.line, self.column)
+
+
+@dataclass
+class Instrument:
+    """How one signal was measured; ``resolution`` and ``noise_std`` in SI."""
+
+    signal: str
+    resolution: float = 0.0
+    noise_std: float = 0.0
+
+    def floor(self) -> float:
+        """Per-sample standard deviation (SI) residuals should stay within.
+
+        Rounding to a step ``resolution`` adds an error uniform on
+        ``±resolution/2``, of standard deviation ``resolution/sqrt(12)``; it is
+        independent of the noise, so the variances add:
+        ``sqrt(noise_std**2 + resolution**2 / 12)``.
+        """
+        return math.hypot(self.noise_std, self.resolution / math.sqrt(12.0))
+
+
+@dataclass
+class Trace:
+    """Sampled signals: ``time`` in s, ``signals`` name -> array in SI."""
+
+    time: np.ndarray
+    signals: dict[str, np.ndarray]
+    file: Optional[Path] = None
+
+
+@dataclass
+class Experiment:
+    """One experiment: SI ``conditions`` and measured-only SI ``measures``."""
+
+    name: str
+    conditions: dict[str, float]
+    measures: dict[str, float] = field(default_factory=dict)
+    trace: Optional[Trace] = None
+    line: Optional[int] = None
+
+
+@dataclass
+class Dataset:
+    """Experiments and instrument description read from (or for) ``folder``."""
+
+    folder: Optional[Path]
+    experiments: list[Experiment]
+    instrument: dict[str, Instrument] = field(default_factory=dict)
+
+    @property
+    def condition_names(self) -> list[str]:
+        """Condition names, in column order."""
+        return list(dict.fromkeys(n for e in self.experiments for n in e.conditions))
+
+    @property
+    def measure_names(self) -> list[str]:
+        """Names of the measures taken in at least one experiment."""
+        return list(dict.fromkeys(n for e in self.experiments for n in e.measures))
+
+    def experiment(self, name: str) -> Experiment:
+        """The experiment called ``name`` (KeyError if there is none)."""
+        for e in self.experiments:
+            if e.name == name:
+                return e
+        raise KeyError(f"no experiment {name!r}")

@@ -1,0 +1,91 @@
+"""Reading CSV tables: comments, unit brackets in headers, located numeric cells."""
+from __future__ import annotations
+
+import csv
+import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+
+from .records import DataError
+
+_HEADER = re.compile(r"^(?P<name>[^\[\]]*?)\s*(?:\[(?P<unit>[^\[\]]*)\])?$")
+
+
+@dataclass
+class Table:
+    """A CSV file read as text: header names and units, rows with line numbers."""
+
+    file: Path
+    header_line: int
+    names: list[str]
+    units: list[Optional[str]]
+    rows: list[tuple[int, list[str]]]
+
+    def column(self, name: str, required: bool = True) -> Optional[int]:
+        """Index of column ``name``; DataError if required and absent."""
+        if name in self.names:
+            return self.names.index(name)
+        if required:
+            raise DataError("missing column", self.file, self.header_line, name)
+        return None
+
+    def header(self, k: int) -> str:
+        """The header text of column ``k`` as written (``'thrt [ms]'``)."""
+        unit = self.units[k]
+        return self.names[k] if unit is None else f"{self.names[k]} [{unit}]"
+
+    def numbers(self, k: int, required: bool) -> np.ndarray:
+        """Column ``k`` as floats, NaN for empty cells (error if ``required``)."""
+        out = np.empty(len(self.rows))
+        for i, (line, cells) in enumerate(self.rows):
+            out[i] = number(cells[k], required, (self.file, line, self.names[k]))
+        return out
+
+
+def number(cell: str, required: bool, where: tuple) -> float:
+    """One cell as a finite float; NaN if empty and not ``required``."""
+    if not cell:
+        if required:
+            raise DataError("missing value", *where)
+        return math.nan
+    try:
+        value = float(cell)
+    except ValueError:
+        raise DataError(f"not a number: {cell!r}", *where) from None
+    if not math.isfinite(value):
+        raise DataError(f"{cell!r} is not a finite number", *where)
+    return value
+
+
+def read_table(path: Path) -> Table:
+    """Read a CSV file: header, unit brackets, rows of the header's width."""
+    if not path.is_file():
+        raise DataError("file not found", path)
+    rows = []
+    with path.open(newline="", encoding="utf-8-sig") as f:
+        for line, text in enumerate(f, start=1):
+            if text.strip() and not text.lstrip().startswith("#"):
+                rows.append((line, [c.strip() for c in next(csv.reader([text]))]))
+    if not rows:
+        raise DataError("no header row", path)
+    (line, header), rows = rows[0], rows[1:]
+    names, units = [], []
+    for text in header:
+        match = _HEADER.match(text)
+        if match is None or not match["name"]:
+            raise DataError(f"cannot read header {text!r}: expected 'name' or "
+                            "'name [unit]'", path, line, text)
+        if match["name"] in names:
+            raise DataError("duplicate column", path, line, match["name"])
+        names.append(match["name"])
+        units.append(match["unit"])
+    for row_line, cells in rows:
+        if len(cells) != len(names):
+            column = names[len(cells)] if len(cells) < len(names) else None
+            raise DataError(f"row has {len(cells)} cells, header has {len(names)}",
+                            path, row_line, column)
+    return Table(path, line, names, units, rows)
