@@ -1,0 +1,110 @@
+"""Model files: plain Python scripts that build a model.
+
+A model file binds a :class:`~acausal.Model` to the module-level name
+``model``; it may define ``experiment`` (an :class:`~acausal.Experiment`)
+and ``measures``, a dict of name -> function(result) -> float (a scalar
+computed from a result, such as a response time). A model file can import
+another one (``from breaker_24kv import build``): its folder is on the path.
+"""
+import os
+import runpy
+import sys
+import traceback
+from dataclasses import dataclass, field
+
+from .compile import compile_model
+from .component import Model
+from .errors import AcausalError, ModelFileError
+from .experiment import Experiment
+
+
+@dataclass
+class ModelFile:
+    path: str
+    model: Model
+    experiment: Experiment
+    measures: dict = field(default_factory=dict)
+    namespace: dict = field(default_factory=dict)
+
+
+def _where(exc, path):
+    """'file:line' of the deepest frame of ``exc`` inside ``path``."""
+    line = None
+    for fr in traceback.extract_tb(exc.__traceback__):
+        if os.path.abspath(fr.filename) == path:
+            line = fr.lineno
+    return f"{path}:{line}" if line else path
+
+
+def load_model_file(path):
+    """Run a model file and collect ``model``, ``experiment`` and ``measures``."""
+    path = os.path.abspath(path)
+    if not os.path.isfile(path):
+        raise ModelFileError(f"{path}: no such model file")
+    folder = os.path.dirname(path)
+    added = folder not in sys.path
+    if added:
+        sys.path.insert(0, folder)
+    try:
+        ns = runpy.run_path(path, run_name="__acausal_model__")
+    except SyntaxError as exc:
+        raise ModelFileError(f"{exc.filename}:{exc.lineno}: syntax error: {exc.msg}") from None
+    except AcausalError as exc:
+        raise ModelFileError(f"{_where(exc, path)}: {exc}") from None
+    except Exception as exc:  # a bug in the script: say where
+        raise ModelFileError(f"{_where(exc, path)}: {type(exc).__name__}: {exc}") from None
+    finally:
+        if added:
+            sys.path.remove(folder)
+    model = ns.get("model")
+    if not isinstance(model, Model):
+        raise ModelFileError(f"{path}: a model file must bind a Model to the name 'model'"
+                             + (f" (found {type(model).__name__})" if model is not None else ""))
+    exp = ns.get("experiment") or Experiment()
+    if not isinstance(exp, Experiment):
+        raise ModelFileError(f"{path}: 'experiment' must be an acausal.Experiment")
+    measures = ns.get("measures") or {}
+    if not isinstance(measures, dict) or not all(callable(f) for f in measures.values()):
+        raise ModelFileError(f"{path}: 'measures' must be a dict of name -> function(result)")
+    return ModelFile(path, model, exp, dict(measures), ns)
+
+
+_CACHE = {}
+
+
+def compile_file(path):
+    """(ModelFile, CompiledModel) for a model file, compiled once per process
+    and file version."""
+    apath = os.path.abspath(path)
+    key = (apath, os.path.getmtime(apath) if os.path.exists(apath) else None)
+    hit = _CACHE.get(key)
+    if hit is not None:
+        return hit
+    mf = load_model_file(apath)
+    if mf.experiment.stop is not None:
+        mf.model.event(mf.experiment.stop.event(mf.model))
+    cm = compile_model(mf.model)
+    _CACHE[key] = (mf, cm)
+    return mf, cm
+
+
+def evaluate_measures(mf, result):
+    """name -> float for every measure; a measure that fails raises an error
+    naming it."""
+    out = {}
+    for name, fn in mf.measures.items():
+        try:
+            out[name] = float(fn(result))
+        except Exception as exc:
+            raise ModelFileError(f"{mf.path}: measure {name!r} failed: "
+                                 f"{type(exc).__name__}: {exc}") from None
+    return out
+
+
+def run_file(path, params=None, **overrides):
+    """Simulate a model file; returns (result, measures)."""
+    mf, cm = compile_file(path)
+    opts = mf.experiment.run_options()
+    opts.update({k: v for k, v in overrides.items() if v is not None})
+    res = cm.simulate(params=params, **opts)
+    return res, evaluate_measures(mf, res)
