@@ -1,0 +1,483 @@
+"""Parameter sweeps: parse ranges, build a grid, run it in parallel, resume, plot.
+
+A sweep maps each point of a grid (a dict ``{param_name: float}``) through a
+``task(point) -> {measure_name: value}`` on an executor from
+:func:`acausal.executor.open_executor`. Every finished point is appended to a
+CSV file at once, so a sweep that stops midway loses no finished work, and
+running it again with the same CSV computes only the missing points::
+
+    params = [parse_param("v_impact=3:5:21"), parse_param("contact.K=1e5,1e6")]
+    with open_executor(workers=2) as ex:
+        rows = run_sweep(task, grid(params), "out/sweep.csv",
+                         executor=ex, measures=["peak_force", "rebound"])
+    plot_sweep(rows, "v_impact", "peak_force", "out/peak_force.png")
+
+CSV columns: the parameter names, the measure names, ``status`` (``ok`` or
+``failed``), ``error`` (``ExceptionType: message`` on one line, empty when ok)
+and ``wall_s`` (task run time measured where it ran). Parameters and measures
+are written with ``repr`` of Python floats, which round-trips exactly; points
+are matched between runs by these values.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import csv
+import itertools
+import math
+import pickle
+import re
+import sys
+import time
+import warnings
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["parse_param", "grid", "run_sweep", "plot_sweep", "SweepRows", "SweepAborted"]
+
+RESERVED = ("status", "error", "wall_s")
+_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*$")
+_MAX_ERROR_CHARS = 500
+
+
+class SweepAborted(RuntimeError):
+    """The executor failed (not the task); finished points are saved in the CSV."""
+
+
+class SweepRows(list):
+    """A list of row dicts that also records which columns are parameters/measures."""
+
+    def __init__(self, rows: Iterable[dict], params: Sequence[str], measures: Sequence[str]):
+        super().__init__(rows)
+        self.params = tuple(params)
+        self.measures = tuple(measures)
+
+
+# ---------------------------------------------------------------------------
+# Parameter specs and grids
+# ---------------------------------------------------------------------------
+
+
+def _number(text: str, spec: str, what: str) -> float:
+    """Parse one finite float of ``spec`` or raise a ValueError naming it."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise ValueError(f"bad parameter spec {spec!r}: {what} {text.strip()!r} is not a number") from None
+    if not math.isfinite(value):
+        raise ValueError(f"bad parameter spec {spec!r}: {what} must be finite, got {text.strip()!r}")
+    return value
+
+
+def _range_values(text: str, spec: str) -> np.ndarray:
+    """Values of ``start:stop:count`` (inclusive linspace)."""
+    parts = text.split(":")
+    if len(parts) != 3:
+        raise ValueError(f"bad parameter spec {spec!r}: a range is start:stop:count, e.g. 'x=3.0:5.0:21'")
+    start = _number(parts[0], spec, "start")
+    stop = _number(parts[1], spec, "stop")
+    try:
+        count = int(parts[2])
+    except ValueError:
+        raise ValueError(f"bad parameter spec {spec!r}: count {parts[2].strip()!r} must be an integer >= 1") from None
+    if count < 1:
+        raise ValueError(f"bad parameter spec {spec!r}: count must be an integer >= 1, got {count}")
+    if count == 1 and start != stop:
+        raise ValueError(f"bad parameter spec {spec!r}: count 1 is only allowed with start == stop")
+    return np.linspace(start, stop, count)
+
+
+def parse_param(spec: str) -> tuple[str, np.ndarray]:
+    """Parse ``"name=values"`` into ``(name, float array)``.
+
+    Values are ``start:stop:count`` (inclusive linspace, e.g. ``"v=3.0:5.0:21"``),
+    a comma list (``"k=1,2,5"``) or one number (``"k=3"``). Names are dotted
+    identifiers such as ``contact.K``. Raises ValueError naming ``spec`` if it is
+    malformed, has non-finite or repeated values, or a count that is not an
+    integer >= 1.
+    """
+    if not isinstance(spec, str) or "=" not in spec:
+        raise ValueError(f"bad parameter spec {spec!r}: expected name=values, e.g. 'contact.K=1e5,1e6'")
+    name, text = (part.strip() for part in spec.split("=", 1))
+    if not _NAME.match(name):
+        raise ValueError(f"bad parameter spec {spec!r}: {name!r} is not a (dotted) parameter name")
+    if not text:
+        raise ValueError(f"bad parameter spec {spec!r}: no values after '='")
+    if ":" in text:
+        values = _range_values(text, spec)
+    else:
+        values = np.array([_number(item, spec, "value") for item in text.split(",")], dtype=float)
+    if len(np.unique(values)) != len(values):
+        raise ValueError(f"bad parameter spec {spec!r}: values repeat")
+    return name, values
+
+
+def grid(params: Sequence[tuple[str, Iterable[float]]]) -> list[dict[str, float]]:
+    """Cartesian product of ``[(name, values), ...]`` as a list of point dicts.
+
+    Order is deterministic: the last parameter varies fastest (like nested
+    loops in the order given). Values become Python floats.
+    """
+    names = [name for name, _ in params]
+    if len(set(names)) != len(names):
+        raise ValueError(f"parameter names repeat: {names}")
+    value_lists = [[float(v) for v in np.asarray(values, dtype=float).ravel()] for _, values in params]
+    return [dict(zip(names, combo)) for combo in itertools.product(*value_lists)]
+
+
+# ---------------------------------------------------------------------------
+# Running one point (executes on a worker)
+# ---------------------------------------------------------------------------
+
+
+def _one_line(exc: BaseException) -> str:
+    """``"Type: message"`` on one line, capped in length."""
+    message = " ".join(str(exc).split())
+    text = f"{type(exc).__name__}: {message}" if message else type(exc).__name__
+    return text if len(text) <= _MAX_ERROR_CHARS else text[: _MAX_ERROR_CHARS - 3] + "..."
+
+
+def _scalar(name: str, value: Any) -> float | str:
+    """A measure value as float (numbers, None -> nan) or str."""
+    if value is None:
+        return math.nan
+    if isinstance(value, str):
+        return value
+    arr = np.asarray(value)
+    if arr.shape == () and arr.dtype.kind in "biuf":
+        return float(arr)
+    raise TypeError(f"measure {name!r} must be a real scalar or a string, got {type(value).__name__}")
+
+
+def _measure_values(result: Any, measures: Sequence[str]) -> dict[str, float | str]:
+    """Pick and convert the measures from a task result."""
+    if not isinstance(result, Mapping):
+        raise TypeError(f"task must return a dict of measures, got {type(result).__name__}")
+    missing = [m for m in measures if m not in result]
+    if missing:
+        raise KeyError(f"task result lacks measures {missing}")
+    return {m: _scalar(m, result[m]) for m in measures}
+
+
+def _run_point(task: Callable[[dict], Mapping], point: dict, measures: Sequence[str]) -> dict:
+    """Run ``task(point)``; task Exceptions become a ``failed`` record.
+
+    Runs on the worker, so only plain data (floats, strings) travels back.
+    BaseExceptions such as KeyboardInterrupt propagate and stop the sweep.
+    """
+    start = time.perf_counter()
+    try:
+        values = _measure_values(task(dict(point)), measures)
+    except Exception as exc:
+        return {"status": "failed", "error": _one_line(exc), "values": {}, "wall_s": time.perf_counter() - start}
+    return {"status": "ok", "error": "", "values": values, "wall_s": time.perf_counter() - start}
+
+
+# ---------------------------------------------------------------------------
+# CSV cells and rows
+# ---------------------------------------------------------------------------
+
+
+def _key(values: Mapping, params: Sequence[str]) -> tuple[str, ...]:
+    """Identity of a point: repr-exact floats of its parameters."""
+    return tuple(repr(float(values[p])) for p in params)
+
+
+def _cell(value: float | str) -> str:
+    return repr(float(value)) if isinstance(value, float) else str(value)
+
+
+def _format_cells(point: Mapping, record: dict, params: Sequence[str], measures: Sequence[str]) -> dict[str, str]:
+    cells = {p: repr(float(point[p])) for p in params}
+    cells.update({m: _cell(record["values"][m]) if m in record["values"] else "" for m in measures})
+    cells.update(status=record["status"], error=record["error"], wall_s=f"{record['wall_s']:.6f}")
+    return cells
+
+
+def _parse_measure(text: str) -> float | str:
+    if text == "":
+        return math.nan
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
+def _parse_row(cells: Mapping[str, str], params: Sequence[str], measures: Sequence[str]) -> dict:
+    """Row dict (params, measures, status, error, wall_s) from CSV cells."""
+    row: dict[str, Any] = {p: float(cells[p]) for p in params}
+    row.update({m: _parse_measure(cells[m]) for m in measures})
+    wall = cells["wall_s"]
+    row.update(status=cells["status"], error=cells["error"], wall_s=float(wall) if wall else math.nan)
+    return row
+
+
+# ---------------------------------------------------------------------------
+# CSV file: load for resume, append as points finish
+# ---------------------------------------------------------------------------
+
+
+def _repair_tail(path: Path) -> None:
+    """Cut a partial last line (left by a crash mid-write) so appends stay aligned."""
+    with open(path, "rb+") as f:
+        data = f.read()
+        if data and not data.endswith(b"\n"):
+            f.truncate(data.rfind(b"\n") + 1)
+            warnings.warn(f"{path}: dropped an incomplete last line", RuntimeWarning, stacklevel=3)
+
+
+def _check_header(path: Path, header: list[str], columns: Sequence[str]) -> None:
+    if len(set(header)) != len(header) or set(header) != set(columns):
+        raise ValueError(
+            f"{path} holds a sweep with columns {header}, but this sweep writes {list(columns)}; "
+            "use another out_csv (or delete it) instead of mixing sweeps"
+        )
+
+
+def _load_rows(path: Path, params: Sequence[str], measures: Sequence[str]) -> tuple[list[str] | None, dict]:
+    """Read a previous run's rows keyed by point; ``(None, {})`` if there is none."""
+    if not path.exists() or path.stat().st_size == 0:
+        return None, {}
+    _repair_tail(path)
+    with open(path, newline="", encoding="utf-8") as f:
+        reader = csv.reader(f)
+        header = next(reader, None)
+        if header is None:
+            return None, {}
+        _check_header(path, header, [*params, *measures, *RESERVED])
+        rows, bad = {}, 0
+        for line in reader:
+            cells = dict(zip(header, line))
+            try:
+                if len(line) != len(header) or cells["status"] not in ("ok", "failed"):
+                    raise ValueError
+                rows[_key(cells, params)] = _parse_row(cells, params, measures)
+            except ValueError:
+                bad += 1
+    if bad:
+        warnings.warn(f"{path}: ignored {bad} malformed line(s); those points will be recomputed",
+                      RuntimeWarning, stacklevel=3)
+    return header, rows
+
+
+@contextlib.contextmanager
+def _csv_appender(path: Path, header: Sequence[str], new: bool):
+    """Yield ``append(cells)`` that writes one row and flushes it."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "w" if new else "a", newline="", encoding="utf-8") as f:
+        writer = csv.DictWriter(f, fieldnames=list(header), lineterminator="\n")
+        if new:
+            writer.writeheader()
+            f.flush()
+
+        def append(cells: dict[str, str]) -> None:
+            writer.writerow(cells)
+            f.flush()
+
+        yield append
+
+
+# ---------------------------------------------------------------------------
+# run_sweep
+# ---------------------------------------------------------------------------
+
+
+def _param_names(points: Sequence[Mapping]) -> tuple[str, ...]:
+    if not points:
+        raise ValueError("run_sweep needs at least one point")
+    names = tuple(points[0])
+    for point in points:
+        if tuple(point) != names:
+            raise ValueError(f"all points must have the same parameters {list(names)}, got {list(point)}")
+    clash = [n for n in names if n in RESERVED]
+    if clash:
+        raise ValueError(f"parameter names {clash} are reserved CSV columns")
+    return names
+
+
+def _check_measures(measures: Sequence[str], params: Sequence[str]) -> tuple[str, ...]:
+    measures = (measures,) if isinstance(measures, str) else tuple(measures)
+    if not measures or not all(isinstance(m, str) and m for m in measures):
+        raise ValueError(f"measures must be a non-empty list of names, got {measures!r}")
+    if len(set(measures)) != len(measures):
+        raise ValueError(f"measure names repeat: {list(measures)}")
+    clash = [m for m in measures if m in RESERVED or m in params]
+    if clash:
+        raise ValueError(f"measure names {clash} clash with parameters or reserved columns")
+    return measures
+
+
+def _check_picklable(task: Callable) -> None:
+    try:
+        pickle.dumps(task)
+    except Exception as exc:
+        raise TypeError(
+            "the sweep task must be picklable for a process pool: use a module-level "
+            f"function or a functools.partial of one ({_one_line(exc)})"
+        ) from exc
+
+
+def _result(future: Any) -> dict:
+    """The record of a finished future; executor failures abort the sweep."""
+    try:
+        return future.result()
+    except Exception as exc:  # task errors are caught on the worker, so this is the executor's
+        raise SweepAborted(
+            f"sweep stopped by an executor failure ({_one_line(exc)}); finished points are "
+            "saved, rerun with the same out_csv to resume"
+        ) from exc
+
+
+def _progress_bar(total: int, initial: int, enabled: bool):
+    from tqdm import tqdm
+
+    return tqdm(total=total, initial=initial, disable=not enabled, file=sys.stderr, desc="sweep", unit="pt")
+
+
+def _collect(executor, futures: dict, on_row: Callable[[dict, dict], None], bar) -> None:
+    """Record futures as they finish; cancel the rest if anything goes wrong."""
+    failed = 0
+    try:
+        for future in executor.as_completed(list(futures)):
+            record = _result(future)
+            on_row(futures[future], record)
+            failed += record["status"] == "failed"
+            if failed:
+                bar.set_postfix(failed=failed, refresh=False)
+            bar.update(1)
+    except BaseException:
+        executor.cancel(list(futures))
+        raise
+    finally:
+        bar.close()
+
+
+def run_sweep(
+    task: Callable[[dict], Mapping],
+    points: Sequence[Mapping[str, float]],
+    out_csv: str | Path,
+    *,
+    executor,
+    measures: Sequence[str],
+    progress: bool = True,
+) -> SweepRows:
+    """Run ``task(point)`` for every point not already in ``out_csv``.
+
+    Args:
+        task: ``task(point) -> {measure: value}``; for a process pool it must be
+            picklable (a module-level function or ``functools.partial`` of one).
+            Expensive set-up belongs in :func:`acausal.executor.worker_cache`.
+        points: dicts ``{param: float}`` with the same keys, e.g. from :func:`grid`.
+        out_csv: results file. Each finished point is appended and flushed at
+            once. Points already in it (status ok *or* failed) are not rerun; to
+            retry failures, delete their lines. A file from a sweep with other
+            parameter/measure columns is refused (ValueError).
+        executor: an :class:`acausal.executor.Executor` (from ``open_executor``).
+        measures: names to take from each task result (numbers or strings).
+        progress: show a tqdm progress bar on stderr.
+
+    Returns:
+        :class:`SweepRows` (a list) with one row per point, in ``points`` order:
+        ``{param: float, measure: float|str (nan if failed), status, error, wall_s}``.
+        Rows in ``out_csv`` for points not in ``points`` are kept in the file but
+        not returned.
+
+    A task exception marks only its point failed. KeyboardInterrupt (also one
+    raised in a process-pool worker) stops the sweep and propagates; a broken
+    executor raises :class:`SweepAborted`. Either way finished points are saved.
+    """
+    points = [dict(p) for p in points]
+    params = _param_names(points)
+    measures = _check_measures(measures, params)
+    out_csv = Path(out_csv)
+    header, done = _load_rows(out_csv, params, measures)
+    todo = list({_key(p, params): p for p in points if _key(p, params) not in done}.values())
+    if todo and executor.needs_pickle:
+        _check_picklable(task)
+
+    with _csv_appender(out_csv, header or [*params, *measures, *RESERVED], new=header is None) as append:
+
+        def on_row(point: dict, record: dict) -> None:
+            cells = _format_cells(point, record, params, measures)
+            append(cells)
+            done[_key(point, params)] = _parse_row(cells, params, measures)
+
+        futures = {executor.submit(_run_point, task, p, measures): p for p in todo}
+        n_unique = len({_key(p, params) for p in points})
+        bar = _progress_bar(n_unique, n_unique - len(todo), progress)
+        _collect(executor, futures, on_row, bar)
+    return SweepRows((done[_key(p, params)] for p in points), params, measures)
+
+
+# ---------------------------------------------------------------------------
+# Plot
+# ---------------------------------------------------------------------------
+
+
+def _series_param(rows: Sequence[Mapping], x: str, by: str | None) -> str | None:
+    """The parameter that splits rows into lines (explicit, or inferred from SweepRows)."""
+    if by is not None or not isinstance(rows, SweepRows):
+        return by
+    others = [p for p in rows.params if p != x and len({r[p] for r in rows}) > 1]
+    if len(others) > 1:
+        raise ValueError(f"rows vary in {others} besides {x!r}; pass by= and rows with the others fixed")
+    return others[0] if others else None
+
+
+def _series(rows: Sequence[Mapping], x: str, by: str | None) -> list[tuple[Any, list[Mapping]]]:
+    """Rows grouped by ``by`` value (one group if None), each sorted by ``x``."""
+    groups: dict[Any, list[Mapping]] = {}
+    for row in rows:
+        groups.setdefault(row[by] if by else None, []).append(row)
+    series = []
+    for value, group in groups.items():
+        xs = [r[x] for r in group]
+        if len(set(xs)) != len(xs):
+            raise ValueError(f"several rows share one {x!r} value in a line; pass by= (or fix other parameters)")
+        series.append((value, sorted(group, key=lambda r: r[x])))
+    return series
+
+
+def _plot_series(ax, group: list[Mapping], x: str, measure: str, label: str | None) -> bool:
+    """One line (failed points are gaps, marked by an x at the bottom); True if any failed."""
+    xs = [r[x] for r in group]
+    ys = [float(r[measure]) if r["status"] == "ok" else math.nan for r in group]
+    (line,) = ax.plot(xs, ys, "o-", ms=3, label=label)
+    failed = [r[x] for r in group if r["status"] != "ok"]
+    if failed:
+        ax.plot(failed, [0.03] * len(failed), "x", color=line.get_color(), ms=8, mew=2,
+                transform=ax.get_xaxis_transform(), clip_on=False)
+    return bool(failed)
+
+
+def plot_sweep(rows: Sequence[Mapping], x: str, measure: str, path: str | Path, *, by: str | None = None) -> Path:
+    """Save a line plot of ``measure`` against parameter ``x`` to ``path``.
+
+    One line per value of ``by``; with rows from :func:`run_sweep` of a 2-D grid,
+    ``by`` defaults to the other parameter. Failed points leave a gap in their
+    line and are marked with an ``x`` at the bottom of the axes. Uses a bare
+    matplotlib ``Figure`` (Agg), so no pyplot state or backend is touched.
+    """
+    from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
+
+    by = _series_param(rows, x, by)
+    fig = Figure(figsize=(6.4, 4.2), layout="constrained")
+    ax = fig.add_subplot()
+    any_failed = False
+    for value, group in _series(rows, x, by):
+        label = f"{by} = {value:g}" if by else None
+        any_failed |= _plot_series(ax, group, x, measure, label)
+    handles, _ = ax.get_legend_handles_labels()
+    if any_failed:
+        handles.append(Line2D([], [], ls="", marker="x", color="0.3", mew=2, label="failed"))
+    if handles:
+        ax.legend(handles=handles, fontsize="small")
+    ax.set_xlabel(x)
+    ax.set_ylabel(measure)
+    ax.grid(alpha=0.3)
+    fig.savefig(path, dpi=120)
+    return Path(path)
