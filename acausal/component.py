@@ -205,6 +205,8 @@ class Model(Component):
 
     def variable(self, name, start=0.0, unit="1", desc="", fixed=False):
         """Declare a variable of this model; returns its symbol."""
+        if isinstance(start, Start):
+            start, fixed = start.value, start.fixed
         v = Variable(start, unit, desc, fixed=fixed)
         v.name = name
         self._extra[name] = v

@@ -98,8 +98,10 @@ class _Run:
         if alg:
             kw["algebraic_idx"] = alg
         if self.cm.n_roots:
-            def roots(t, y, yp, g, _f=cb[2]):
-                _f(t, y, yp, g)
+            f = cb[2]
+
+            def roots(t, y, yp, g):
+                f(t, y, yp, g)
             roots.terminal = [True] * self.cm.n_roots
             roots.direction = list(self.directions)
             kw.update(eventsfn=roots, num_events=self.cm.n_roots)
