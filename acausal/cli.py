@@ -125,5 +125,53 @@ def variables(file):
         click.echo(f"  {d.symbol.name:32s} [{d.unit}] {d.desc}; discrete, start {d.start.value}")
 
 
+@main.command()
+@click.argument("file", type=click.Path(dir_okay=False))
+@click.argument("data", type=click.Path(file_okay=False))
+@click.option("--fit", required=True, metavar="P1,P2,...",
+              help="parameters to fit; with --method report give PARAM:MEASURE pairs "
+                   "in the order the report calibrates them (contact.K:contact_period,hook.bh:thrt)")
+@click.option("--method", type=click.Choice(["lsq", "report"]), default="lsq", show_default=True)
+@click.option("--json", "as_json", is_flag=True, help="print one JSON object")
+def calibrate(file, data, fit, method, as_json):
+    """Fit parameters of a model file to a measured dataset."""
+    from . import calibrate as cal
+    from .modelfile import compile_file
+    try:
+        mf, cm = compile_file(file)
+        ds = cal.model_dataset(file, data)
+        items = [x.strip() for x in fit.split(",") if x.strip()]
+        if method == "report":
+            pairs = []
+            for it in items:
+                if ":" not in it:
+                    raise click.BadParameter(f"--fit {it!r}: the report method needs PARAM:MEASURE")
+                p, m = it.split(":", 1)
+                pairs.append((p, m))
+            cal.check_names(cm, [p for p, _ in pairs])
+            out = cal.report_method(file, ds, pairs)
+        else:
+            names = [it.split(":", 1)[0] for it in items]
+            cal.check_names(cm, names)
+            out = cal.least_squares(file, ds, names)
+    except (AcausalError, click.BadParameter) as exc:
+        _fail(exc)
+    if as_json:
+        click.echo(json.dumps(out.to_dict(), indent=1, default=float))
+        return
+    click.echo(f"calibration ({out.method}) of {file} against {data}: {out.n_sim} simulations")
+    for name, v in out.values.items():
+        ci = out.ci95.get(name)
+        ci_s = f"  95% CI [{ci[0]:.6g}, {ci[1]:.6g}]" if ci else ""
+        click.echo(f"  {name} = {v:.6g}{ci_s}")
+    if out.correlation is not None and len(out.values) > 1:
+        click.echo("  correlation:")
+        for name, row in zip(out.values, out.correlation):
+            click.echo(f"    {name:20s} " + " ".join(f"{x:+.3f}" for x in row))
+    click.echo("  residuals (simulated - measured):")
+    for exp, sig in out.residuals.items():
+        click.echo(f"    {exp}: " + ", ".join(f"{k} {v:+.4g}" for k, v in sig.items()))
+
+
 if __name__ == "__main__":  # pragma: no cover
     main()
