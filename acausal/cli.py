@@ -173,5 +173,45 @@ def calibrate(file, data, fit, method, as_json):
         click.echo(f"    {exp}: " + ", ".join(f"{k} {v:+.4g}" for k, v in sig.items()))
 
 
+@main.command()
+@click.argument("file", type=click.Path(dir_okay=False))
+@click.option("--param", "params", multiple=True, required=True, metavar="NAME=A:B:N",
+              help="a swept parameter: start:stop:count, a list a,b,c, or one value")
+@click.option("--measure", "measures", multiple=True, required=True, help="measure(s) to record")
+@click.option("--out", type=click.Path(dir_okay=False), default="sweep.csv", show_default=True,
+              help="results CSV; running again with the same file resumes")
+@click.option("--plot", type=click.Path(dir_okay=False), help="plot the first measure")
+@click.option("--scheduler", help="Dask scheduler address (default: local processes)")
+@click.option("--workers", type=int, help="local worker processes (default: all cores)")
+@click.option("--no-progress", is_flag=True)
+def sweep(file, params, measures, out, plot, scheduler, workers, no_progress):
+    """Run a grid of simulations in parallel."""
+    import functools
+    import os
+
+    from .executor import open_executor
+    from .modelfile import compile_file, sweep_task
+    from .sweep import grid, parse_param, plot_sweep, run_sweep
+    try:
+        mf, cm = compile_file(file)
+        specs = [parse_param(p) for p in params]
+        for name, _ in specs:
+            cm.param_index(name)
+        for m in measures:
+            if m not in mf.measures:
+                raise click.BadParameter(f"--measure {m!r}: the model file defines "
+                                         f"{sorted(mf.measures) or 'no measures'}")
+        task = functools.partial(sweep_task, os.path.abspath(file))
+        with open_executor(scheduler, workers) as ex:
+            rows = run_sweep(task, grid(specs), out, executor=ex, measures=list(measures),
+                             progress=not no_progress)
+        if plot:
+            plot_sweep(rows, specs[0][0], measures[0], plot)
+    except (AcausalError, click.BadParameter, ValueError) as exc:
+        _fail(exc)
+    failed = sum(1 for r in rows if r.get("status") != "ok")
+    click.echo(f"{len(rows)} points, {failed} failed; results in {out}")
+
+
 if __name__ == "__main__":  # pragma: no cover
     main()
