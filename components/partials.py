@@ -146,11 +146,13 @@ class PartialSource(Component):
       takes two arguments, of its rate (velocity or angular velocity); it
       returns a sympy expression (it may also use ``acausal.time``).
 
-    A leaf sets ``quantity`` = (name, unit, description), declares the
-    Variable of that name and writes its connector equation.
+    A leaf sets ``quantity`` = (name, unit, description) and
+    ``across_name``, declares the Variable of that name and writes its
+    connector equation with :meth:`law`.
     """
 
     quantity = ("u", "1", "source value")
+    across_name = "across variable"   # how the law's argument is called in messages
 
     def __init__(self, value=0.0, **kw):
         super().__init__(**kw)
@@ -172,11 +174,8 @@ class PartialSource(Component):
             self._call(value, sp.Symbol("x"), sp.Symbol("v"))  # fail early
         else:
             raise ParameterError(f"{where} must be a number, a sympy expression or a "
-                                 f"function of the flange {self._across_name()}, "
+                                 f"function of the flange {self.across_name}, "
                                  f"got {value!r}")
-
-    def _across_name(self):
-        return "position" if self.quantity[0] == "f" else "angle"
 
     def _call(self, fn, x, v):
         name = self.quantity[0]
@@ -184,14 +183,18 @@ class PartialSource(Component):
         n = _n_positional(fn)
         if n not in (1, 2):
             raise ParameterError(f"{where}: the {name} law must take 1 argument (the "
-                                 f"flange {self._across_name()}) or 2 (and its rate); "
+                                 f"flange {self.across_name}) or 2 (and its rate); "
                                  f"it takes {n}")
         try:
             out = fn(x) if n == 1 else fn(x, v)
-            return sp.sympify(out)
+            return sp.sympify(out, strict=True)
         except Exception as exc:
+            hint = ""
+            if "truth value" in str(exc):
+                hint = " (the law gets sympy symbols: use sympy.Max/Min/Piecewise, not " \
+                       "max/min/if)"
             raise ParameterError(f"{where}: the {name} law failed: "
-                                 f"{type(exc).__name__}: {exc}") from None
+                                 f"{type(exc).__name__}: {exc}{hint}") from None
 
     def law(self, x):
         """The source value as a sympy expression; ``x`` is the flange's

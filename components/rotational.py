@@ -127,6 +127,7 @@ class Torque(PartialSource):
     """
 
     quantity = ("tau", "N*m", "applied torque about +phi")
+    across_name = "angle"
     flange = RotFlange("flange the torque acts on")
     tau = Variable(0.0, "N*m", "applied torque about +phi")
 

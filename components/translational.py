@@ -129,6 +129,7 @@ class Force(PartialSource):
     """
 
     quantity = ("f", "N", "applied force along +s")
+    across_name = "position"
     flange = Flange("flange the force acts on")
     f = Variable(0.0, "N", "applied force along +s")
 

@@ -275,6 +275,8 @@ def test_force_law_validation():
         Force(f=lambda s, v, a: s)
     with pytest.raises(ParameterError, match=r"the f law failed: ZeroDivisionError"):
         Force(f=lambda s: 1 / 0)
+    with pytest.raises(ParameterError, match=r"use sympy\.Max/Min/Piecewise"):
+        Force(f=lambda s: max(s, 0.0))
     with pytest.raises(ParameterError, match=r"parameter Force\.f_const = inf"):
         Force(f=float("inf"))
     with pytest.raises(ParameterError, match=r"Position\.s must be"):
