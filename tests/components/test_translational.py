@@ -136,12 +136,15 @@ def test_force_of_time():
     assert maxerr(res, "force.flange.f", -F0 * np.sin(W * t)) < 1e-12
 
 
-def test_force_of_position_harmonic():
+@pytest.mark.parametrize("kind", ["lambda", "sympy.Lambda"])
+def test_force_of_position_harmonic(kind):
     """F = k0*(g0 - s): harmonic about g0 at sqrt(k0/m)."""
     m, k0, g0, s0 = 0.8, 500.0, 0.02, 0.07
+    x = sp.Symbol("x")
+    law = (lambda s: k0 * (g0 - s)) if kind == "lambda" else sp.Lambda(x, k0 * (g0 - x))
     model = Model()
     model.mass = Mass(m=m, s=s0, v=0.0)
-    model.sol = Force(f=lambda s: k0 * (g0 - s))
+    model.sol = Force(f=law)
     model.connect(model.mass.flange, model.sol.flange)
     res = run(model, t_end=0.5, step=1e-3)
     w = np.sqrt(k0 / m)
