@@ -5,7 +5,8 @@ sliding in slow mechanisms).
     driver (s = V t) --/\\/\\/\\-- [block m] on the table (Coulomb friction)
 
 The friction levels are given in normal-force form, F_c = mu_k N and
-F_s = mu_s N with N = m g (model parameters, so a sweep can vary them).
+F_s = mu_s N with N = m g (model parameters, so a sweep can vary them;
+N does not follow block.m: set both).
 
 Closed form (omega = sqrt(k/m)): the block sticks until the spring force
 reaches F_s, at t = F_s/(k V) for the first time. It then slides, harmonic
@@ -18,35 +19,21 @@ returns these; the measures take them from the simulated events.
 import math
 
 import numpy as np
-from sympy import Eq
 
-from acausal import Component, Experiment, Flange, Model, Parameter, time
+from acausal import Experiment, Model, time
 from components.friction import GroundFriction
-from components.translational import Mass, Spring
-
-
-class Driver(Component):
-    """The pulled end of the spring: ``flange.s = V * time``.
-
-    Parameters: ``V`` [m/s] speed. Connectors: ``flange``.
-    """
-
-    flange = Flange("moving end")
-    V = Parameter(0.05, "m/s", "driver speed")
-
-    def equations(self):
-        return [Eq(self.flange.s, self.V * time)]
-
+from components.translational import Mass, Position, Spring
 
 M, K, V, MU_K, MU_S, G = 1.0, 200.0, 0.05, 0.4, 0.6, 9.81
 
 model = Model()
+speed = model.parameter("V", V, "m/s", "driver speed", min=0.0, min_open=True)
 mu_k = model.parameter("mu_k", MU_K, "1", "kinetic friction coefficient", min=0.0)
 mu_s = model.parameter("mu_s", MU_S, "1", "static friction coefficient", min=0.0)
 normal = model.parameter("N", M * G, "N", "normal force (block weight)", min=0.0)
 model.block = Mass(m=M, s=0.0, v=0.0)
 model.spring = Spring(c=K)
-model.driver = Driver(V=V)
+model.driver = Position(s=speed * time)
 model.friction = GroundFriction(F_c=mu_k * normal, F_s=mu_s * normal)
 model.connect(model.driver.flange, model.spring.flange_b)
 model.connect(model.spring.flange_a, model.block.flange, model.friction.flange)

@@ -361,7 +361,7 @@ def test_stick_slip_example_file():
     assert abs(ms["dwell"] - cf["dwell"]) / cf["dwell"] < 1e-6
     assert abs(ms["slip_time"] - cf["slip"]) / cf["slip"] < 1e-6
     # a sweep point: other friction levels and driver speed, same closed form
-    res, ms = run_file(path, params={"mu_s": 0.7, "driver.V": 0.1})
+    res, ms = run_file(path, params={"mu_s": 0.7, "V": 0.1})
     cf = stick_slip.closed_form(mu_s=0.7, v=0.1)
     assert abs(ms["period"] - cf["period"]) / cf["period"] < 1e-6
     assert abs(ms["dwell"] - cf["dwell"]) / cf["dwell"] < 1e-6
