@@ -41,6 +41,9 @@ class EventState:
         for j, prm in enumerate(self.cm.params):
             if prm.name == name:
                 return "p", j
+        for s, expr in self.cm._subs.items():   # a parameter bound to others
+            if s.name == name:
+                return "b", expr
         raise KeyError(f"event action asked for {name!r}, which is not in the model")
 
     def _index(self):
@@ -51,6 +54,8 @@ class EventState:
 
     def __getitem__(self, sym):
         kind, j = self._find(sym)
+        if kind == "b":
+            return float(j.xreplace(dict(zip(self.cm.param_syms, self.p))))
         return {"d": self.d, "v": self._obs, "p": self.p}[kind][j]
 
     def __setitem__(self, sym, value):
