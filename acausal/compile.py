@@ -12,6 +12,7 @@ import sympy as sp
 from .aliases import eliminate_aliases
 from .causalize import build_dae
 from .codegen import generate
+from .declare import Start
 from .errors import ModelError, ParameterError
 from .flatten import flatten
 from .structure import Graph, check_structure, dummy_derivatives, pantelides
@@ -50,8 +51,10 @@ class CompiledModel:
         self.disc_syms = [d.symbol for d in self.discretes]
         g = self.graph = Graph(red.equations, red.unknowns)
         pantelides(g)
+        self._root_starts = _alias_starts(flat, red)
         values = self._start_values()
         fixed = {v.symbol for v in flat.variables.values() if v.start.fixed}
+        fixed |= {r for r, st in self._root_starts.items() if st.fixed}
         dummies = dummy_derivatives(g, values, lambda s: base_and_order(s)[0] in fixed)
         self.dae = build_dae(g, dummies, set(self.param_syms))
         if not self.dae.y:
@@ -99,6 +102,8 @@ class CompiledModel:
         for info in self.flat.variables.values():
             v = info.start.value
             vals[info.symbol] = v
+        for r, st in self._root_starts.items():
+            vals[r] = st.value
         for d in self.flat.discretes.values():
             vals[d.symbol] = d.start.value
         for k, v in list(vals.items()):
@@ -162,7 +167,8 @@ class CompiledModel:
             base, k = base_and_order(s)
             info = self.flat.variables.get(base.name)
             if k == 0 and info is not None:
-                y[i] = self._eval_start(info.start.value, p)
+                st = self._root_starts.get(base, info.start)
+                y[i] = self._eval_start(st.value, p)
         return y
 
     def state_guess_order(self):
@@ -181,6 +187,49 @@ class CompiledModel:
     def simulate(self, **kw):
         from .simulate import simulate
         return simulate(self, **kw)
+
+
+def _alias_starts(flat, red):
+    """Start values given on variables eliminated as aliases, carried to the
+    variable that stays (``root``): root symbol -> :class:`Start`.
+
+    A root without a fixed start takes the fixed start of an alias (first by
+    name), else, if its own start is a zero guess, the first non-zero guess
+    of an alias; ``x = s*root + o`` gives ``root = (x0 - o)/s``. Fixed starts
+    of aliases are still imposed by name at initialisation; this only makes
+    them (and guesses) reach the state selection and the initial guess.
+    """
+    groups = {}
+    for x, expr in red.aliases.items():
+        roots = [s for s in expr.free_symbols if s.name in flat.variables]
+        if len(roots) != 1:
+            continue
+        r = roots[0]
+        sign = sp.diff(expr, r)
+        if sign not in (1, -1):
+            continue
+        groups.setdefault(r, []).append((x, sign, expr - sign * r))
+    out = {}
+    for r, members in groups.items():
+        own = flat.variables[r.name].start
+        if own.fixed:
+            continue
+        members.sort(key=lambda m: m[0].name)
+        starts = [(flat.variables[x.name].start, sign, off) for x, sign, off in members]
+        pick = next((m for m in starts if m[0].fixed), None)
+        if pick is None and _is_zero(own.value):
+            pick = next((m for m in starts if not _is_zero(m[0].value)), None)
+        if pick is not None:
+            st, sign, off = pick
+            out[r] = Start((sp.sympify(st.value) - off) / sign, st.fixed)
+    return out
+
+
+def _is_zero(v):
+    try:
+        return float(v) == 0.0
+    except (TypeError, ValueError):
+        return False
 
 
 def compile_model(model):

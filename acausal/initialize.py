@@ -72,12 +72,27 @@ def initial_point(cm, p, d, cb, t0):
 
     z0 = np.concatenate([y0, np.zeros(ns)])
     guess_rows = _choose_guesses(jac(z0, []), ns, cm.state_guess_order())
-    sol = least_squares(residual, z0, jac=jac, args=(guess_rows,), method="trf",
-                        xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=200,
-                        x_scale="jac")
-    z = sol.x
+    # Newton from the guesses first: it converges to the solution nearest to
+    # them (e.g. the assembly mode of a linkage its guesses describe). The
+    # trust-region least squares is the fallback; its long steps (in
+    # variables with small Jacobian columns, such as lengths in m) can reach
+    # another solution.
+    z = _newton(lambda zz: residual(zz, guess_rows), lambda zz: jac(zz, guess_rows), z0)
+    if z is None or not _consistent(cm, residual(z, []), jac(z, []), z, fixed, n):
+        sol = least_squares(residual, z0, jac=jac, args=(guess_rows,), method="trf",
+                            xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=200,
+                            x_scale="jac")
+        z = sol.x
     y, yp = split(z)
-    _check(cm, residual(z, []), jac(z, []), z, fixed, n)
+    violated = _violated_assertion(cm, cb, t0, y, yp)
+    try:
+        _check(cm, residual(z, []), jac(z, []), z, fixed, n)
+    except InitializationError as exc:
+        if violated:
+            raise InitializationError(f"{violated}; {exc}") from None
+        raise
+    if violated:
+        raise InitializationError(violated)
     if _snap_fixed_states(cm, y, fixed):
         # least squares meets a fixed start only to ~1e-16: impose it exactly
         # (a body that starts at rest must be exactly at rest) and recompute
@@ -107,6 +122,58 @@ def _snap_fixed_states(cm, y, fixed):
             y[i] = sign * value
             changed = True
     return changed
+
+
+def _violated_assertion(cm, cb, t, y, yp):
+    """Message of the first assertion that does not hold (``expr < 0``) at
+    the initial point, or None. An assertion only fires when its expression
+    crosses zero, so one that is already violated at the start must be
+    reported here."""
+    if not cm.assertions:
+        return None
+    g = np.zeros(cm.n_roots)
+    try:
+        cb[2](t, y, yp, g)
+    except (ArithmeticError, ValueError):
+        return None
+    n_ev = len(cm.events)
+    for a, v in zip(cm.assertions, g[n_ev:]):
+        if v < 0 or not np.isfinite(v):
+            return f"{a.owner}: {a.message} (at the initial point, t = {t:g} s)"
+    return None
+
+
+def _newton(fun, jac, z, max_iter=50):
+    """Gauss-Newton with step halving from ``z``; the last iterate (the
+    caller checks it) or None when the residual is not finite."""
+    r = fun(z)
+    nr = np.linalg.norm(r)
+    for _ in range(max_iter):
+        if not np.all(np.isfinite(r)):
+            return None
+        dz = np.linalg.lstsq(jac(z), -r, rcond=None)[0]
+        step = 1.0
+        for _ in range(30):
+            z2 = z + step * dz
+            r2 = fun(z2)
+            n2 = np.linalg.norm(r2)
+            if np.isfinite(n2) and n2 <= nr * (1 - 1e-4 * step) or n2 <= 1e-300:
+                break
+            step *= 0.5
+        else:
+            return z          # no more progress (converged to round-off, or stuck)
+        z, r, nr = z2, r2, n2
+        if np.all(np.abs(step * dz) <= 1e-13 * (1 + np.abs(z))) or nr == 0.0:
+            return z
+    return z
+
+
+def _consistent(cm, full, J, z, fixed, n):
+    try:
+        _check(cm, full, J, z, fixed, n)
+        return True
+    except InitializationError:
+        return False
 
 
 def _choose_guesses(J, ns, order):

@@ -205,7 +205,33 @@ def dummy_derivatives(g, values, prefer_state):
     numbers used to evaluate Jacobians; ``prefer_state(sym)`` is true for
     variables that should stay states when there is a choice. Returns the
     set of dummy variable nodes.
+
+    The preference for fixed starts is a heuristic: with first-order chains
+    (``der(phi) = w``) a fixed ``w`` but free ``phi`` can make it keep
+    ``der(w)`` and drop ``der(phi)``, which leaves ``phi`` with neither a
+    state nor an equation. Such a selection is detected by counting and the
+    selection is redone without the preference.
     """
+    dummies = _select_dummies(g, values, prefer_state)
+    if not _consistent(g, dummies):
+        dummies = _select_dummies(g, values, lambda s: False)
+    return dummies
+
+
+def _consistent(g, dummies):
+    """True when the index-1 system left by ``dummies`` is square: as many
+    equations as unknowns (derivatives of states + algebraic nodes), the
+    count :func:`acausal.causalize.build_dae` needs."""
+    nv = len(g.vsym)
+    states = {j for j in range(nv) if g.vder[j] != -1 and g.vder[j] not in dummies}
+    state_ders = {g.vder[j] for j in states}
+    n_unknowns = len(states) + sum(1 for j in range(nv)
+                                   if j not in states and j not in state_ders)
+    n_links = sum(1 for j in states if g.vder[j] in states)
+    return n_unknowns == len(g.eexpr) + n_links
+
+
+def _select_dummies(g, values, prefer_state):
     dummies = set()
     geqs = [i for i in range(len(g.eexpr)) if g.eder[i] == -1 and i in g.eint]
     hvars = [j for j in range(len(g.vsym)) if g.vder[j] == -1 and j in g.vint]
