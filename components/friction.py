@@ -70,12 +70,9 @@ def _num(value):
 def _param_value(state, sym):
     """A parameter's value in an event action, also when it is bound to an
     expression of other parameters (then it is not a free parameter)."""
-    try:
-        return f"{float(state[sym]):g}"
-    except KeyError:
-        cm = state.cm
-        value = float(cm.resolve(sym).xreplace(dict(zip(cm.param_syms, state.p))))
-        return f"{value:g} (bound to {cm.bound.get(sym.name, '?')})"
+    value = f"{float(state[sym]):g}"
+    bound = state.cm.bound.get(sym.name)
+    return f"{value} (bound to {bound})" if bound is not None else value
 
 
 class _StickSlip:
