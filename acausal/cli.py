@@ -125,5 +125,93 @@ def variables(file):
         click.echo(f"  {d.symbol.name:32s} [{d.unit}] {d.desc}; discrete, start {d.start.value}")
 
 
+@main.command()
+@click.argument("file", type=click.Path(dir_okay=False))
+@click.argument("data", type=click.Path(file_okay=False))
+@click.option("--fit", required=True, metavar="P1,P2,...",
+              help="parameters to fit; with --method report give PARAM:MEASURE pairs "
+                   "in the order the report calibrates them (contact.K:contact_period,hook.bh:thrt)")
+@click.option("--method", type=click.Choice(["lsq", "report"]), default="lsq", show_default=True)
+@click.option("--json", "as_json", is_flag=True, help="print one JSON object")
+def calibrate(file, data, fit, method, as_json):
+    """Fit parameters of a model file to a measured dataset."""
+    from . import calibrate as cal
+    from .modelfile import compile_file
+    try:
+        mf, cm = compile_file(file)
+        ds = cal.model_dataset(file, data)
+        items = [x.strip() for x in fit.split(",") if x.strip()]
+        if method == "report":
+            pairs = []
+            for it in items:
+                if ":" not in it:
+                    raise click.BadParameter(f"--fit {it!r}: the report method needs PARAM:MEASURE")
+                p, m = it.split(":", 1)
+                pairs.append((p, m))
+            cal.check_names(cm, [p for p, _ in pairs])
+            out = cal.report_method(file, ds, pairs)
+        else:
+            names = [it.split(":", 1)[0] for it in items]
+            cal.check_names(cm, names)
+            out = cal.least_squares(file, ds, names)
+    except (AcausalError, click.BadParameter) as exc:
+        _fail(exc)
+    if as_json:
+        click.echo(json.dumps(out.to_dict(), indent=1, default=float))
+        return
+    click.echo(f"calibration ({out.method}) of {file} against {data}: {out.n_sim} simulations")
+    for name, v in out.values.items():
+        ci = out.ci95.get(name)
+        ci_s = f"  95% CI [{ci[0]:.6g}, {ci[1]:.6g}]" if ci else ""
+        click.echo(f"  {name} = {v:.6g}{ci_s}")
+    if out.correlation is not None and len(out.values) > 1:
+        click.echo("  correlation:")
+        for name, row in zip(out.values, out.correlation):
+            click.echo(f"    {name:20s} " + " ".join(f"{x:+.3f}" for x in row))
+    click.echo("  residuals (simulated - measured):")
+    for exp, sig in out.residuals.items():
+        click.echo(f"    {exp}: " + ", ".join(f"{k} {v:+.4g}" for k, v in sig.items()))
+
+
+@main.command()
+@click.argument("file", type=click.Path(dir_okay=False))
+@click.option("--param", "params", multiple=True, required=True, metavar="NAME=A:B:N",
+              help="a swept parameter: start:stop:count, a list a,b,c, or one value")
+@click.option("--measure", "measures", multiple=True, required=True, help="measure(s) to record")
+@click.option("--out", type=click.Path(dir_okay=False), default="sweep.csv", show_default=True,
+              help="results CSV; running again with the same file resumes")
+@click.option("--plot", type=click.Path(dir_okay=False), help="plot the first measure")
+@click.option("--scheduler", help="Dask scheduler address (default: local processes)")
+@click.option("--workers", type=int, help="local worker processes (default: all cores)")
+@click.option("--no-progress", is_flag=True)
+def sweep(file, params, measures, out, plot, scheduler, workers, no_progress):
+    """Run a grid of simulations in parallel."""
+    import functools
+    import os
+
+    from .executor import open_executor
+    from .modelfile import compile_file, sweep_task
+    from .sweep import grid, parse_param, plot_sweep, run_sweep
+    try:
+        mf, cm = compile_file(file)
+        specs = [parse_param(p) for p in params]
+        for name, _ in specs:
+            cm.param_index(name)
+        for m in measures:
+            if m not in mf.measures:
+                raise click.BadParameter(f"--measure {m!r}: the model file defines "
+                                         f"{sorted(mf.measures) or 'no measures'}")
+        task = functools.partial(sweep_task, os.path.abspath(file))
+        with open_executor(scheduler, workers) as ex:
+            rows = run_sweep(task, grid(specs), out, executor=ex, measures=list(measures),
+                             progress=not no_progress)
+        if plot:
+            plot_sweep(rows, specs[0][0], measures[0], plot)
+    except (AcausalError, click.BadParameter, ValueError) as exc:
+        _fail(exc)
+    failed = sum(1 for r in rows if r.get("status") != "ok")
+    click.echo(f"{len(rows)} points, {failed} failed; results in {out}")
+
+
 if __name__ == "__main__":  # pragma: no cover
     main()

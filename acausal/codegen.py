@@ -108,7 +108,9 @@ def generate(dae, params, discretes, roots, observed):
     npar, nd = len(params), len(discretes)
     L = ["def make(p, d):"]
     L += _unpack("p", npar, "p", "    ", False) + _unpack("d", nd, "d", "    ", False)
+    L += ["    count = [0, None]  # step attempts: distinct times the residual sees"]
     L += ["    def res(t, y, yp, r):"]
+    L += ["        if t != count[1]:", "            count[0] += 1", "            count[1] = t"]
     L += _unpack("y", n, "y") + _unpack("yp", n, "yp")
     L += _body(res, [f"r[{i}]" for i in range(n)])
     L += ["    def jac(t, y, yp, r, cj, J):"]
@@ -127,7 +129,7 @@ def generate(dae, params, discretes, roots, observed):
     L += ["        o = [0.0] * %d" % len(obs)]
     L += _body(obs, [f"o[{i}]" for i in range(len(obs))])
     L += ["        return o"]
-    L += ["    return res, jac, roots, jacs, observe"]
+    L += ["    return res, jac, roots, jacs, observe, count"]
     src = "\n".join(L) + "\n"
     _counter[0] += 1
     fname = f"<acausal-generated-{_counter[0]}>"

@@ -57,6 +57,11 @@ class CompiledModel:
         fixed |= {r for r, st in self._root_starts.items() if st.fixed}
         dummies = dummy_derivatives(g, values, lambda s: base_and_order(s)[0] in fixed)
         self.dae = build_dae(g, dummies, set(self.param_syms))
+        if not self.dae.y:
+            raise ModelError("the model leaves nothing to integrate: every variable is "
+                             "given explicitly (prescribed motion, constants), so there is no "
+                             "state or implicit unknown for the solver; add a dynamic element "
+                             "(a mass, an inertia, a damper between moving parts)")
         self._subs = dict(red.param_subs)
         self._alias = red.subs
         self.var_names = list(flat.variables)

@@ -77,8 +77,11 @@ def flatten(model):
     comps = list(model.walk())
     for comp in comps:
         _declare(flat, comp)
+    known = _known_names(flat)
     for comp in comps:
-        _equations(flat, comp)
+        _relocate_values(flat, comp, known)
+    for comp in comps:
+        _equations(flat, comp, known)
     _connections(flat, model, comps)
     return flat
 
@@ -101,9 +104,49 @@ def _declare(flat, comp):
             flat.variables[sym.name] = VarInfo(sym, Start(0.0, False), unit, desc, path, True)
 
 
-def _equations(flat, comp):
+def relocate(expr, comp, known):
+    """Give symbols their full paths. An expression built inside a model's
+    constructor, before the model was attached to its parent, names symbols
+    relative to that model (``body.phi`` instead of ``hook.body.phi``): each
+    unknown name is looked up under the paths of ``comp``'s ancestors,
+    nearest first."""
+    if not isinstance(expr, sp.Basic):
+        return expr
+    subs = {}
+    for s in expr.free_symbols:
+        if s == time:
+            continue
+        base, k = base_and_order(s)
+        if base.name in known:
+            continue
+        node = comp
+        while node is not None:
+            p = node.path
+            cand = f"{p}.{base.name}" if p else base.name
+            if cand in known:
+                new = sp.Symbol(cand)
+                for _ in range(k):
+                    new = sp.Symbol(f"der({new.name})")
+                subs[s] = new
+                break
+            node = node._parent
+    return expr.xreplace(subs) if subs else expr
+
+
+def _relocate_values(flat, comp, known):
+    pre = f"{comp.path}." if comp.path else ""
+    for name in comp.declarations():
+        full = pre + name
+        info = flat.params.get(full)
+        if info is not None and not info.decl.structural:
+            info.value = relocate(info.value, comp, known)
+        vinfo = flat.variables.get(full)
+        if vinfo is not None and isinstance(vinfo.start.value, sp.Basic):
+            vinfo.start = Start(relocate(vinfo.start.value, comp, known), vinfo.start.fixed)
+
+
+def _equations(flat, comp, known):
     path = comp.path
-    known = None
     for i, eq in enumerate(comp.gather("equations")):
         if isinstance(eq, sp.Equality):
             expr = eq.lhs - eq.rhs
@@ -111,8 +154,7 @@ def _equations(flat, comp):
             expr = sp.sympify(eq)
         if expr == 0 or expr is sp.true:
             continue
-        if known is None:
-            known = _known_names(flat)
+        expr = relocate(expr, comp, known)
         for s in expr.free_symbols:
             base, _ = base_and_order(s)
             if s != time and base.name not in known:
@@ -122,9 +164,11 @@ def _equations(flat, comp):
         flat.equations.append(Equation(expr, path, f"equation {i + 1} ({type(comp).__name__})"))
     for ev in comp.gather("events"):
         ev.owner = path
+        ev.expr = relocate(ev.expr, comp, known)
         flat.events.append(ev)
     for a in comp.gather("assertions"):
         a.owner = path
+        a.expr = relocate(a.expr, comp, known)
         flat.assertions.append(a)
 
 

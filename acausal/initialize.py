@@ -11,6 +11,7 @@ recomputed, the states are kept.
 """
 import numpy as np
 import scipy.linalg
+import sympy as sp
 from scipy.optimize import least_squares
 
 from .errors import InitializationError
@@ -92,7 +93,35 @@ def initial_point(cm, p, d, cb, t0):
         raise
     if violated:
         raise InitializationError(violated)
-    return y, yp
+    if _snap_fixed_states(cm, y, fixed):
+        # least squares meets a fixed start only to ~1e-16: impose it exactly
+        # (a body that starts at rest must be exactly at rest) and recompute
+        # the algebraic unknowns and y' for the exact states
+        y, yp = reinitialize(cm, cb, t0, y, yp)
+        z = np.concatenate([y, yp[:ns]])
+        _check(cm, residual(z, []), jac(z, []), z, fixed, n)
+    return y, _algebraic_rates(cm, cb, t0, y, yp)
+
+
+def _snap_fixed_states(cm, y, fixed):
+    """Set every state slot that a fixed start names (directly or negated)
+    exactly to its value; True when a slot changed."""
+    ns = cm.dae.n_states
+    slot = {s: i for i, s in enumerate(cm.dae.y[:ns])}
+    changed = False
+    for _, value, name in fixed:
+        try:
+            e = cm.resolve(sp.Symbol(name))
+        except Exception:  # not expressible in y (never for a fixed start)
+            continue
+        sign = 1.0
+        if isinstance(e, sp.Mul) and len(e.args) == 2 and e.args[0] == -1:
+            sign, e = -1.0, e.args[1]
+        i = slot.get(e)
+        if i is not None and y[i] != sign * value:
+            y[i] = sign * value
+            changed = True
+    return changed
 
 
 def _violated_assertion(cm, cb, t, y, yp):
@@ -207,5 +236,40 @@ def reinitialize(cm, cb, t, y, yp):
         yp[:ns] = z[n - ns:]
         if np.all(np.abs(dz) <= 1e-12 * (1 + np.abs(z))):
             break
-    cb[0](t, y, yp, r)
-    return y, yp
+    return y, _algebraic_rates(cm, cb, t, y, yp)
+
+
+def _algebraic_rates(cm, cb, t, y, yp):
+    """Fill y' of the algebraic slots with their true rates.
+
+    IDA keeps every component, algebraic ones too, in its BDF history and
+    error test; an algebraic unknown that moves (a holding force under a
+    ramped load) with y' = 0 makes the first step's error estimate ~ h*rate,
+    which fails the error test down to the minimum step at tight tolerances.
+    Differentiating F(t, y, y') = 0 once along the solution gives
+    ``[F_y(alg) F_y'(states)] [y'_alg; y''_states] = -(F_t + F_y(states) y'_states)``:
+    the same matrix as the re-initialisation. F_t by a central difference.
+    """
+    dae = cm.dae
+    n, ns = len(dae.y), dae.n_states
+    if n == ns:
+        return yp
+    yp = np.array(yp, dtype=float)
+    Jy, Jyp = _jacobians(cb, t, y, yp, n)
+    J = np.hstack([Jy[:, ns:], Jyp[:, :ns]])
+    dt = 1e-6 * max(1.0, abs(t))
+    rp, rm = np.zeros(n), np.zeros(n)
+    count = cb[5] if len(cb) > 5 else None
+    saved = list(count) if count is not None else None
+    cb[0](t + dt, y, yp, rp)
+    cb[0](t - dt, y, yp, rm)
+    if count is not None:   # these are not solver step attempts
+        count[:] = saved
+    rhs = -((rp - rm) / (2 * dt) + Jy[:, :ns] @ yp[:ns])
+    try:
+        sol = scipy.linalg.solve(J, rhs)
+    except (scipy.linalg.LinAlgError, ValueError):
+        sol = np.linalg.lstsq(J, rhs, rcond=None)[0]
+    if np.all(np.isfinite(sol)):
+        yp[ns:] = sol[:n - ns]
+    return yp

@@ -108,3 +108,10 @@ def run_file(path, params=None, **overrides):
     opts.update({k: v for k, v in overrides.items() if v is not None})
     res = cm.simulate(params=params, **opts)
     return res, evaluate_measures(mf, res)
+
+
+def sweep_task(path, point):
+    """One sweep point: the model file compiled once per worker process
+    (the compile cache is per process), simulated with ``point`` as
+    parameter overrides; returns the measures. Module-level, so picklable."""
+    return run_file(path, params=point)[1]

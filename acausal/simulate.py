@@ -41,6 +41,9 @@ class EventState:
         for j, prm in enumerate(self.cm.params):
             if prm.name == name:
                 return "p", j
+        for s, expr in self.cm._subs.items():   # a parameter bound to others
+            if s.name == name:
+                return "b", expr
         raise KeyError(f"event action asked for {name!r}, which is not in the model")
 
     def _index(self):
@@ -51,6 +54,8 @@ class EventState:
 
     def __getitem__(self, sym):
         kind, j = self._find(sym)
+        if kind == "b":
+            return float(j.xreplace(dict(zip(self.cm.param_syms, self.p))))
         return {"d": self.d, "v": self._obs, "p": self.p}[kind][j]
 
     def __setitem__(self, sym, value):
@@ -87,10 +92,10 @@ class _Run:
         self.directions = [e.direction for e in ev] + [-1] * len(cm.assertions)
 
     def record(self, t, y, yp, d):
-        self.T.append(float(t))
-        self.Y.append(np.array(y, float))
-        self.YP.append(np.array(yp, float))
-        self.D.append(list(d))
+        self.T.append(np.atleast_1d(np.asarray(t, float)))
+        self.Y.append(np.atleast_2d(np.asarray(y, float)))
+        self.YP.append(np.atleast_2d(np.asarray(yp, float)))
+        self.D.append(np.tile(np.asarray(d, float), (len(self.T[-1]), 1)))
 
     def solver(self, cb):
         kw = dict(self.opts)
@@ -110,8 +115,11 @@ class _Run:
     def result(self, status="ok", message=""):
         stats = dict(nfev=self.nfev, njev=self.njev, steps=self.steps,
                      events=len(self.events))
-        return Result(self.cm, self.p, self.T, self.Y, self.YP, self.D, list(self.events),
-                      stats, status, message)
+        n = len(self.cm.dae.y)
+        cat = (lambda blocks, w: np.concatenate(blocks) if blocks else np.zeros((0, w)))
+        return Result(self.cm, self.p, cat(self.T, 0) if self.T else np.zeros(0),
+                      cat(self.Y, n), cat(self.YP, n), cat(self.D, len(self.cm.discretes)),
+                      list(self.events), stats, status, message)
 
 
 def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_step=None,
@@ -126,45 +134,32 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
     y, yp = initial_point(cm, p, d, cb, t0)
     y, yp, d, cb, stop = _event_iteration(run, cb, t0, y, yp, d, initial=True)
     tout = _output_times(t0, t_end, output_step, output_times)
-    k = int(np.searchsorted(tout, t0, side="right"))
     run.record(t0, y, yp, d)
     t = t0
     try:
         while not stop and t < t_end:
             ida = run.solver(cb)
-            ida.init_step(t, y, yp)
-            nfev0, njev0, t_step = 0, 0, t
-            while True:
-                r = ida.step(t_end, method="onestep", tstop=t_end)
-                if r.status < 0:
-                    run.nfev += r.nfev
-                    raise _failure(run, cm, r, cb)
-                if r.t > t_step:  # a ONE_STEP call right after an interpolated
-                    run.steps += 1  # output returns without stepping
-                    t_step = r.t
-                while k < len(tout) and tout[k] < r.t:
-                    ri = ida.step(float(tout[k]), method="normal")
-                    run.record(ri.t, ri.y, ri.yp, d)
-                    k += 1
-                nfev0, njev0 = r.nfev, r.njev
-                if r.status == 2:
-                    break
-                if k < len(tout) and tout[k] == r.t:
-                    k += 1
-                if r.t >= t_end:
-                    break
-            run.nfev += nfev0
-            run.njev += njev0
-            t, y, yp = float(r.t), np.array(r.y), np.array(r.yp)
-            run.record(t, y, yp, d)
-            if r.status != 2:
+            later = tout[tout > t]
+            tspan = np.concatenate([[t], later if len(later) and later[-1] >= t_end
+                                    else np.append(later, t_end)])
+            sol = ida.solve(tspan, y, yp)
+            run.nfev += sol.nfev
+            run.njev += sol.njev
+            run.steps += cb[5][0]
+            cb[5][0] = 0
+            if sol.status < 0:
+                if len(sol.t) > 1:
+                    run.record(sol.t[1:], sol.y[1:], sol.yp[1:], d)
+                raise _failure(run, cm, sol, cb)
+            run.record(sol.t[1:], sol.y[1:], sol.yp[1:], d)
+            t, y, yp = float(sol.t[-1]), np.array(sol.y[-1]), np.array(sol.yp[-1])
+            if sol.status != 2:
                 break
-            fired = [i for i, s in enumerate(r.i_events[-1]) if s != 0]
+            fired = [i for i, s_ in enumerate(sol.i_events[-1]) if s_ != 0]
+            d_before = list(d)
             y, yp, d, cb, stop = _handle(run, cb, t, y, yp, d, fired)
-            if not stop or run.T[-1] != t or run.D[-1] != list(d):
+            if list(d) != d_before:
                 run.record(t, y, yp, d)
-            while k < len(tout) and tout[k] <= t:
-                k += 1
     except SolverError as exc:
         exc.result = exc.result or run.result("failed", str(exc))
         exc.result.stats["wall_s"] = _time.perf_counter() - wall0
@@ -242,8 +237,10 @@ def _log_event(run, t, ev):
                 component=owners[0], result=run.result("failed", "chattering"))
 
 
-def _failure(run, cm, r, cb):
+def _failure(run, cm, sol, cb):
     """A SolverError naming the component whose equation is worst off."""
+    r = type("Last", (), dict(t=float(np.atleast_1d(sol.t)[-1]), y=np.atleast_2d(sol.y)[-1],
+                              yp=np.atleast_2d(sol.yp)[-1], message=sol.message))
     t = float(r.t)
     n = len(cm.dae.y)
     res = np.zeros(n)

@@ -1,14 +1,72 @@
-"""Levers and transformers between rotation and translation."""
+"""Levers and transformers between rotation and translation, and gears.
+
+All are massless, rigid and power conserving, with their pivot/support on
+the fixed frame (like Modelica's IdealGear with a grounded support): put the
+mass or inertia of a lever in an :class:`~components.rotational.Inertia`
+or :class:`~components.translational.Mass` on one of its flanges.
+Sign convention: :mod:`acausal.connectors`.
+"""
 from sympy import Eq, cos, sin
 
-from acausal import Component, Flange, Parameter, Variable
+from acausal import Component, Flange, Parameter, ParameterError, RotFlange, Variable
+
+__all__ = ["IdealLever", "TwoArmLever", "IdealGear"]
+
+
+class NonZeroParameter(Parameter):
+    """A parameter that may have either sign but not be zero (an arm, a
+    ratio): zero would make the transformer degenerate."""
+
+    def check_bounds(self, v, label):
+        super().check_bounds(v, label)
+        if v == 0:
+            raise ParameterError(f"parameter {label} = 0 [{self.unit}] must be non-zero "
+                                 f"({self.desc})")
+
+
+class IdealLever(Component):
+    """A rigid arm turning a rotation into a translation (the bond-graph TF
+    with modulus ``arm`` or ``arm*cos(phi)``):
+
+    * small angle (``exact=False``): ``flange_t.s = arm * phi``,
+      ``flange_r.tau = -arm * flange_t.f``;
+    * exact (``exact=True``): ``flange_t.s = arm * sin(phi)``,
+      ``flange_r.tau = -arm * cos(phi) * flange_t.f``
+
+    with ``phi = flange_r.phi``. Power is conserved:
+    ``flange_r.tau * der(phi) + flange_t.f * der(flange_t.s) = 0``. The
+    exact form is a pin on the arm driving a slider along a line
+    perpendicular to the arm at ``phi = 0`` (a scotch yoke); it is singular
+    at ``phi = +-pi/2``. An inertia ``J`` on ``flange_r`` and a mass ``m``
+    on ``flange_t`` move as one inertia ``J + m*arm^2`` (small angle).
+    ``arm`` is signed: a negative arm moves the point the other way.
+
+    Parameters: ``arm`` [m] lever arm (non-zero), ``exact`` (structural) exact
+    kinematics. Connectors: ``flange_r`` (rotational), ``flange_t``
+    (translational).
+    """
+
+    flange_r = RotFlange("rotating side (the lever's shaft)")
+    flange_t = Flange("translating side (the point on the arm)")
+    arm = NonZeroParameter(0.1, "m", "lever arm (signed, non-zero)")
+    exact = Parameter(False, "1", "use arm*sin(phi) instead of arm*phi", structural=True,
+                      choices=(False, True))
+
+    def equations(self):
+        phi = self.flange_r.phi
+        k = sin(phi) if self.exact else phi
+        dk = cos(phi) if self.exact else 1
+        return [Eq(self.flange_t.s, self.arm * k),
+                Eq(self.flange_r.tau, -self.arm * dk * self.flange_t.f)]
 
 
 class TwoArmLever(Component):
     """A massless rigid lever on a fixed pivot with two arms on the same side:
     ``flange_a.s = a * phi``, ``flange_b.s = b * phi`` and torque balance
     ``a * flange_a.f + b * flange_b.f = 0`` (small-angle form; with
-    ``exact=True`` the arms see ``arm * sin(phi)``).
+    ``exact=True`` the arms see ``arm * sin(phi)`` and the balance is
+    multiplied by ``cos(phi)``). Arms are signed: an arm on the other side
+    of the pivot is negative.
 
     Parameters: ``a``, ``b`` [m] arm lengths, ``exact`` (structural).
     States: ``phi`` [rad] lever angle. Connectors: ``flange_a``, ``flange_b``.
@@ -28,3 +86,22 @@ class TwoArmLever(Component):
         return [Eq(self.flange_a.s, self.a * k),
                 Eq(self.flange_b.s, self.b * k),
                 Eq(self.a * dk * self.flange_a.f + self.b * dk * self.flange_b.f, 0)]
+
+
+class IdealGear(Component):
+    """Ideal gear on a fixed support: ``flange_a.phi = ratio * flange_b.phi``,
+    ``ratio * flange_a.tau + flange_b.tau = 0`` (power conserving, as
+    Modelica's IdealGear). An inertia ``J_b`` on ``flange_b`` is felt on
+    ``flange_a`` as ``J_b / ratio^2``. A negative ratio reverses the sense.
+
+    Parameters: ``ratio`` [1] transmission ratio flange_a.phi/flange_b.phi
+    (non-zero). Connectors: ``flange_a``, ``flange_b``.
+    """
+
+    flange_a = RotFlange("driving flange")
+    flange_b = RotFlange("driven flange")
+    ratio = NonZeroParameter(1.0, "1", "transmission ratio flange_a.phi / flange_b.phi")
+
+    def equations(self):
+        return [Eq(self.flange_a.phi, self.ratio * self.flange_b.phi),
+                Eq(self.ratio * self.flange_a.tau + self.flange_b.tau, 0)]

@@ -1,0 +1,111 @@
+"""Generated model vs hand-written scikit-sundae residual, same equations,
+same tolerances, measured in the same run (ratios, because the machine is
+shared and noisy). Target: ratio <= 1.5.
+
+    python benchmarks/core_speed.py [--repeat N]
+"""
+import argparse
+import os
+import statistics
+import sys
+import time
+
+import numpy as np
+import sksundae as sun
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+
+from acausal.modelfile import compile_file  # noqa: E402
+
+
+def best_of(fn, repeat):
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return min(times), statistics.median(times)
+
+
+# -- oscillator ------------------------------------------------------------------
+def oscillator_handwritten(rtol=1e-8, atol=1e-10):
+    def res(t, y, yp, r):
+        r[0] = yp[0] - y[1]
+        r[1] = 1.0 * yp[1] + 100.0 * y[0]
+
+    def jac(t, y, yp, r, cj, J):
+        J[0, 0] = cj
+        J[0, 1] = -1.0
+        J[1, 0] = 100.0
+        J[1, 1] = cj
+
+    s = sun.ida.IDA(res, jacfn=jac, rtol=rtol, atol=atol)
+    out = s.solve(np.linspace(0, 1, 1001), [0.1, 0.0], [0.0, -10.0])
+    return out.y[-1, 0], out.nfev
+
+
+# -- Hertz impact: mass into a wall, contact switched on/off by events -------------
+def hertz_handwritten(rtol=1e-8, atol=1e-12, m=0.1, K=1e9, v0=1.0):
+    """y = [s, v]; contact while s > 0 (wall at 0): m v' = -K s^1.5."""
+    state = {"on": False}
+
+    def res(t, y, yp, r):
+        s = y[0]
+        f = K * s ** 1.5 if state["on"] and s > 0 else 0.0
+        r[0] = yp[0] - y[1]
+        r[1] = m * yp[1] + f
+
+    def ev(t, y, yp, g):
+        g[0] = y[0]
+    ev.terminal = [True]
+    ev.direction = [0]
+    s = sun.ida.IDA(res, eventsfn=ev, num_events=1, rtol=rtol, atol=atol)
+    t, y, yp = 0.0, np.array([-1e-3, v0]), np.array([v0, 0.0])
+    s.init_step(t, y, yp)
+    nfev = 0
+    while t < 4e-3:
+        r = s.step(4e-3, method="onestep", tstop=4e-3)
+        t = r.t
+        if r.status == 2:
+            state["on"] = not state["on"]
+            y = r.y
+            f = K * max(y[0], 0) ** 1.5 if state["on"] else 0.0
+            nfev += r.nfev
+            s.init_step(t, y, np.array([y[1], -f / m]))
+    return y[1], nfev
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--repeat", type=int, default=20)
+    args = ap.parse_args(argv)
+    rows = []
+    _, osc = compile_file(os.path.join(ROOT, "models/examples/oscillator.py"))
+    out = np.linspace(0, 1, 1001)
+
+    def gen_osc():
+        return osc.simulate(t_end=1.0, rtol=1e-8, atol=1e-10, output_times=out)
+    rows.append(("oscillator", gen_osc, oscillator_handwritten,
+                 gen_osc().stats["nfev"], oscillator_handwritten()[1]))
+    hertz = os.path.join(ROOT, "models/examples/hertz_impact.py")
+    if os.path.exists(hertz):
+        mf, hz = compile_file(hertz)
+        opts = mf.experiment.run_options()
+        opts.update(rtol=1e-8, atol=1e-12)
+
+        def gen_hz():
+            return hz.simulate(**opts)
+        rows.append(("hertz_impact", gen_hz, hertz_handwritten,
+                     gen_hz().stats["nfev"], hertz_handwritten()[1]))
+    print(f"{'model':16s} {'generated [ms]':>15s} {'hand [ms]':>10s} {'ratio':>6s} "
+          f"{'nfev gen/hand':>14s}")
+    for name, gen, hand, nf_g, nf_h in rows:
+        tg, _ = best_of(gen, args.repeat)
+        th, _ = best_of(hand, args.repeat)
+        print(f"{name:16s} {tg * 1e3:15.2f} {th * 1e3:10.2f} {tg / th:6.2f} "
+              f"{nf_g:>7d}/{nf_h:<6d}")
+
+
+if __name__ == "__main__":
+    main()

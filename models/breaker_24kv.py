@@ -1,0 +1,172 @@
+"""The 24 kV circuit-breaker driving mechanism of the research report
+(Yu, Wang and Hsu, NSC 99-2221-E-011-015), composed from the component
+library following the report's five sub-models (section 2, Figs. 3 and 4):
+
+  armature --contact--> hook (lever s3) --four-bar (cam/roller)--> main shaft
+     |                    |  reset spring kh at s4, friction bh     |  open spring ko at s1,
+     Fe, reset spring ka  |                                         |  wipe spring kw at s2
+
+Sign convention (docs/breaker_model.md section 1, the report's own): the
+armature moves along -s, pushes the hook's contact point (s = s3*phi) along
+-s, so the hook angle ``hook.phi`` decreases from 0 to -Ra at release.
+Parameters from Table 1 (data/report/table1_parameters.csv); the values the
+report leaves out (main-shaft inertia, spring preloads, initial angles) are
+documented with their effect on the response time in docs/breaker_model.md.
+
+The run starts 1 um before first contact (so the contact's onset is a real
+event) and stops when the hook reaches its release angle. Measures:
+``thrt`` (first contact to release), ``contact_period`` (first impact),
+``peak_force``, ``impact_velocity``.
+"""
+import math
+
+from acausal import Experiment, Model, Stop, guess
+from components import contact as ct
+from components.contact import Contact
+from components.fourbar import FourBar, fourbar_angles
+from components.levers import IdealLever
+from components.rotational import Fixed as RotFixed
+from components.rotational import Inertia, RotationalDamper
+from components.translational import Fixed, Force, Mass, Spring
+
+GAP0 = 1e-6          # [m] armature-hook distance at t = 0 (first contact at ~0.26 us)
+THETA1_0 = 0.0       # [rad] hook angle at first contact (report's figures start at 0)
+
+
+class Armature(Model):
+    """Solenoid armature (Fig. 4a): mass ``ma``, reset spring ``ka``, constant
+    electromagnetic force ``Fe`` along -s. Connector: ``flange``."""
+
+    def __init__(self, v0, **kw):
+        super().__init__(**kw)
+        ma = self.parameter("ma", 0.22, "kg", "armature mass", min=0.0, min_open=True)
+        ka = self.parameter("ka", 0.013, "N/m", "armature reset-spring stiffness", min=0.0)
+        Fe = self.parameter("Fe", 160.0, "N", "electromagnetic force during impact", min=0.0)
+        self.mass = Mass(m=ma, s=GAP0, v=-v0)
+        self.coil = Force(f=-Fe)
+        self.reset = Spring(c=ka, s_rel0=GAP0)
+        self.frame = Fixed()
+        self.connect(self.frame.flange, self.reset.flange_a)
+        self.connect(self.reset.flange_b, self.mass.flange, self.coil.flange)
+        self.flange = self.mass.flange
+
+
+class TriggerHook(Model):
+    """Trigger hook (Fig. 4c): inertia ``Jh``, contact point at arm ``s3``,
+    reset spring ``kh`` at arm ``s4``, viscous shaft friction ``bh``.
+    Connectors: ``point`` (translational, the armature's contact point),
+    ``shaft`` (rotational, to the cam). Variable ``phi`` [rad]."""
+
+    def __init__(self, **kw):
+        super().__init__(**kw)
+        Jh = self.parameter("Jh", 0.00044, "kg*m^2", "hook moment of inertia", min=0.0,
+                            min_open=True)
+        bh = self.parameter("bh", 0.219, "N*m*s/rad", "hook friction coefficient", min=0.0)
+        s3 = self.parameter("s3", 0.055, "m", "arm of the armature contact point", min=0.0,
+                            min_open=True)
+        s4 = self.parameter("s4", 0.058, "m", "arm of the hook reset spring", min=0.0,
+                            min_open=True)
+        kh = self.parameter("kh", 714.0, "N/m", "hook reset-spring stiffness", min=0.0)
+        self.body = Inertia(J=Jh, phi=THETA1_0, w=0.0)
+        self.friction = RotationalDamper(d=bh)
+        self.arm3 = IdealLever(arm=s3)
+        self.arm4 = IdealLever(arm=s4)
+        self.reset = Spring(c=kh)
+        self.frame = RotFixed()
+        self.ground = Fixed()
+        self.connect(self.frame.flange, self.friction.flange_a)
+        self.connect(self.body.flange, self.friction.flange_b, self.arm3.flange_r,
+                     self.arm4.flange_r)
+        self.connect(self.arm4.flange_t, self.reset.flange_b)
+        self.connect(self.reset.flange_a, self.ground.flange)
+        self.point = self.arm3.flange_t
+        self.shaft = self.body.flange
+        phi = self.variable("phi", 0.0, "rad", "hook angle (decreases when tripped)")
+        self.equation(phi - self.body.phi)
+
+
+class MainShaft(Model):
+    """Main shaft (Fig. 4e): inertia ``Js``, open spring ``ko`` at arm ``s1``
+    and wipe spring ``kw`` at arm ``s2``, preloaded with ``Fo0``/``Fw0`` at the
+    closed position ``theta0``. Connector: ``shaft``."""
+
+    def __init__(self, theta0, **kw):
+        super().__init__(**kw)
+        Js = self.parameter("Js", 0.05, "kg*m^2", "main-shaft inertia (assumed)", min=0.0,
+                            min_open=True)
+        ko = self.parameter("ko", 7.0e4, "N/m", "open-spring stiffness", min=0.0)
+        kw = self.parameter("kw", 2.4e5, "N/m", "wipe-spring stiffness", min=0.0)
+        s1 = self.parameter("s1", 0.091, "m", "open-spring arm", min=0.0, min_open=True)
+        s2 = self.parameter("s2", 0.091, "m", "wipe-spring arm", min=0.0, min_open=True)
+        Fo0 = self.parameter("Fo0", 5600.0, "N", "open-spring force when closed (assumed)")
+        Fw0 = self.parameter("Fw0", 9000.0, "N", "wipe-spring force when closed (assumed)")
+        self.body = Inertia(J=Js, phi=guess(theta0), w=guess(0.0))
+        self.arm1 = IdealLever(arm=s1)
+        self.arm2 = IdealLever(arm=s2)
+        self.open_spring = Spring(c=ko, s_rel0=s1 * theta0, f0=Fo0)
+        self.wipe_spring = Spring(c=kw, s_rel0=s2 * theta0, f0=Fw0)
+        self.ground = Fixed()
+        self.connect(self.body.flange, self.arm1.flange_r, self.arm2.flange_r)
+        self.connect(self.arm1.flange_t, self.open_spring.flange_b)
+        self.connect(self.arm2.flange_t, self.wipe_spring.flange_b)
+        self.connect(self.ground.flange, self.open_spring.flange_a, self.wipe_spring.flange_a)
+        self.shaft = self.body.flange
+
+
+def build(v_impact=3.8, K=8.3e9, bh=0.219):
+    """The breaker model (defaults: the report's calibrated bh, K from eq. 3)."""
+    m = Model()
+    v = m.parameter("v_impact", v_impact, "m/s", "armature speed at first contact",
+                    min=0.0, min_open=True)
+    Ra = m.parameter("Ra", math.radians(5.0), "rad", "release angle of the trigger hook",
+                     min=0.0, min_open=True)
+    theta3_0 = fourbar_angles(THETA1_0)[1]
+    m.armature = Armature(v)
+    m.hook = TriggerHook()
+    m.hook.set(bh=bh)
+    m.contact = Contact(K=K, e=0.74, gamma=1.5, law="lankarani_nikravesh")
+    m.cam = FourBar(theta1=guess(THETA1_0))
+    m.main_shaft = MainShaft(theta3_0)
+    m.connect(m.hook.point, m.contact.flange_a)
+    m.connect(m.contact.flange_b, m.armature.flange)
+    m.connect(m.hook.shaft, m.cam.flange_a)
+    m.connect(m.cam.flange_b, m.main_shaft.shaft)
+    m.Ra_sym = Ra
+    return m
+
+
+model = build(K=6.25e8, bh=0.219)
+experiment = Experiment(t_end=0.02, rtol=1e-8, atol=1e-11, output_step=2e-6,
+                        stop=Stop(model.hook.phi, "<=", -model.Ra_sym, name="release"))
+
+
+def _t_first_contact(res):
+    return ct.impacts(res, "contact")[0].t_onset
+
+
+measures = {
+    "thrt": lambda res: res.event_times("release")[0] - _t_first_contact(res),
+    "contact_period": lambda res: ct.contact_period(res, "contact"),
+    "peak_force": lambda res: ct.peak_force(res, "contact"),
+    "impact_velocity": lambda res: ct.impact_velocity(res, "contact"),
+}
+
+
+def plot(res, path):
+    """The report's Fig. 7/10: impact force, hook angle, hook velocity and
+    armature velocity, with the contact period and THRT marked."""
+    import numpy as np
+    from acausal.plot import plot_result
+    t0 = _t_first_contact(res)
+    imp = ct.impacts(res, "contact")[0]
+    t_rel = res.event_times("release")[0]
+    s3 = float(res["hook.s3"][0])
+    return plot_result(
+        res, ["contact.fc", "hook.phi", "hook.body.w", "armature.mass.v"], path,
+        title=f"24 kV breaker, v_impact = {res['v_impact'][0]:.2f} m/s: contact "
+              f"{(imp.t_release - t0) * 1e3:.3f} ms, THRT {(t_rel - t0) * 1e3:.3f} ms",
+        scales={"contact.fc": -1.0, "hook.phi": 180 / np.pi, "hook.body.w": s3},
+        labels={"contact.fc": "impact force [N]", "hook.phi": "hook angle [deg]",
+                "hook.body.w": "hook velocity\nat s3 [m/s]",
+                "armature.mass.v": "armature\nvelocity [m/s]"},
+        marks=[(imp.t_release, "contact end"), (t_rel, "release (THRT)")])
