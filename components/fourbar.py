@@ -32,9 +32,9 @@ closing. Along a closed linkage
 import math
 
 import sympy as sp
-from sympy import Eq, Max, Min, acos, atan2, cos, sin, sqrt
+from sympy import Eq, Max, Min, cos, sin, sqrt
 
-from acausal import (Assertion, Component, Parameter, RotFlange, Start, Variable)
+from acausal import Assertion, Component, Parameter, RotFlange, Start, Variable
 
 
 def _closed_form(th1, e, f, r1, r2, r3, mode, lib):
