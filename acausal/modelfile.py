@@ -1,9 +1,11 @@
 """Model files: plain Python scripts that build a model.
 
 A model file binds a :class:`~acausal.Model` to the module-level name
-``model``; it may define ``experiment`` (an :class:`~acausal.Experiment`)
-and ``measures``, a dict of name -> function(result) -> float (a scalar
-computed from a result, such as a response time). A model file can import
+``model``; it may define ``experiment`` (an :class:`~acausal.Experiment`),
+``measures``, a dict of name -> function(result) -> float (a scalar
+computed from a result, such as a response time), ``free_parameters``, a
+dict of parameter -> (low, high) that calibration and diagnosis may fit,
+and ``plot(result, path)``. A model file can import
 another one (``from breaker_24kv import build``): its folder is on the path.
 """
 import os
@@ -25,6 +27,7 @@ class ModelFile:
     experiment: Experiment
     measures: dict = field(default_factory=dict)
     namespace: dict = field(default_factory=dict)
+    free: dict = field(default_factory=dict)   # parameter -> (low, high) bounds
 
 
 def _where(exc, path):
@@ -66,7 +69,13 @@ def load_model_file(path):
     measures = ns.get("measures") or {}
     if not isinstance(measures, dict) or not all(callable(f) for f in measures.values()):
         raise ModelFileError(f"{path}: 'measures' must be a dict of name -> function(result)")
-    return ModelFile(path, model, exp, dict(measures), ns)
+    free = ns.get("free_parameters") or {}
+    if not isinstance(free, dict) or not all(
+            isinstance(b, (tuple, list)) and len(b) == 2 for b in free.values()):
+        raise ModelFileError(f"{path}: 'free_parameters' must be a dict of "
+                             "name -> (low, high)")
+    return ModelFile(path, model, exp, dict(measures), ns, {k: tuple(map(float, v))
+                                                            for k, v in free.items()})
 
 
 _CACHE = {}
