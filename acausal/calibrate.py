@@ -36,6 +36,17 @@ def model_dataset(path, folder):
     return load_dataset(folder, parameters=params, measures=measures, variables=variables)
 
 
+def subset(dataset, names):
+    """The dataset restricted to the experiments ``names`` (in that order)."""
+    import dataclasses
+    known = [e.name for e in dataset.experiments]
+    bad = [n for n in names if n not in known]
+    if bad:
+        raise CalibrationError(f"{dataset.folder}: no experiment {bad[0]!r}; the dataset has "
+                               + ", ".join(known))
+    return dataclasses.replace(dataset, experiments=[dataset.experiment(n) for n in names])
+
+
 def simulate_experiment(path, params, conditions):
     """(result, measures) for one experiment with fitted ``params``."""
     mf, cm = compile_file(path)
@@ -63,38 +74,73 @@ class Calibration:
                     residuals=self.residuals, cost=self.cost, dof=self.dof, n_sim=self.n_sim)
 
 
-def report_method(path, dataset, pairs, experiment=None, brackets=None, base=None):
+def report_method(path, dataset, pairs, experiment=None, brackets=None, base=None,
+                  passes=2):
     """Calibrate ``pairs`` = [(parameter, measure), ...] in order, each by a
-    1-D root search so that the simulated measure equals the measured one at
-    ``experiment`` (default: the first experiment that has every measure)."""
+    1-D root search (``scipy.optimize.brentq``; on the logarithm of the
+    parameter when its range is positive) so that the simulated measure
+    equals the measured one at ``experiment`` (default: the first experiment
+    that measures every one of them). ``base`` gives starting values of other
+    parameters (the report starts with ``hook.bh = 0``). The sequence is
+    repeated ``passes`` times, since each parameter moves the other's
+    measure a little. A simulation that cannot produce the measure (the
+    hook never releases, the solver fails) counts as a measure larger than
+    any target, which is right for times to an event."""
     names = [m for _, m in pairs]
     exp = _nominal(dataset, names, experiment)
     values = dict(base or {})
     n_sim = [0]
-    _, cm = compile_file(path)
-    for pname, measure in pairs:
-        target = exp.measures[measure]
-        default = cm.params[cm.param_index(pname)].default
-        lo, hi = (brackets or {}).get(pname, (default / 30.0 if default > 0 else 1e-3,
-                                                default * 30.0 if default > 0 else 10.0))
-
-        def f(logx, pname=pname, measure=measure, target=target):
-            trial = dict(values)
-            trial[pname] = float(np.exp(logx))
-            n_sim[0] += 1
-            return simulate_experiment(path, trial, exp.conditions)[1][measure] - target
-
-        a, b = np.log(lo), np.log(hi)
-        fa, fb = f(a), f(b)
-        if np.sign(fa) == np.sign(fb):
-            raise CalibrationError(
-                f"report method: {measure} does not cross its measured value "
-                f"{target:.6g} for {pname} in [{lo:.4g}, {hi:.4g}] "
-                f"(residuals {fa:.3g} and {fb:.3g}); give a bracket")
-        values[pname] = float(np.exp(optimize.brentq(f, a, b, xtol=1e-10, rtol=1e-10)))
+    mf, cm = compile_file(path)
+    history = []
+    for _ in range(max(1, passes)):
+        for pname, measure in pairs:
+            values[pname] = _search(path, mf, cm, values, pname, measure, exp,
+                                    (brackets or {}).get(pname), n_sim)
+        history.append(dict(values))
+        if len(history) > 1 and all(abs(history[-1][k] - history[-2][k])
+                                    <= 1e-6 * max(abs(history[-1][k]), 1e-300)
+                                    for k in values):
+            break
     _, final = simulate_experiment(path, values, exp.conditions)
     resid = {exp.name: {m: final[m] - exp.measures[m] for m in names}}
     return Calibration("report", values, residuals=resid, n_sim=n_sim[0])
+
+
+def _bracket(mf, cm, pname, given):
+    if given is not None:
+        return tuple(map(float, given))
+    if pname in mf.free:
+        return mf.free[pname]
+    entry = cm.params[cm.param_index(pname)]
+    d = entry.default
+    lo = entry.decl.min if entry.decl.min is not None else (d / 30.0 if d > 0 else -abs(d) - 1)
+    hi = entry.decl.max if entry.decl.max is not None else (d * 30.0 if d > 0 else abs(d) + 1)
+    return lo, hi
+
+
+def _search(path, mf, cm, values, pname, measure, exp, bracket, n_sim):
+    target = exp.measures[measure]
+    lo, hi = _bracket(mf, cm, pname, bracket)
+    logscale = lo > 0
+    to_x = (lambda u: float(np.exp(u))) if logscale else float
+    scale = max(abs(target), 1e-300)
+
+    def f(u):
+        trial = dict(values)
+        trial[pname] = to_x(u)
+        n_sim[0] += 1
+        try:
+            return (simulate_experiment(path, trial, exp.conditions)[1][measure] - target) / scale
+        except AcausalError:
+            return 1e3   # no measure (no event, solver failure): beyond any target
+    a, b = (np.log(lo), np.log(hi)) if logscale else (lo, hi)
+    fa, fb = f(a), f(b)
+    if np.sign(fa) == np.sign(fb):
+        raise CalibrationError(
+            f"report method: {measure} does not cross its measured value {target:.6g} "
+            f"for {pname} in [{lo:.4g}, {hi:.4g}] (relative residuals {fa:.3g} and "
+            f"{fb:.3g}); give other bounds in the model file's free_parameters")
+    return to_x(optimize.brentq(f, a, b, xtol=1e-12, rtol=1e-10))
 
 
 def _nominal(dataset, measures, name=None):
@@ -143,20 +189,36 @@ def _sigma(dataset, signal, values):
 
 
 def least_squares(path, dataset, names, bounds=None, x0=None, signals=None):
-    """Output-error least squares over parameters ``names``."""
-    _, cm = compile_file(path)
+    """Output-error least squares over parameters ``names``.
+
+    Bounds come from ``bounds``, else the model file's ``free_parameters``,
+    else the parameters' declared limits. A parameter whose range is
+    positive is fitted on its logarithm, so its 95 % interval is asymmetric
+    and never crosses zero. Intervals use the Jacobian at the optimum, scaled
+    by the reduced chi-square when it exceeds 1 (never narrower than the
+    instrument model says), with Student t quantiles."""
+    mf, cm = compile_file(path)
     entries = [cm.params[cm.param_index(n)] for n in names]
     start = np.array([(x0 or {}).get(e.name, e.default) for e in entries], float)
-    lo = np.array([(bounds or {}).get(e.name, (e.decl.min if e.decl.min is not None
-                                               else -np.inf, None))[0] for e in entries], float)
-    hi = np.array([(bounds or {}).get(e.name, (None, e.decl.max if e.decl.max is not None
-                                               else np.inf))[1] for e in entries], float)
+    lo, hi = np.empty(len(names)), np.empty(len(names))
+    for k, e in enumerate(entries):
+        b = (bounds or {}).get(e.name) or mf.free.get(e.name) or (
+            e.decl.min if e.decl.min is not None else -np.inf,
+            e.decl.max if e.decl.max is not None else np.inf)
+        lo[k], hi[k] = b
+    logp = lo > 0
     scale = np.where(start != 0, np.abs(start), 1.0)
+
+    def to_x(z):
+        return np.where(logp, np.exp(z), z * scale)
+
+    def to_z(x):
+        return np.where(logp, np.log(np.where(logp, x, 1.0)), x / scale)
     n_sim = [0]
 
     def fun(z):
         n_sim[0] += len(dataset.experiments)
-        params = dict(zip(names, z * scale))
+        params = dict(zip(names, to_x(z).tolist()))
         try:
             return residual_vector(path, dataset, params, signals)[0]
         except AcausalError:
@@ -166,20 +228,26 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None):
     if n_res < len(names):
         raise CalibrationError(f"{n_res} measured values cannot determine {len(names)} "
                                "parameters")
-    z0 = np.clip(start / scale, lo / scale, hi / scale)
-    sol = optimize.least_squares(fun, z0, bounds=(lo / scale, hi / scale), x_scale=1.0,
-                                 diff_step=1e-6, xtol=1e-12, ftol=1e-12, gtol=1e-12)
-    values = dict(zip(names, (sol.x * scale).tolist()))
+    zlo, zhi = to_z(lo), to_z(hi)
+    zlo = np.where(np.isfinite(lo), zlo, -np.inf)
+    zhi = np.where(np.isfinite(hi), zhi, np.inf)
+    z0 = np.clip(to_z(np.clip(start, lo, hi)), zlo, zhi)
+    sol = optimize.least_squares(fun, z0, bounds=(zlo, zhi), diff_step=1e-6,
+                                 xtol=1e-12, ftol=1e-12, gtol=1e-12)
+    xs = to_x(sol.x)
+    values = dict(zip(names, xs.tolist()))
     dof = max(n_res - len(names), 0)
-    J = sol.jac / scale  # d r / d param
     ci, corr = {}, None
     try:
-        cov = np.linalg.inv(J.T @ J)
+        cov = np.linalg.inv(sol.jac.T @ sol.jac)
         s2 = 2 * sol.cost / dof if dof > 0 else 1.0
-        cov = cov * max(s2, 1.0)  # never narrower than the instrument model says
+        cov = cov * max(s2, 1.0)
         sd = np.sqrt(np.diag(cov))
         tq = stats.t.ppf(0.975, dof) if dof > 0 else stats.norm.ppf(0.975)
-        ci = {n: (v - tq * s, v + tq * s) for (n, v), s in zip(values.items(), sd)}
+        for k, n in enumerate(names):
+            zk = sol.x[k] + np.array([-1.0, 1.0]) * tq * sd[k]
+            xk = np.exp(zk) if logp[k] else zk * scale[k]
+            ci[n] = (float(xk[0]), float(xk[1]))
         corr = cov / np.outer(sd, sd)
     except np.linalg.LinAlgError:
         ci = {n: (float("nan"), float("nan")) for n in names}

@@ -132,14 +132,18 @@ def variables(file):
               help="parameters to fit; with --method report give PARAM:MEASURE pairs "
                    "in the order the report calibrates them (contact.K:contact_period,hook.bh:thrt)")
 @click.option("--method", type=click.Choice(["lsq", "report"]), default="lsq", show_default=True)
+@click.option("--experiments", metavar="E1,E2,...",
+              help="fit only these experiments (e.g. V110, as the report does)")
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object")
-def calibrate(file, data, fit, method, as_json):
+def calibrate(file, data, fit, method, experiments, as_json):
     """Fit parameters of a model file to a measured dataset."""
     from . import calibrate as cal
     from .modelfile import compile_file
     try:
         mf, cm = compile_file(file)
         ds = cal.model_dataset(file, data)
+        if experiments:
+            ds = cal.subset(ds, [x.strip() for x in experiments.split(",") if x.strip()])
         items = [x.strip() for x in fit.split(",") if x.strip()]
         if method == "report":
             pairs = []
