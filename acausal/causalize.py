@@ -11,6 +11,7 @@ algebraic unknowns of implicit blocks.
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg
 import scipy.sparse as sps
 from scipy.sparse.csgraph import connected_components, maximum_bipartite_matching
 import sympy as sp
@@ -28,7 +29,7 @@ class DAE:
     explicit: dict     # eliminated algebraic symbol -> expression of y/yp symbols
 
 
-def build_dae(g, dummies, params):
+def build_dae(g, dummies, params, values=None):
     """``params``: the set of parameter symbols (constant coefficients)."""
     nv = len(g.vsym)
     states = [j for j in range(nv) if g.vder[j] != -1 and g.vder[j] not in dummies]
@@ -62,7 +63,7 @@ def build_dae(g, dummies, params):
             (ei, ui), = block
             expr = _subs(eqs[ei][0], explicit)
             u = unknowns[ui]
-            sol = _solve_linear(expr, u, params)
+            sol = _solve_linear(expr, u, params, values)
             if sol is not None and u not in yp_set:
                 explicit[u] = sol
                 continue
@@ -73,7 +74,7 @@ def build_dae(g, dummies, params):
             continue
         exprs = [_subs(eqs[ei][0], explicit) for ei, _ in block]
         us = [unknowns[ui] for _, ui in block]
-        sol = _solve_linear_block(exprs, us, params)
+        sol = _solve_linear_block(exprs, us, params, values)
         if sol is not None:
             for (ei, ui), u, v in zip(block, us, sol):
                 if u in yp_set:
@@ -111,17 +112,43 @@ def _subs(expr, explicit):
     return expr.xreplace(hit) if hit else expr
 
 
-def _solve_linear(expr, u, params):
+def _numeric(expr, values):
+    try:
+        v = complex(expr.xreplace(values or {}))
+    except (TypeError, ValueError, ZeroDivisionError):
+        return float("nan")
+    return v.real if abs(v.imag) <= 1e-12 * max(1.0, abs(v.real)) else float("nan")
+
+
+def _solve_linear(expr, u, params, values=None):
     """u = -rest/coeff when expr is linear in u with a coefficient made of
     numbers and parameters only (never zero in a valid model)."""
     coeff = sp.diff(expr, u)
-    if coeff == 0 or coeff.has(u) or not coeff.free_symbols <= params:
+    if coeff == 0 or coeff.has(u) or not _safe_coefficient(coeff, params):
         return None
+    if not coeff.free_symbols <= params:
+        # a coefficient of variables: only divide if it is clearly non-zero
+        # at the start values (else the matching chose a bad pivot there)
+        c = _numeric(coeff, values)
+        if not np.isfinite(c) or abs(c) < 1e-9:
+            return None
     rest = expr.xreplace({u: 0})
     return -rest / coeff
 
 
-def _solve_linear_block(exprs, us, params, max_size=12):
+def _safe_coefficient(c, params):
+    """A coefficient we may divide by: numbers and parameters, or smooth
+    functions of variables already known (states, earlier blocks) — but never
+    a mode-dependent (Piecewise) one, which is zero in some mode (a stuck
+    friction element has no force law). A coefficient of known variables can
+    still vanish at a singular configuration (a linkage at dead centre);
+    components guard those with assertions."""
+    if c.free_symbols <= params:
+        return True
+    return not c.has(sp.Piecewise, sp.Heaviside, sp.sign, sp.Abs, sp.Max, sp.Min)
+
+
+def _solve_linear_block(exprs, us, params, values=None, max_size=12):
     """Solve a block of equations linear in its unknowns, with constant
     (parameter) coefficients, symbolically; None when it is not such a block."""
     if len(us) > max_size:
@@ -130,10 +157,22 @@ def _solve_linear_block(exprs, us, params, max_size=12):
         A, b = sp.linear_eq_to_matrix(exprs, us)
     except (sp.PolynomialError, ValueError, TypeError):
         return None
-    if not all(a.free_symbols <= params for a in A):
+    if any(a.has(*us) for a in A) or not all(_safe_coefficient(a, params) for a in A):
         return None
     if any(set(us) & bi.free_symbols for bi in b):
         return None
+    if not all(a.free_symbols <= params for a in A):
+        # pivots chosen numerically at the start values (partial pivoting),
+        # then imposed on the symbolic LU by reordering the rows: sympy would
+        # otherwise take the first structurally non-zero pivot, which can be
+        # zero there (e*sin(theta1) at theta1 = 0)
+        An = np.array([[_numeric(a, values) for a in A.row(i)] for i in range(A.rows)])
+        if not np.all(np.isfinite(An)) or np.linalg.matrix_rank(An) < A.rows:
+            return None
+        perm = scipy.linalg.lu(An)[0].T @ np.arange(A.rows)
+        order = [int(round(k)) for k in perm]
+        A = A.extract(order, list(range(A.cols)))
+        b = b.extract(order, [0])
     try:
         x = A.LUsolve(b)
     except (ValueError, ZeroDivisionError):

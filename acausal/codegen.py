@@ -65,7 +65,7 @@ class Names:
 def _body(exprs, targets, indent="        "):
     """Lines computing ``targets[i] = exprs[i]`` with common sub-expressions."""
     printer = _Printer()
-    reps, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("c_"), optimizations="basic")
+    reps, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("c_"), order="none")
     lines = [f"{indent}{printer.doprint(v)} = {printer.doprint(e)}" for v, e in reps]
     lines += [f"{indent}{t} = {printer.doprint(e)}" for t, e in zip(targets, reduced)]
     return lines

@@ -56,13 +56,14 @@ class CompiledModel:
         fixed = {v.symbol for v in flat.variables.values() if v.start.fixed}
         fixed |= {r for r, st in self._root_starts.items() if st.fixed}
         dummies = dummy_derivatives(g, values, lambda s: base_and_order(s)[0] in fixed)
-        self.dae = build_dae(g, dummies, set(self.param_syms))
+        self.dae = build_dae(g, dummies, set(self.param_syms), values)
         if not self.dae.y:
             raise ModelError("the model leaves nothing to integrate: every variable is "
                              "given explicitly (prescribed motion, constants), so there is no "
                              "state or implicit unknown for the solver; add a dynamic element "
                              "(a mass, an inertia, a damper between moving parts)")
         self._subs = dict(red.param_subs)
+        self._start_fns = {}
         self._alias = red.subs
         self.var_names = list(flat.variables)
         observed = [self.resolve(flat.variables[n].symbol) for n in self.var_names]
@@ -146,10 +147,62 @@ class CompiledModel:
         return p
 
     def _eval_start(self, value, p):
+        """A start value, which may be an expression of parameters."""
         if isinstance(value, sp.Basic) and not value.is_number:
-            e = value.xreplace(self._subs).xreplace(dict(zip(self.param_syms, p)))
-            return float(e)
+            fn = self._start_fns.get(value)
+            if fn is None:  # compiled once per expression (it runs every simulation)
+                e = value.xreplace(self._subs)
+                fn = self._start_fns[value] = sp.lambdify([self.param_syms], e, "math")
+            return float(fn(p))
         return float(value)
+
+    def fixed_jacobian(self):
+        """A function (y, yp) -> d(fixed-start variables)/d(y, y'_states),
+        generated once: the rows the initialisation adds for fixed starts."""
+        fn = getattr(self, "_fixed_jac", None)
+        if fn is None:
+            ns = self.dae.n_states
+            zs = list(self.dae.y) + [s for s in self.dae.yp[:ns]]
+            rows = []
+            for name in self.var_names:
+                if self.flat.variables[name].start.fixed:
+                    e = self.resolve(sp.Symbol(name))
+                    rows.append([sp.diff(e, z) for z in zs])
+            ysyms = list(self.dae.y)
+            ypsyms = [s if s is not None else sp.Dummy() for s in self.dae.yp]
+            args = [time] + ysyms + ypsyms + self.param_syms + self.disc_syms
+            fn = sp.lambdify(args, sp.Matrix(rows) if rows else sp.zeros(0, len(zs)),
+                             "numpy")
+            self._fixed_jac = fn
+        return fn
+
+    def state_slot_of(self, name):
+        """(slot, sign) when variable ``name`` is ±(one state slot), else None."""
+        cache = self.__dict__.setdefault("_slot_cache", {})
+        if name not in cache:
+            e = self.resolve(sp.Symbol(name))
+            sign = 1.0
+            if isinstance(e, sp.Mul) and len(e.args) == 2 and e.args[0] == -1:
+                sign, e = -1.0, e.args[1]
+            slots = {s: i for i, s in enumerate(self.dae.y[:self.dae.n_states])}
+            cache[name] = (slots[e], sign) if e in slots else None
+        return cache[name]
+
+    def slot_names(self):
+        """For each solver unknown, the names that denote it up to sign: its
+        own symbol and every variable that resolves to ±it."""
+        names = getattr(self, "_slot_names", None)
+        if names is None:
+            names = [[s.name] for s in self.dae.y]
+            index = {s: i for i, s in enumerate(self.dae.y)}
+            for name in self.var_names:
+                e = self.resolve(sp.Symbol(name))
+                if isinstance(e, sp.Mul) and len(e.args) == 2 and e.args[0] == -1:
+                    e = e.args[1]
+                if e in index:
+                    names[index[e]].append(name)
+            self._slot_names = names
+        return names
 
     def fixed_starts(self, p):
         """(index in var_names, value, name) of every fixed start value."""

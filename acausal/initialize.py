@@ -31,6 +31,7 @@ def initial_point(cm, p, d, cb, t0):
     fixed = cm.fixed_starts(p)           # list of (var index, value, name)
     y0 = cm.guess_vector(p)
     res_fn, observe = cb[0], cb[4]
+    fixed_jac = cm.fixed_jacobian()
     r = np.zeros(n)
 
     def split(z):
@@ -53,16 +54,8 @@ def initial_point(cm, p, d, cb, t0):
         top = np.hstack([Jy, Jyp[:, :ns]])
         rows = [top]
         if fixed:
-            eps = 1e-7 * (1 + np.abs(z))
-            base = np.array([observe(t0, y, yp)[k] for k, _, _ in fixed])
-            Jf = np.zeros((len(fixed), len(z)))
-            for j in range(len(z)):
-                z2 = z.copy()
-                z2[j] += eps[j]
-                yy, yyp = split(z2)
-                o = observe(t0, yy, yyp)
-                Jf[:, j] = (np.array([o[k] for k, _, _ in fixed]) - base) / eps[j]
-            rows.append(Jf)
+            rows.append(np.asarray(fixed_jac(t0, *y, *yp, *p, *d), dtype=float)
+                        .reshape(len(fixed), len(z)))
         if guess_rows:
             G = np.zeros((len(guess_rows), len(z)))
             for a, k in enumerate(guess_rows):
@@ -106,20 +99,11 @@ def initial_point(cm, p, d, cb, t0):
 def _snap_fixed_states(cm, y, fixed):
     """Set every state slot that a fixed start names (directly or negated)
     exactly to its value; True when a slot changed."""
-    ns = cm.dae.n_states
-    slot = {s: i for i, s in enumerate(cm.dae.y[:ns])}
     changed = False
     for _, value, name in fixed:
-        try:
-            e = cm.resolve(sp.Symbol(name))
-        except Exception:  # not expressible in y (never for a fixed start)
-            continue
-        sign = 1.0
-        if isinstance(e, sp.Mul) and len(e.args) == 2 and e.args[0] == -1:
-            sign, e = -1.0, e.args[1]
-        i = slot.get(e)
-        if i is not None and y[i] != sign * value:
-            y[i] = sign * value
+        hit = cm.state_slot_of(name)
+        if hit is not None and y[hit[0]] != hit[1] * value:
+            y[hit[0]] = hit[1] * value
             changed = True
     return changed
 

@@ -71,6 +71,8 @@ def _output_times(t0, t_end, output_step, output_times):
     if output_times is not None:
         ts = np.asarray(sorted(output_times), dtype=float)
         return ts[(ts >= t0) & (ts <= t_end)]
+    if output_step == 0:   # every internal step of the solver
+        return np.array([t0, t_end], dtype=float)
     step = output_step or (t_end - t0) / 500.0
     n = int(np.floor((t_end - t0) / step + 1e-9))
     ts = t0 + step * np.arange(n + 1)
@@ -79,11 +81,33 @@ def _output_times(t0, t_end, output_step, output_times):
     return ts
 
 
+def _atol(cm, atol):
+    """A scalar, or a dict of absolute tolerances by variable name (any
+    variable that is, up to sign, one of the solver's unknowns: ``mass.v``
+    works whether the solver keeps ``mass.v`` or ``der(mass.s)``), with
+    ``"*"`` the default for the others."""
+    if not isinstance(atol, dict):
+        return float(atol)
+    slots = cm.slot_names()
+    default = float(atol.get("*", 1e-8))
+    out = np.full(len(cm.dae.y), default)
+    for name, value in atol.items():
+        if name == "*":
+            continue
+        hits = [i for i, names in enumerate(slots) if name in names]
+        if not hits:
+            from .errors import ModelError
+            raise ModelError(f"atol: {name!r} is not (up to sign) one of the solver's "
+                             "unknowns: " + ", ".join(n[0] for n in slots))
+        out[hits[0]] = float(value)
+    return out
+
+
 class _Run:
     def __init__(self, cm, p, t0, t_end, rtol, atol, max_step, max_steps):
         self.cm, self.p = cm, np.asarray(p, float)
         self.t0, self.t_end = t0, t_end
-        self.opts = dict(rtol=rtol, atol=atol, max_step=max_step or 0.0,
+        self.opts = dict(rtol=rtol, atol=_atol(cm, atol), max_step=max_step or 0.0,
                          max_num_steps=max_steps)
         self.T, self.Y, self.YP, self.D = [], [], [], []
         self.events, self.event_log = [], []
@@ -98,19 +122,31 @@ class _Run:
         self.D.append(np.tile(np.asarray(d, float), (len(self.T[-1]), 1)))
 
     def solver(self, cb):
+        """The IDA object of this run, made once: its callbacks dispatch to the
+        current mode's generated functions (``self.cb``), so a mode change
+        only swaps them (creating an IDA object costs more than a segment of
+        a short contact)."""
+        self.cb = cb
+        if getattr(self, "_ida", None) is not None:
+            return self._ida
         kw = dict(self.opts)
         alg = list(range(self.cm.dae.n_states, len(self.cm.dae.y)))
         if alg:
             kw["algebraic_idx"] = alg
-        if self.cm.n_roots:
-            f = cb[2]
 
+        def res(t, y, yp, r):
+            self.cb[0](t, y, yp, r)
+
+        def jac(t, y, yp, r, cj, J):
+            self.cb[1](t, y, yp, r, cj, J)
+        if self.cm.n_roots:
             def roots(t, y, yp, g):
-                f(t, y, yp, g)
+                self.cb[2](t, y, yp, g)
             roots.terminal = [True] * self.cm.n_roots
             roots.direction = list(self.directions)
             kw.update(eventsfn=roots, num_events=self.cm.n_roots)
-        return IDA(cb[0], jacfn=cb[1], **kw)
+        self._ida = IDA(res, jacfn=jac, **kw)
+        return self._ida
 
     def result(self, status="ok", message=""):
         stats = dict(nfev=self.nfev, njev=self.njev, steps=self.steps,
@@ -142,16 +178,23 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
             later = tout[tout > t]
             tspan = np.concatenate([[t], later if len(later) and later[-1] >= t_end
                                     else np.append(later, t_end)])
+            # two points: IDA reports every internal step (output_step=0)
             sol = ida.solve(tspan, y, yp)
+            if len(tspan) == 2 and output_step != 0 and len(sol.t) > 2:
+                # IDA reported every internal step; keep what was asked for
+                keep = np.r_[0, len(sol.t) - 1]
+                sol_t, sol_y, sol_yp = sol.t[keep], sol.y[keep], sol.yp[keep]
+            else:
+                sol_t, sol_y, sol_yp = sol.t, sol.y, sol.yp
             run.nfev += sol.nfev
             run.njev += sol.njev
             run.steps += cb[5][0]
             cb[5][0] = 0
             if sol.status < 0:
-                if len(sol.t) > 1:
-                    run.record(sol.t[1:], sol.y[1:], sol.yp[1:], d)
+                if len(sol_t) > 1:
+                    run.record(sol_t[1:], sol_y[1:], sol_yp[1:], d)
                 raise _failure(run, cm, sol, cb)
-            run.record(sol.t[1:], sol.y[1:], sol.yp[1:], d)
+            run.record(sol_t[1:], sol_y[1:], sol_yp[1:], d)
             t, y, yp = float(sol.t[-1]), np.array(sol.y[-1]), np.array(sol.yp[-1])
             if sol.status != 2:
                 break
