@@ -188,6 +188,16 @@ class CompiledModel:
             cache[name] = (slots[e], sign) if e in slots else None
         return cache[name]
 
+    def dynamic_discretes(self):
+        """Indices of the discrete values the residual equations use."""
+        dyn = getattr(self, "_dynamic", None)
+        if dyn is None:
+            used = set()
+            for r in self.dae.residuals:
+                used |= r.free_symbols
+            dyn = self._dynamic = {j for j, s in enumerate(self.disc_syms) if s in used}
+        return dyn
+
     def slot_names(self):
         """For each solver unknown, the names that denote it up to sign: its
         own symbol and every variable that resolves to ±it."""

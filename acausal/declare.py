@@ -135,10 +135,14 @@ class Event:
     With ``recheck=True`` the condition is also tested right after any other
     event re-initialised the model (an event iteration, as Modelica does), so
     a mode that is not valid at the new point is left at once.
+    ``observer=True`` marks an event whose action only records values
+    (discrete values that no equation uses, such as a peak force): IDA does
+    not stop for it, the action runs on the state IDA located, and the
+    integration goes on undisturbed.
     """
 
     def __init__(self, name, expr, direction=0, action=None, *, terminal=False,
-                 recheck=False):
+                 recheck=False, observer=False):
         if direction not in (-1, 0, 1):
             raise ValueError(f"event {name}: direction must be -1, 0 or +1")
         self.name = name
@@ -147,6 +151,7 @@ class Event:
         self.action = action
         self.terminal = terminal
         self.recheck = recheck
+        self.observer = observer
         self.owner = None  # set by flattening: the component path
 
 

@@ -142,7 +142,9 @@ class _Run:
         if self.cm.n_roots:
             def roots(t, y, yp, g):
                 self.cb[2](t, y, yp, g)
-            roots.terminal = [True] * self.cm.n_roots
+            roots.terminal = [not e.observer for e in self.cm.events] + \
+                [True] * len(self.cm.assertions)
+            self._roots = roots
             roots.direction = list(self.directions)
             kw.update(eventsfn=roots, num_events=self.cm.n_roots)
         self._ida = IDA(res, jacfn=jac, **kw)
@@ -167,6 +169,7 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
     d = cm.discrete_start()
     run = _Run(cm, p, t0, t_end, rtol, atol, max_step, max_steps)
     cb = cm.callbacks(p, d)
+    run.cb_d = list(d)
     y, yp = initial_point(cm, p, d, cb, t0)
     y, yp, d, cb, stop = _event_iteration(run, cb, t0, y, yp, d, initial=True)
     tout = _output_times(t0, t_end, output_step, output_times)
@@ -179,6 +182,7 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
             tspan = np.concatenate([[t], later if len(later) and later[-1] >= t_end
                                     else np.append(later, t_end)])
             # two points: IDA reports every internal step (output_step=0)
+            _reset_event_log(getattr(run, "_roots", None))
             sol = ida.solve(tspan, y, yp)
             if len(tspan) == 2 and output_step != 0 and len(sol.t) > 2:
                 # IDA reported every internal step; keep what was asked for
@@ -196,9 +200,13 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
                 raise _failure(run, cm, sol, cb)
             run.record(sol_t[1:], sol_y[1:], sol_yp[1:], d)
             t, y, yp = float(sol.t[-1]), np.array(sol.y[-1]), np.array(sol.yp[-1])
+            d, final_fired = _observers(run, cb, sol, d)
+            if d != run.cb_d:
+                cb = cm.callbacks(run.p, d)
+            run.cb_d = list(d)
             if sol.status != 2:
                 break
-            fired = [i for i, s_ in enumerate(sol.i_events[-1]) if s_ != 0]
+            fired = final_fired
             d_before = list(d)
             y, yp, d, cb, stop = _handle(run, cb, t, y, yp, d, fired)
             if list(d) != d_before:
@@ -211,6 +219,54 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
     res.stats["wall_s"] = _time.perf_counter() - wall0
     res.stats["compile_s"] = cm.compile_s
     return res
+
+
+def _reset_event_log(roots):
+    """scikit-sundae keeps the located roots (and per-event counts that decide
+    when to stop) on the events function; one IDA object serves every
+    segment of a run, so clear them before each segment."""
+    if roots is not None and hasattr(roots, "_i"):
+        for name in ("_i", "_t", "_y", "_yp"):
+            getattr(roots, name).clear()
+        roots._i_cnt[:] = 0
+
+
+def _observers(run, cb, sol, d):
+    """Run the actions of observer events IDA located during the segment (it
+    did not stop for them), in time order; the discrete values they record
+    are written into the rows from their time on. Returns the discrete
+    values and the events that ended the segment (without its observers)."""
+    cm = run.cm
+    roots = getattr(run, "_roots", None)
+    if roots is None or not getattr(roots, "_i", None):
+        return d, [i for i, s_ in enumerate(sol.i_events[-1]) if s_ != 0] \
+            if sol.status == 2 else []
+    d = list(d)
+    n_ev = len(cm.events)
+    final = []
+    last = len(roots._i) - 1
+    for k, (flags, te, ye, ype) in enumerate(zip(roots._i, roots._t, roots._y, roots._yp)):
+        fired = [i for i, s_ in enumerate(flags) if s_ != 0]
+        obs = [i for i in fired if i < n_ev and cm.events[i].observer]
+        if k == last and sol.status == 2:
+            final = [i for i in fired if i not in obs]
+        if not obs:
+            continue
+        state = EventState(cm, run.p, d, te, cb[4](te, ye, ype))
+        before = list(d)
+        for i in obs:
+            _log_event(run, te, cm.events[i])
+            cm.events[i].action(state)
+        for j, (a, b) in enumerate(zip(before, d)):
+            if a != b:
+                if j in cm.dynamic_discretes():
+                    raise SolverError(
+                        f"{cm.events[obs[0]].owner}: observer event {cm.events[obs[0]].name!r} "
+                        f"changed {cm.discretes[j].symbol.name}, which the equations use; "
+                        "make it a regular event", t=te, component=cm.events[obs[0]].owner)
+                rows = run.T[-1] >= te
+                run.D[-1][rows, j] = b
+    return d, final
 
 
 def _handle(run, cb, t, y, yp, d, fired):

@@ -286,7 +286,8 @@ class PartialContact(Component):
             # that a resting contact's decaying oscillation fires no more events
             f1 = self.K * PosPow(self.delta, self.gamma) * PosPow(fac, 1)   # fc in mode 1
             rising = m1 & (f1 > self.f_peak * (1 + PEAK_MARGIN))
-            evs.append(Event(f"{p}.peak", Piecewise((dFdt, rising), (1, True)), -1, peak))
+            evs.append(Event(f"{p}.peak", Piecewise((dFdt, rising), (1, True)), -1, peak,
+                             observer=True))
         return evs
 
 

@@ -347,7 +347,13 @@ def test_bouncing_ball_comes_to_rest_without_chattering():
     res = compile_model(model).simulate(t_end=1.0, rtol=1e-8, atol=1e-12, output_step=1e-2)
     f = res.final()
     assert f["floor.mode"] == 1 and n_impacts(res, "floor") == 15
-    assert len(res.events) < 50                                  # measured 44
+    # events that stop and restart the solver: 15 onsets + 14 releases; the
+    # peak events are observers (IDA does not stop for them; their guard
+    # keeps the segment's f_peak, so a settling contact may report a few
+    # more local maxima): bounded too
+    stops = [e for e in res.events if not e[1].endswith(".peak")]
+    assert len(stops) == 29
+    assert len(res.events) - len(stops) < 50                     # measured 42
     assert f["floor.delta"] == pytest.approx((m * g / K) ** (2 / 3), rel=1e-9)
     assert f["floor.fc"] == pytest.approx(m * g, rel=1e-9)
     assert abs(f["ball.v"]) < 1e-12
