@@ -1,0 +1,139 @@
+"""The command line: JSON output, exit codes and messages of every error path."""
+import json
+import os
+import textwrap
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from acausal.cli import main
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+EX = os.path.join(ROOT, "models", "examples")
+
+
+def run(*args):
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+def test_simulate_json_oscillator_matches_closed_form():
+    r = run("simulate", os.path.join(EX, "oscillator.py"), "--json")
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.output)
+    assert set(out) == {"final", "events", "measures", "stats"}
+    assert {"nfev", "steps", "wall_s", "compile_s"} <= set(out["stats"])
+    exact = 0.1 * np.cos(10.0)
+    assert abs(out["final"]["mass.s"] / exact - 1) < 1e-6
+    assert abs(out["final"]["spring.f"] - 100.0 * out["final"]["mass.s"]) < 1e-9
+
+
+def test_simulate_json_lever_masses_matches_closed_form():
+    r = run("simulate", os.path.join(EX, "lever_masses.py"), "--json")
+    assert r.exit_code == 0, r.output
+    f = json.loads(r.output)["final"]
+    w = np.sqrt(1000 * 0.1**2 / (2 * 0.1**2 + 1 * 0.3**2))
+    phi = 0.1 * np.cos(w * 1.0)
+    assert abs(f["lever.phi"] / phi - 1) < 1e-6
+    assert abs(f["m2.s"] / (0.3 * phi) - 1) < 1e-6
+
+
+def test_simulate_events_and_measures_in_json():
+    r = run("simulate", os.path.join(EX, "hertz_impact.py"), "--json")
+    out = json.loads(r.output)
+    names = [e["name"] for e in out["events"]]
+    assert names[0] == "contact.onset" and "contact.release" in names
+    assert abs(out["measures"]["contact_period"] / 3.21807e-4 - 1) < 1e-3
+
+
+def test_set_writes_csv_and_plot(tmp_path):
+    csv, png = tmp_path / "r.csv", tmp_path / "r.png"
+    r = run("simulate", os.path.join(EX, "oscillator.py"), "--set", "spring.c=400",
+            "--t-end", "0.5", "--out", csv, "--plot", png)
+    assert r.exit_code == 0, r.output
+    head = csv.read_text().splitlines()
+    assert head[0].startswith("time,") and "mass.s" in head[0]
+    last = dict(zip(head[0].split(","), map(float, head[-1].split(","))))
+    assert abs(last["mass.s"] - 0.1 * np.cos(20 * 0.5)) < 1e-6
+    assert png.stat().st_size > 1000
+
+
+def test_variables_lists_units():
+    r = run("variables", os.path.join(EX, "oscillator.py"))
+    assert r.exit_code == 0
+    assert "spring.c" in r.output and "[N/m]" in r.output and "mass.s" in r.output
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--set", "mass.m=-1"], ["mass.m", "must be > 0"]),
+    (["--set", "mass.q=1"], ["mass.q"]),
+    (["--set", "mass.m"], ["PATH=VALUE"]),
+])
+def test_bad_set_exits_2(args, words):
+    r = run("simulate", os.path.join(EX, "oscillator.py"), *args)
+    assert r.exit_code == 2
+    for w in words:
+        assert w in r.output
+    assert "Traceback" not in r.output
+
+
+def write(tmp_path, text, name="m.py"):
+    p = tmp_path / name
+    p.write_text(textwrap.dedent(text))
+    return p
+
+
+def test_model_file_syntax_error_names_line(tmp_path):
+    p = write(tmp_path, "from acausal import Model\nmodel = Model(\n")
+    r = run("simulate", p)
+    assert r.exit_code == 2 and f"{p}:" in r.output and "syntax" in r.output
+
+
+def test_model_file_exception_names_line(tmp_path):
+    p = write(tmp_path, """\
+        from acausal import Model
+        from components.translational import Mass
+        model = Model()
+        model.mass = Mass(m=-2.0)
+        """)
+    r = run("simulate", p)
+    assert r.exit_code == 2
+    assert f"{p}:4" in r.output and "must be > 0" in r.output
+
+
+def test_model_file_without_model(tmp_path):
+    p = write(tmp_path, "x = 1\n")
+    r = run("simulate", p)
+    assert r.exit_code == 2 and "'model'" in r.output
+
+
+def test_unconnected_flange_exits_2_and_names_it(tmp_path):
+    p = write(tmp_path, """\
+        from acausal import Model
+        from components.translational import Mass, Spring
+        model = Model()
+        model.mass = Mass(m=1.0, s=0.1)
+        model.spring = Spring(c=100.0)
+        model.connect(model.spring.flange_b, model.mass.flange)
+        """)
+    r = run("simulate", p)
+    assert r.exit_code == 2 and "spring.flange_a" in r.output
+
+
+def test_solver_failure_exits_3_names_time_and_keeps_partial_results(tmp_path):
+    # m s'' = 1e3 s^3 from s = 1: s blows up at a finite time (~0.056 s)
+    p = write(tmp_path, """\
+        from acausal import Experiment, Model
+        from components.translational import Force, Mass
+        model = Model()
+        model.mass = Mass(m=1.0, s=1.0, v=0.0)
+        model.push = Force(f=lambda s: 1e3 * s**3)
+        model.connect(model.push.flange, model.mass.flange)
+        experiment = Experiment(t_end=1.0, output_step=1e-3)
+        """)
+    out = tmp_path / "partial.csv"
+    r = run("simulate", p, "--out", out)
+    assert r.exit_code == 3, r.output
+    assert "failed at t = 0.05" in r.output and "mass" in r.output
+    rows = out.read_text().splitlines()
+    assert len(rows) > 20                              # what was computed is kept
