@@ -104,7 +104,7 @@ def _declare(flat, comp):
             flat.variables[sym.name] = VarInfo(sym, Start(0.0, False), unit, desc, path, True)
 
 
-def relocate(expr, comp, known):
+def relocate(expr, comp, known, start=None):
     """Give symbols their full paths. An expression built inside a model's
     constructor, before the model was attached to its parent, names symbols
     relative to that model (``body.phi`` instead of ``hook.body.phi``): each
@@ -119,7 +119,7 @@ def relocate(expr, comp, known):
         base, k = base_and_order(s)
         if base.name in known:
             continue
-        node = comp
+        node = start if start is not None else comp
         while node is not None:
             p = node.path
             cand = f"{p}.{base.name}" if p else base.name
@@ -134,15 +134,21 @@ def relocate(expr, comp, known):
 
 
 def _relocate_values(flat, comp, known):
+    """Parameter values and start values were given by whoever built the
+    component: its parent model (``Mass(m=ma)`` inside a sub-model), or the
+    model itself for its own declarations (``self.parameter(...)``)."""
     pre = f"{comp.path}." if comp.path else ""
+    own = comp._extra
     for name in comp.declarations():
         full = pre + name
+        start = comp if name in own else (comp._parent or comp)
         info = flat.params.get(full)
         if info is not None and not info.decl.structural:
-            info.value = relocate(info.value, comp, known)
+            info.value = relocate(info.value, comp, known, start)
         vinfo = flat.variables.get(full)
         if vinfo is not None and isinstance(vinfo.start.value, sp.Basic):
-            vinfo.start = Start(relocate(vinfo.start.value, comp, known), vinfo.start.fixed)
+            vinfo.start = Start(relocate(vinfo.start.value, comp, known, start),
+                                vinfo.start.fixed)
 
 
 def _equations(flat, comp, known):

@@ -369,23 +369,18 @@ class Clearance(Model):
                            min_open=d.min_open, max_open=d.max_open)
         self.lower = Contact(law=law, peak_event=peak_event)
         self.upper = Contact(law=law, peak_event=peak_event)
+        # both sides use this model's parameters (names are relative to this
+        # model here; flattening gives them their full paths)
+        shared = {name: self.symbol(name) for name in self.SHARED}
+        gap, s_rel0 = self.symbol("gap"), self.symbol("s_rel0")
+        # lower: s_rel < s_rel0 - gap  ->  Contact(a, b) with its gap = s_rel0 - gap
+        self.lower.set(gap=s_rel0 - gap, **shared)
+        # upper: s_rel > s_rel0 + gap  ->  Contact(b, a), whose s_rel is -s_rel
+        self.upper.set(gap=-(s_rel0 + gap), **shared)
         self.connect(self.lower.flange_a, self.upper.flange_b)
         self.connect(self.lower.flange_b, self.upper.flange_a)
         self.flange_a = self.lower.flange_a
         self.flange_b = self.lower.flange_b
-
-    def walk(self):
-        # bind the sides to this model's parameters now that its path is final
-        # (a parameter symbol is named by the path, unknown in __init__)
-        sym = self.symbol
-        for side in (self.lower, self.upper):
-            for name in self.SHARED:
-                side._values[name] = sym(name)
-        # lower: s_rel < s_rel0 - gap  ->  Contact(a, b) with its gap = s_rel0 - gap
-        self.lower._values["gap"] = sym("s_rel0") - sym("gap")
-        # upper: s_rel > s_rel0 + gap  ->  Contact(b, a), whose s_rel is -s_rel
-        self.upper._values["gap"] = -(sym("s_rel0") + sym("gap"))
-        yield from super().walk()
 
 
 # -- measures -------------------------------------------------------------------

@@ -254,3 +254,26 @@ def test_time_window_chattering_guard(monkeypatch):
         compile_model(m).simulate(t_end=1.0)
     assert "slot" in str(err.value)
     assert err.value.result is not None and len(err.value.result.events) >= 100
+
+
+class SpringOnMass(Model):
+    """A sub-assembly built in its constructor, before it has a path: its
+    parameter ``c`` shares its name with the spring's own ``c``."""
+
+    def __init__(self):
+        super().__init__()
+        c = self.parameter("c", 100.0, "N/m", "stiffness", min=0.0)
+        self.mass = Mass(m=1.0, s=0.1)
+        self.spring = Spring(c=c)
+        self.ground = Fixed()
+        self.connect(self.ground.flange, self.spring.flange_a)
+        self.connect(self.spring.flange_b, self.mass.flange)
+
+
+def test_sub_model_bindings_get_full_paths():
+    m = Model()
+    m.sub = SpringOnMass()
+    cm = compile_model(m)
+    assert str(cm.bound["sub.spring.c"]) == "sub.c"
+    res = cm.simulate(t_end=0.3, params={"sub.c": 400.0}, rtol=1e-9, atol=1e-11)
+    assert abs(res.final()["sub.mass.s"] - 0.1 * np.cos(20 * 0.3)) < 1e-7
