@@ -277,3 +277,39 @@ def test_sub_model_bindings_get_full_paths():
     assert str(cm.bound["sub.spring.c"]) == "sub.c"
     res = cm.simulate(t_end=0.3, params={"sub.c": 400.0}, rtol=1e-9, atol=1e-11)
     assert abs(res.final()["sub.mass.s"] - 0.1 * np.cos(20 * 0.3)) < 1e-7
+
+
+def test_connecting_different_domains_is_named():
+    from acausal import ModelError
+    from components.rotational import Inertia
+    m = Model()
+    m.mass = Mass(m=1.0)
+    m.wheel = Inertia(J=1.0)
+    m.connect(m.mass.flange, m.wheel.flange)
+    with pytest.raises(ModelError) as err:
+        compile_model(m)
+    msg = str(err.value)
+    assert "mass.flange" in msg and "wheel.flange" in msg and "RotFlange" in msg
+
+
+def test_equation_with_an_unknown_name_is_named():
+    from acausal import ModelError
+    m = oscillator()
+    m.equation(Eq(m.mass.s, sp.Symbol("mass.typo")))
+    with pytest.raises(ModelError, match="mass.typo"):
+        compile_model(m)
+
+
+def test_binding_to_a_non_parameter_is_named():
+    from acausal import ModelError
+    m = oscillator()
+    m.spring.set(c=sp.Symbol("stiffnes"))
+    with pytest.raises(ModelError, match="stiffnes"):
+        compile_model(m)
+
+
+def test_unknown_parameter_keyword_lists_the_valid_ones():
+    from acausal import ParameterError
+    with pytest.raises(ParameterError) as err:
+        Mass(mass=1.0)
+    assert "'mass'" in str(err.value) and "m" in str(err.value)
