@@ -79,6 +79,18 @@ def _output_times(t0, t_end, output_step, output_times):
     return ts
 
 
+def _atol_vector(cm, atol, atol_algebraic):
+    """``atol`` as given, or a per-unknown vector with ``atol_algebraic`` on
+    the algebraic unknowns (those after the states)."""
+    if atol_algebraic is None:
+        return atol
+    if not (atol_algebraic > 0 and np.isfinite(atol_algebraic)):
+        raise ValueError(f"atol_algebraic must be a positive number, got {atol_algebraic!r}")
+    vec = np.full(len(cm.dae.y), float(atol))
+    vec[cm.dae.n_states:] = float(atol_algebraic)
+    return vec
+
+
 class _Run:
     def __init__(self, cm, p, t0, t_end, rtol, atol, max_step, max_steps):
         self.cm, self.p = cm, np.asarray(p, float)
@@ -123,13 +135,26 @@ class _Run:
 
 
 def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_step=None,
-             output_times=None, max_step=None, max_steps=100000):
+             output_times=None, max_step=None, max_steps=100000, atol_algebraic=None):
     """Simulate a :class:`CompiledModel` from ``t0`` to ``t_end`` (or until a
-    terminal event). ``params`` overrides parameter values by dotted path."""
+    terminal event). ``params`` overrides parameter values by dotted path.
+
+    ``atol`` applies to every unknown unless ``atol_algebraic`` is given: then
+    the algebraic unknowns (forces, torques, dummy derivatives, constrained
+    positions; everything but the selected states) get that absolute
+    tolerance instead. IDA puts them into its local error test (and Newton
+    convergence test); one that is computed as the small difference of large
+    terms (a cam force balancing a kilonewton preload) and crosses zero can
+    then fail the test with a tight SI ``atol`` at every step there, so that
+    the step size collapses. A large value (e.g. 1e-2) practically leaves
+    them out of the error test (like IDA's ``suppressalg``, which
+    scikit-sundae does not expose); their accuracy then follows from the
+    states'. Default ``None``: ``atol`` for all, as before."""
     wall0 = _time.perf_counter()
     p = cm.param_vector(params)
     d = cm.discrete_start()
-    run = _Run(cm, p, t0, t_end, rtol, atol, max_step, max_steps)
+    run = _Run(cm, p, t0, t_end, rtol, _atol_vector(cm, atol, atol_algebraic), max_step,
+               max_steps)
     cb = cm.callbacks(p, d)
     y, yp = initial_point(cm, p, d, cb, t0)
     y, yp, d, cb, stop = _event_iteration(run, cb, t0, y, yp, d, initial=True)
