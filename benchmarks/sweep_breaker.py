@@ -14,7 +14,7 @@ trials are repeated and all are printed.
 
 Usage (from the repository root)::
 
-    PYTHONPATH=. python benchmarks/sweep_breaker.py [--trials 3] [--scheduler processes|dask]
+    PYTHONPATH=. python benchmarks/sweep_breaker.py [--trials 3] [--repeat 1] [--scheduler processes|dask]
 """
 from __future__ import annotations
 
@@ -45,14 +45,15 @@ def dask_pool(workers: int):
             yield ex
 
 
-def trial(points, workers: int, scheduler: str) -> dict:
+def trial(points, workers: int, scheduler: str, repeat: int = 1) -> dict:
     from acausal.modelfile import compile_file, sweep_task
     from sweep_scaling import measure_scaling
 
     task = functools.partial(sweep_task, MODEL)
     warm = functools.partial(compile_file, MODEL)
     pool = functools.partial(dask_pool, workers) if scheduler == "dask" else None
-    return measure_scaling(task, points, ["thrt"], workers=workers, warmup=warm, open_pool=pool)
+    return measure_scaling(task, points, ["thrt"], workers=workers, warmup=warm, open_pool=pool,
+                           repeat=repeat)
 
 
 def main(argv=None) -> int:
@@ -60,6 +61,8 @@ def main(argv=None) -> int:
     parser.add_argument("--points", default="v_impact=3.0:5.0:21")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--trials", type=int, default=3)
+    parser.add_argument("--repeat", type=int, default=1,
+                        help="time each sweep N times within a trial, keep the fastest")
     parser.add_argument("--scheduler", choices=("processes", "dask"), default="processes")
     args = parser.parse_args(argv)
 
@@ -72,7 +75,7 @@ def main(argv=None) -> int:
     results = []
     for k in range(args.trials):
         t0 = time.perf_counter()
-        r = trial(points, args.workers, args.scheduler)
+        r = trial(points, args.workers, args.scheduler, args.repeat)
         results.append(r)
         print(f"\n-- trial {k + 1} ({time.perf_counter() - t0:.1f} s, load average "
               f"{os.getloadavg()[0]:.2f})")

@@ -24,10 +24,14 @@ Same sign convention, run and measures as the base file, plus ``n_impacts``
 (impacts of the armature on the hook before release).
 Run: ``acausal simulate models/breaker_24kv_light_hook.py --plot FILE``.
 """
-from breaker_24kv import build, _t_first_contact
+from breaker_24kv import build
 
 from acausal import Experiment, Stop
 from components import contact as ct
+
+def _t_first_contact(res):
+    return ct.impacts(res, "contact")[0].t_onset
+
 
 JH_LIGHT = 0.30e-3     # [kg*m^2] base 0.44e-3
 KH_STIFF = 1428.0      # [N/m] base 714

@@ -26,7 +26,7 @@ Run: ``acausal simulate models/breaker_24kv_rotary_armature.py --plot FILE``.
 import math
 
 import sympy as sp
-from breaker_24kv import GAP0, THETA1_0, MainShaft, TriggerHook, _t_first_contact
+from breaker_24kv import GAP0, THETA1_0, MainShaft, TriggerHook
 
 from acausal import Experiment, Model, Stop, guess
 from components import contact as ct
@@ -35,6 +35,10 @@ from components.fourbar import FourBar, fourbar_angles
 from components.levers import IdealLever
 from components.rotational import Fixed as RotFixed
 from components.rotational import Inertia, Torque, TorsionSpring
+
+
+def _t_first_contact(res):
+    return ct.impacts(res, "contact")[0].t_onset
 
 
 class RotaryArmature(Model):

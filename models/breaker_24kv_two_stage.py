@@ -31,7 +31,7 @@ Run: ``acausal simulate models/breaker_24kv_two_stage.py --plot FILE``.
 """
 import math
 
-from breaker_24kv import THETA1_0, Armature, MainShaft, TriggerHook, _t_first_contact
+from breaker_24kv import THETA1_0, Armature, MainShaft, TriggerHook
 
 from acausal import Experiment, Model, Stop, guess
 from components import contact as ct
@@ -40,6 +40,10 @@ from components.fourbar import FourBar, fourbar_angles
 from components.levers import IdealLever
 from components.rotational import Fixed as RotFixed
 from components.rotational import Inertia, RotationalDamper, TorsionSpring
+
+
+def _t_first_contact(res):
+    return ct.impacts(res, "contact")[0].t_onset
 
 
 class TripLever(Model):
