@@ -58,9 +58,12 @@ class Experiment:
     atol: float = 1e-8
     output_step: float = None
     max_step: float = None
+    atol_algebraic: float = None   # see acausal.simulate.simulate
     stop: Stop = None
     options: dict = field(default_factory=dict)
 
     def run_options(self):
         return dict(t_end=self.t_end, t0=self.t0, rtol=self.rtol, atol=self.atol,
-                    output_step=self.output_step, max_step=self.max_step)
+                    output_step=self.output_step, max_step=self.max_step,
+                    **({} if self.atol_algebraic is None
+                       else {"atol_algebraic": self.atol_algebraic}))

@@ -103,11 +103,26 @@ def _atol(cm, atol):
     return out
 
 
+def _atol_vector(cm, atol, atol_algebraic):
+    """``atol`` (see :func:`_atol`), with ``atol_algebraic`` on the algebraic
+    unknowns (those after the states) when given: their magnitudes (forces,
+    accelerations) can be far from the states' and the local error test on
+    them can make IDA fail to make progress."""
+    atol = _atol(cm, atol)
+    if atol_algebraic is None:
+        return atol
+    if not (atol_algebraic > 0 and np.isfinite(atol_algebraic)):
+        raise ValueError(f"atol_algebraic must be a positive number, got {atol_algebraic!r}")
+    vec = np.broadcast_to(np.asarray(atol, dtype=float), (len(cm.dae.y),)).copy()
+    vec[cm.dae.n_states:] = float(atol_algebraic)
+    return vec
+
+
 class _Run:
     def __init__(self, cm, p, t0, t_end, rtol, atol, max_step, max_steps):
         self.cm, self.p = cm, np.asarray(p, float)
         self.t0, self.t_end = t0, t_end
-        self.opts = dict(rtol=rtol, atol=_atol(cm, atol), max_step=max_step or 0.0,
+        self.opts = dict(rtol=rtol, atol=atol, max_step=max_step or 0.0,
                          max_num_steps=max_steps)
         self.T, self.Y, self.YP, self.D = [], [], [], []
         self.events, self.event_log = [], []
@@ -161,13 +176,26 @@ class _Run:
 
 
 def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_step=None,
-             output_times=None, max_step=None, max_steps=100000):
+             output_times=None, max_step=None, max_steps=100000, atol_algebraic=None):
     """Simulate a :class:`CompiledModel` from ``t0`` to ``t_end`` (or until a
-    terminal event). ``params`` overrides parameter values by dotted path."""
+    terminal event). ``params`` overrides parameter values by dotted path.
+
+    ``atol`` applies to every unknown unless ``atol_algebraic`` is given: then
+    the algebraic unknowns (forces, torques, dummy derivatives, constrained
+    positions; everything but the selected states) get that absolute
+    tolerance instead. IDA puts them into its local error test (and Newton
+    convergence test); one that is computed as the small difference of large
+    terms (a cam force balancing a kilonewton preload) and crosses zero can
+    then fail the test with a tight SI ``atol`` at every step there, so that
+    the step size collapses. A large value (e.g. 1e-2) practically leaves
+    them out of the error test (like IDA's ``suppressalg``, which
+    scikit-sundae does not expose); their accuracy then follows from the
+    states'. Default ``None``: ``atol`` for all, as before."""
     wall0 = _time.perf_counter()
     p = cm.param_vector(params)
     d = cm.discrete_start()
-    run = _Run(cm, p, t0, t_end, rtol, atol, max_step, max_steps)
+    run = _Run(cm, p, t0, t_end, rtol, _atol_vector(cm, atol, atol_algebraic), max_step,
+               max_steps)
     cb = cm.callbacks(p, d)
     run.cb_d = list(d)
     y, yp = initial_point(cm, p, d, cb, t0)

@@ -99,8 +99,13 @@ def measure_scaling(
     workers: int = 2,
     warmup: Callable[[], object] = _noop,
     repeat: int = 1,
+    open_pool: Callable[[], object] | None = None,
 ) -> dict[str, float]:
     """Time ``points`` sequentially and on a ``workers``-process pool.
+
+    ``open_pool`` (default ``lambda: open_executor(workers=workers)``) opens
+    the parallel executor as a context manager, e.g. a Dask cluster of
+    ``workers`` single-threaded processes; its opening counts as start-up.
 
     ``task`` and ``warmup`` must be picklable. ``warmup`` runs once in this
     process before the sequential run and once per worker before the parallel
@@ -124,7 +129,7 @@ def measure_scaling(
         with open_executor("serial") as ex:
             sequential, seq_task = _best_sweep(task, points, measures, ex, tmp, "seq", repeat)
         t0 = time.perf_counter()
-        with open_executor(workers=workers) as ex:
+        with (open_pool or functools.partial(open_executor, workers=workers))() as ex:
             _warm_all(ex, warmup, workers)
             t1 = time.perf_counter()
             parallel, par_task = _best_sweep(task, points, measures, ex, tmp, "par", repeat)

@@ -1,0 +1,100 @@
+"""Acceptance of ``acausal sweep`` on the real breaker model, through the CLI,
+on a Dask LocalCluster (two worker processes, ``--scheduler ADDRESS``):
+the results equal sequential simulations, a rerun with the same ``--out``
+computes nothing, and a point that makes the model invalid is recorded as
+failed while the others finish. The timing acceptance (21 points on 2
+cores) is benchmarks/sweep_breaker.py, not a test: the machine is shared."""
+import csv
+import os
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from acausal import executor as executor_mod
+from acausal.cli import main
+from acausal.modelfile import run_file
+
+distributed = pytest.importorskip("distributed")
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+MODEL = os.path.join(ROOT, "models", "breaker_24kv.py")
+SPEEDS = np.linspace(3.3, 4.5, 5)
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as c:
+        yield c
+
+
+@pytest.fixture
+def submissions(monkeypatch):
+    """Count the tasks the sweep hands to the executor."""
+    calls = []
+    real = executor_mod.Executor.submit
+
+    def counting(self, fn, *args, **kw):
+        calls.append(args)
+        return real(self, fn, *args, **kw)
+
+    monkeypatch.setattr(executor_mod.Executor, "submit", counting)
+    return calls
+
+
+def sweep(out, scheduler, *params):
+    args = ["sweep", MODEL, "--measure", "thrt", "--out", str(out), "--scheduler", scheduler,
+            "--no-progress"]
+    for p in params:
+        args += ["--param", p]
+    result = CliRunner().invoke(main, args, catch_exceptions=False)
+    assert result.exit_code == 0, result.output
+    return result.output
+
+
+def rows(out):
+    with open(out, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def test_sweep_on_dask_equals_sequential_runs_and_resumes(cluster, submissions, tmp_path):
+    out = tmp_path / "thrt.csv"
+    text = sweep(out, cluster.scheduler_address, "v_impact=3.3:4.5:5")
+    assert "5 points, 0 failed" in text
+    assert len(submissions) == 5
+    got = {float(r["v_impact"]): r for r in rows(out)}
+    assert sorted(got) == pytest.approx(list(SPEEDS), abs=0)
+    for v in SPEEDS:
+        row = got[float(v)]
+        assert row["status"] == "ok" and row["error"] == ""
+        # same code, same numbers: the worker's run equals an in-process one
+        assert float(row["thrt"]) == pytest.approx(run_file(MODEL, params={"v_impact": v})[1]
+                                                   ["thrt"], abs=1e-12)
+    # Table 2's calculated column at 3.3 and 4.5 m/s (docs/breaker_model.md)
+    assert float(got[3.3]["thrt"]) * 1e3 == pytest.approx(2.556, abs=1e-3)
+    assert float(got[4.5]["thrt"]) * 1e3 == pytest.approx(1.460, abs=1e-3)
+
+    before = out.read_bytes()
+    submissions.clear()
+    text = sweep(out, cluster.scheduler_address, "v_impact=3.3:4.5:5")
+    assert "5 points, 0 failed" in text
+    assert submissions == []                      # resumed: nothing recomputed
+    assert out.read_bytes() == before             # and nothing appended
+
+
+def test_failing_point_is_recorded_and_the_sweep_goes_on(cluster, submissions, tmp_path):
+    """v_impact = 0 violates the parameter's bound (> 0): that point fails
+    with the model's message, the two valid points around it finish; a rerun
+    does not retry it."""
+    out = tmp_path / "bad.csv"
+    text = sweep(out, cluster.scheduler_address, "v_impact=3.8,0,4.5")
+    assert "3 points, 1 failed" in text
+    got = {float(r["v_impact"]): r for r in rows(out)}
+    assert got[0.0]["status"] == "failed" and got[0.0]["thrt"] == ""
+    assert got[0.0]["error"].startswith("ParameterError: parameter v_impact = 0")
+    assert [got[v]["status"] for v in (3.8, 4.5)] == ["ok", "ok"]
+    assert float(got[3.8]["thrt"]) * 1e3 == pytest.approx(1.900, abs=1e-3)
+    submissions.clear()
+    assert "3 points, 1 failed" in sweep(out, cluster.scheduler_address, "v_impact=3.8,0,4.5")
+    assert submissions == []
