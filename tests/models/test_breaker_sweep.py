@@ -60,7 +60,8 @@ def rows(out):
 
 def test_sweep_on_dask_equals_sequential_runs_and_resumes(cluster, submissions, tmp_path):
     out = tmp_path / "thrt.csv"
-    text = sweep(out, cluster.scheduler_address, "v_impact=3.3:4.5:5")
+    # at the report's K (the model file defaults to the project's 6.17e8)
+    text = sweep(out, cluster.scheduler_address, "v_impact=3.3:4.5:5", "contact.K=6.25e8")
     assert "5 points, 0 failed" in text
     assert len(submissions) == 5
     got = {float(r["v_impact"]): r for r in rows(out)}
@@ -69,15 +70,15 @@ def test_sweep_on_dask_equals_sequential_runs_and_resumes(cluster, submissions, 
         row = got[float(v)]
         assert row["status"] == "ok" and row["error"] == ""
         # same code, same numbers: the worker's run equals an in-process one
-        assert float(row["thrt"]) == pytest.approx(run_file(MODEL, params={"v_impact": v})[1]
-                                                   ["thrt"], abs=1e-12)
+        ref = run_file(MODEL, params={"v_impact": v, "contact.K": 6.25e8})[1]["thrt"]
+        assert float(row["thrt"]) == pytest.approx(ref, abs=1e-12)
     # Table 2's calculated column at 3.3 and 4.5 m/s (docs/breaker_model.md)
     assert float(got[3.3]["thrt"]) * 1e3 == pytest.approx(2.556, abs=1e-3)
     assert float(got[4.5]["thrt"]) * 1e3 == pytest.approx(1.460, abs=1e-3)
 
     before = out.read_bytes()
     submissions.clear()
-    text = sweep(out, cluster.scheduler_address, "v_impact=3.3:4.5:5")
+    text = sweep(out, cluster.scheduler_address, "v_impact=3.3:4.5:5", "contact.K=6.25e8")
     assert "5 points, 0 failed" in text
     assert submissions == []                      # resumed: nothing recomputed
     assert out.read_bytes() == before             # and nothing appended
