@@ -5,7 +5,7 @@ Design change: the hook's moment of inertia is cut by 32 % (0.44e-3 ->
 0.30e-3 kg*m^2, e.g. lightening holes or a thinner web away from the shaft)
 and the hook reset spring is made twice as stiff (714 -> 1428 N/m at the
 same arm s4, for a faster and surer re-latching after a trip). Everything
-else is the base design: the same armature, contact (K = 6.25e8,
+else is the base design: the same armature, contact (the base's calibrated K,
 e = 0.74, Lankarani-Nikravesh), hook arms, viscous latch friction
 bh = 0.219 N*m*s/rad, four-bar and main shaft, composed by the base file's
 ``build()``. Kept on purpose: bh is the friction of the heavily loaded latch
@@ -24,7 +24,7 @@ Same sign convention, run and measures as the base file, plus ``n_impacts``
 (impacts of the armature on the hook before release).
 Run: ``acausal simulate models/breaker_24kv_light_hook.py --plot FILE``.
 """
-from breaker_24kv import build
+from breaker_24kv import BH_CAL, K_CAL, build
 
 from acausal import Experiment, Stop
 from components import contact as ct
@@ -36,7 +36,7 @@ def _t_first_contact(res):
 JH_LIGHT = 0.30e-3     # [kg*m^2] base 0.44e-3
 KH_STIFF = 1428.0      # [N/m] base 714
 
-model = build(K=6.25e8, bh=0.219)
+model = build(K=K_CAL, bh=BH_CAL)
 model.hook.set(Jh=JH_LIGHT, kh=KH_STIFF)
 free_parameters = {"contact.K": (1e8, 1e10), "hook.bh": (0.0, 1.0)}
 

@@ -26,7 +26,7 @@ Run: ``acausal simulate models/breaker_24kv_rotary_armature.py --plot FILE``.
 import math
 
 import sympy as sp
-from breaker_24kv import GAP0, THETA1_0, MainShaft, TriggerHook
+from breaker_24kv import BH_CAL, GAP0, K_CAL, THETA1_0, MainShaft, TriggerHook
 
 from acausal import Experiment, Model, Stop, guess
 from components import contact as ct
@@ -77,7 +77,7 @@ class RotaryArmature(Model):
         self.equation(v - k * self.body.w)
 
 
-def build(v_impact=3.8, K=6.25e8, bh=0.219, exact=True):
+def build(v_impact=3.8, K=K_CAL, bh=BH_CAL, exact=True):
     """The base breaker with the clapper armature (base's K and bh)."""
     m = Model()
     v = m.parameter("v_impact", v_impact, "m/s", "pin speed at first contact",

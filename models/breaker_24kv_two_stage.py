@@ -18,7 +18,7 @@ matched to the hook. Between lever and hook there is a clearance ``gap2``
 angular momentum one undamped plastic-to-elastic exchange can give the hook
 through a massless lever), gap2 = 0.1 mm, c1 = 0.05 N*m/rad, d1 = 0.005
 N*m*s/rad (a lightly loaded pin). The lever-hook contact ``latch_contact``
-uses the base contact's law and calibrated values (K = 6.25e8, e = 0.74).
+uses the base contact's law and calibrated values (the base's calibrated K, e = 0.74).
 
 Sign convention as the base file: the armature moves along -s, the trip
 lever angle ``trip_lever.phi`` and the hook angle ``hook.phi`` decrease.
@@ -31,7 +31,7 @@ Run: ``acausal simulate models/breaker_24kv_two_stage.py --plot FILE``.
 """
 import math
 
-from breaker_24kv import THETA1_0, Armature, MainShaft, TriggerHook
+from breaker_24kv import BH_CAL, K_CAL, THETA1_0, Armature, MainShaft, TriggerHook
 
 from acausal import Experiment, Model, Stop, guess
 from components import contact as ct
@@ -78,7 +78,7 @@ class TripLever(Model):
         self.equation(phi - self.body.phi)
 
 
-def build(v_impact=3.8, K=6.25e8, bh=0.219, gap2=1e-4):
+def build(v_impact=3.8, K=K_CAL, bh=BH_CAL, gap2=1e-4):
     """The base breaker with a trip lever between armature and hook."""
     m = Model()
     v = m.parameter("v_impact", v_impact, "m/s", "armature speed at first contact",

@@ -158,9 +158,13 @@ def test_two_stage_hook_gets_less_momentum_and_releases_later(base):
 def test_two_stage_runs_where_the_algebraic_error_test_collapsed_the_step(v):
     """With atol 1e-11 also on the algebraic unknowns IDA failed at 3.3 and
     3.6 m/s (step size -> 1e-25 s); atol_algebraic = 1e-2 runs in ~1000
-    steps and gives the THRT of atol_algebraic = 1e-6 within 1e-9 s."""
+    steps. Its THRT against a tight reference (rtol 1e-10, atol_algebraic
+    1e-6): measured 1.5e-9 s at 3.3 m/s (5e-7 relative; the looser
+    algebraic tolerance costs accuracy there, atol_algebraic 1e-6 at rtol
+    1e-8 is within 0.3e-9 s), bounded here at 1e-6 relative."""
     res, m = run_file(path("two_stage"), params={"v_impact": v})
     assert res.stats["steps"] < 3000
-    ref, mr = run_file(path("two_stage"), params={"v_impact": v}, atol_algebraic=1e-6)
-    assert m["thrt"] == pytest.approx(mr["thrt"], abs=1e-9)
+    ref, mr = run_file(path("two_stage"), params={"v_impact": v}, atol_algebraic=1e-6,
+                       rtol=1e-10)
+    assert m["thrt"] == pytest.approx(mr["thrt"], rel=1e-6)
     assert math.isfinite(m["thrt"])
