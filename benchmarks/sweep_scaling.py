@@ -72,8 +72,9 @@ def _warm_all(executor, warmup: Callable[[], object], workers: int) -> None:
             return
 
 
-def _timed_sweep(task, points, measures, executor, csv_path: Path) -> tuple[float, float]:
-    """(wall time of the sweep, summed per-point task time measured on the workers)."""
+def _timed_sweep(task, points, measures, executor, csv_path: Path) -> tuple[float, float, float]:
+    """(wall time of the sweep, summed per-point task time measured on the workers,
+    summed ``cpu_s`` measure if the task reports one, else nan)."""
     from acausal.sweep import run_sweep
 
     start = time.perf_counter()
@@ -82,10 +83,11 @@ def _timed_sweep(task, points, measures, executor, csv_path: Path) -> tuple[floa
     failed = sum(r["status"] != "ok" for r in rows)
     if failed:
         print(f"warning: {failed} point(s) failed; timings are suspect", file=sys.stderr)
-    return wall, sum(r["wall_s"] for r in rows)
+    cpu = sum(r["cpu_s"] for r in rows) if "cpu_s" in measures else math.nan
+    return wall, sum(r["wall_s"] for r in rows), cpu
 
 
-def _best_sweep(task, points, measures, executor, tmp: str, name: str, repeat: int) -> tuple[float, float]:
+def _best_sweep(task, points, measures, executor, tmp: str, name: str, repeat: int) -> tuple[float, float, float]:
     """Fastest of ``repeat`` timed sweeps (least disturbed by other load)."""
     runs = [_timed_sweep(task, points, measures, executor, Path(tmp, f"{name}{i}.csv")) for i in range(repeat)]
     return min(runs)
@@ -120,19 +122,24 @@ def measure_scaling(
     ``task_slowdown`` (summed per-point task time, parallel / sequential: > 1
     when concurrent tasks slow each other, e.g. shared cores or memory
     bandwidth) and ``scheduling_ratio`` (parallel_s over the summed parallel
-    task time / workers: what the pool itself costs).
+    task time / workers: what the pool itself costs). If the task returns a
+    ``cpu_s`` measure (its own CPU time) and ``measures`` lists it, also
+    ``cpu_slowdown`` (summed CPU time, parallel / sequential: ~1 unless the
+    workers slow each other's computation) and ``cpu_share`` (summed parallel
+    CPU time / (workers * parallel_s): the share of the ``workers`` cores the
+    tasks got; < 1 when other processes use them); else these are nan.
     """
     from acausal.executor import open_executor
 
     with tempfile.TemporaryDirectory() as tmp:
         warmup()
         with open_executor("serial") as ex:
-            sequential, seq_task = _best_sweep(task, points, measures, ex, tmp, "seq", repeat)
+            sequential, seq_task, seq_cpu = _best_sweep(task, points, measures, ex, tmp, "seq", repeat)
         t0 = time.perf_counter()
         with (open_pool or functools.partial(open_executor, workers=workers))() as ex:
             _warm_all(ex, warmup, workers)
             t1 = time.perf_counter()
-            parallel, par_task = _best_sweep(task, points, measures, ex, tmp, "par", repeat)
+            parallel, par_task, par_cpu = _best_sweep(task, points, measures, ex, tmp, "par", repeat)
             t2 = time.perf_counter()
         t3 = time.perf_counter()
     return {
@@ -146,6 +153,8 @@ def measure_scaling(
         "ideal_ratio": math.ceil(len(points) / workers) / (len(points) / workers),
         "task_slowdown": par_task / seq_task,
         "scheduling_ratio": parallel / (par_task / workers),
+        "cpu_slowdown": par_cpu / seq_cpu,
+        "cpu_share": par_cpu / (workers * parallel),
     }
 
 
@@ -162,7 +171,10 @@ def report(result: Mapping[str, float]) -> str:
         f"  per-point task time, parallel/sequential: {result['task_slowdown']:.3f} (contention between workers)",
         f"  pool: parallel wall / (summed task time / {w}): {result['scheduling_ratio']:.3f} "
         f"(whole rounds alone give {result['ideal_ratio']:.3f})",
-    ])
+    ] + ([] if math.isnan(result.get("cpu_share", math.nan)) else [
+        f"  task CPU time, parallel/sequential: {result['cpu_slowdown']:.3f}; share of the {w} "
+        f"cores the tasks got: {result['cpu_share']:.3f}",
+    ]))
 
 
 def main(argv: Sequence[str] | None = None) -> int:

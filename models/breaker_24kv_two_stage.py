@@ -14,9 +14,8 @@ elsewhere, and the lever ratio ``b1/a1`` sets how the armature's momentum is
 matched to the hook. Between lever and hook there is a clearance ``gap2``
 (the lever travels freely before it hits the hook). Default values: J1 =
 6e-5 kg*m^2 (a 5 mm steel lever of about 40 g), a1 = 30 mm, b1 = 36 mm
-(ratio 1.2, about the ratio sqrt(ma/mh) = 1.23 that maximises the
-angular momentum one undamped plastic-to-elastic exchange can give the hook
-through a massless lever), gap2 = 0.1 mm, c1 = 0.05 N*m/rad, d1 = 0.005
+(ratio 1.2, about the ratio sqrt(ma/mh) = 1.23 at which one impact
+through a massless lever gives the hook the most angular momentum), gap2 = 0.1 mm, c1 = 0.05 N*m/rad, d1 = 0.005
 N*m*s/rad (a lightly loaded pin). The lever-hook contact ``latch_contact``
 uses the base contact's law and calibrated values (the base's calibrated K, e = 0.74).
 
