@@ -26,10 +26,20 @@ class CalibrationError(AcausalError):
     """The calibration could not be carried out (no bracket, no data...)."""
 
 
+def resolve(model):
+    """(ModelFile, CompiledModel) for a model file path, or the pair itself.
+
+    Every function here taking ``path`` also accepts such a pair, e.g. the
+    model file extended with a hypothesis by :mod:`acausal.diagnose`."""
+    if isinstance(model, tuple) and len(model) == 2:
+        return model
+    return compile_file(model)
+
+
 def model_dataset(path, folder):
     """Load ``folder`` checking its columns against the model file's
     parameters, measures and variables (with their units)."""
-    mf, cm = compile_file(path)
+    mf, cm = resolve(path)
     params = {p.name: p.unit for p in cm.params}
     measures = {name: None for name in mf.measures}
     variables = {n: cm.flat.variables[n].unit for n in cm.var_names}
@@ -38,7 +48,7 @@ def model_dataset(path, folder):
 
 def simulate_experiment(path, params, conditions):
     """(result, measures) for one experiment with fitted ``params``."""
-    mf, cm = compile_file(path)
+    mf, cm = resolve(path)
     over = dict(params)
     over.update(conditions)
     res = cm.simulate(params=over, **mf.experiment.run_options())
@@ -109,7 +119,7 @@ def _nominal(dataset, measures, name=None):
 def residual_vector(path, dataset, params, signals=None):
     """Weighted residuals (simulated - measured)/sigma over every experiment:
     measures first, then trace samples. Returns (vector, labels, raw)."""
-    mf, _ = compile_file(path)
+    path = resolve(path)
     vec, labels, raw = [], [], {}
     for exp in dataset.experiments:
         res, meas = simulate_experiment(path, params, exp.conditions)
@@ -144,7 +154,8 @@ def _sigma(dataset, signal, values):
 
 def least_squares(path, dataset, names, bounds=None, x0=None, signals=None):
     """Output-error least squares over parameters ``names``."""
-    _, cm = compile_file(path)
+    path = resolve(path)
+    _, cm = path
     entries = [cm.params[cm.param_index(n)] for n in names]
     start = np.array([(x0 or {}).get(e.name, e.default) for e in entries], float)
     lo = np.array([(bounds or {}).get(e.name, (e.decl.min if e.decl.min is not None
