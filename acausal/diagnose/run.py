@@ -46,6 +46,9 @@ from .library import load_library
 
 __all__ = ["diagnose", "DiagnosisError"]
 
+FIT_TOL = 1e-6   # ftol/xtol of the candidate fits (S to about 1e-6 relative)
+LOO_TOL = 1e-4   # of the warm-started leave-one-out refits (predictions only)
+
 
 class DiagnosisError(AcausalError):
     """The diagnosis cannot run on this input (no data, unknown hypothesis...)."""
@@ -104,7 +107,7 @@ def fit_task(model_path, folder, library, hyp_id, location, spec_rows, free, max
         hi = {n: v[2] for n, v in free.items()} | {r[0]: r[3] for r in spec_rows}
         sc = {n: v[3] for n, v in free.items()} | {r[0]: r[4] for r in spec_rows}
         f = fit(pair, ds, names, x0, lo, hi, sc, starts=_starts(spec_rows),
-                max_nfev=max_nfev)
+                max_nfev=max_nfev, tol=FIT_TOL)
         return dict(hyp=hyp_id, location=location, fit=f, loo=linear_loo(f) if f.ok else {},
                     error=None, wall_s=time.perf_counter() - t0)
     except Exception as exc:  # noqa: BLE001 - a candidate that cannot be built is reported
@@ -119,7 +122,7 @@ def loo_task(model_path, folder, library, hyp_id, location, names, start, low, h
     pair = _model(model_path, library, hyp_id, location)
     train = subset(ds, [e.name for e in ds.experiments if e.name != held])
     test = subset(ds, [held])
-    f = fit(pair, train, names, start, low, high, scale, max_nfev=max_nfev)
+    f = fit(pair, train, names, start, low, high, scale, max_nfev=max_nfev, tol=LOO_TOL)
     r = weighted_residuals(pair, test, f.values)[0]
     return dict(hyp=hyp_id, location=location, held=held, residuals=r, values=f.values,
                 n_sim=f.n_sim)
@@ -290,7 +293,7 @@ def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
                 for e in ds.experiments:
                     calls.append((loo_task, (model_path, data_folder, lib_name, h, l,
                                              f.names, f.values, lo, hi, sc, e.name,
-                                             max(10, max_nfev // 3))))
+                                             max(5, max_nfev // 4))))
             for r in _run_tasks(ex, calls, "leave-one-out", progress):
                 loo_exact.setdefault((r["hyp"], r["location"]), {})[r["held"]] = r["residuals"]
     t_cv = time.perf_counter() - t_start - t_fit

@@ -198,7 +198,11 @@ def weak_evidence(*, n: int, k: int, d_null: float, d_runner: float | None,
     if n < MIN_PER_PARAM * k:
         out.append(f"too few data: {n} values for {k} fitted parameters "
                    f"(fewer than {MIN_PER_PARAM} per parameter)")
-    if d_null < STRONG:
+    if d_null <= 0:
+        out.append(f"no extension is better than none by AICc: the best is {-d_null:.1f} "
+                   f"units worse than the model as it is (strong evidence needs "
+                   f"{STRONG:g} better)")
+    elif d_null < STRONG:
         out.append(f"the best extension improves AICc by only {d_null:.1f} over no "
                    f"extension (strong evidence needs more than {STRONG:g})")
     if d_runner is not None and d_runner < RUNNER_UP:

@@ -107,7 +107,7 @@ def test_weak_evidence_rules_real_data_like():
     reasons = st.weak_evidence(n=7, k=3, d_null=-4.0, d_runner=0.5, heldout_nominal=2.0,
                                heldout_best=1.9, ci_rel=3.0, c_hat=4.0, coarse=0.66)
     text = " | ".join(reasons)
-    for part in ("too few data: 7 values for 3", "only -4.0", "only 0.5", "1.9",
+    for part in ("too few data: 7 values for 3", "4.0 units worse", "only 0.5", "1.9",
                  "300%", "2x the noise", "0.66 resolution steps"):
         assert part in text
     assert st.weak_evidence(n=600, k=3, d_null=300, d_runner=20, heldout_nominal=3.0,
