@@ -46,12 +46,17 @@ def model_dataset(path, folder):
     return load_dataset(folder, parameters=params, measures=measures, variables=variables)
 
 
-def simulate_experiment(path, params, conditions):
-    """(result, measures) for one experiment with fitted ``params``."""
+def simulate_experiment(path, params, conditions, output_times=None):
+    """(result, measures) for one experiment with fitted ``params``;
+    ``output_times`` replaces the experiment's output step."""
     mf, cm = resolve(path)
     over = dict(params)
     over.update(conditions)
-    res = cm.simulate(params=over, **mf.experiment.run_options())
+    opts = mf.experiment.run_options()
+    if output_times is not None:
+        opts.pop("output_step", None)
+        opts["output_times"] = output_times
+    res = cm.simulate(params=over, **opts)
     return res, evaluate_measures(mf, res)
 
 
@@ -116,13 +121,18 @@ def _nominal(dataset, measures, name=None):
     raise CalibrationError(f"no experiment measures all of {measures}")
 
 
-def residual_vector(path, dataset, params, signals=None):
+def residual_vector(path, dataset, params, signals=None, trace_times=False):
     """Weighted residuals (simulated - measured)/sigma over every experiment:
-    measures first, then trace samples. Returns (vector, labels, raw)."""
+    measures first, then trace samples. Returns (vector, labels, raw).
+    ``trace_times``: simulate an experiment that has a trace and no measures
+    with output at the trace's sample times (exact and cheaper than a fine
+    output step followed by interpolation)."""
     path = resolve(path)
     vec, labels, raw = [], [], {}
     for exp in dataset.experiments:
-        res, meas = simulate_experiment(path, params, exp.conditions)
+        tout = exp.trace.time if (trace_times and exp.trace is not None
+                                  and not exp.measures) else None
+        res, meas = simulate_experiment(path, params, exp.conditions, tout)
         raw[exp.name] = {}
         for m, y in exp.measures.items():
             if signals and m not in signals:

@@ -62,7 +62,7 @@ def subset(dataset: Dataset, names) -> Dataset:
 
 def weighted_residuals(model, dataset, params):
     """(vector, groups, signals) of weighted residuals for ``params``."""
-    vec, labels, _ = residual_vector(resolve(model), dataset, params)
+    vec, labels, _ = residual_vector(resolve(model), dataset, params, trace_times=True)
     return vec, [g for g, _ in labels], [s for _, s in labels]
 
 

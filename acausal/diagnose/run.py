@@ -80,12 +80,13 @@ def _model(model_path, library, hyp_id, location):
 
 def _starts(spec_rows):
     """Extra starting points along the first extension parameter: its scale
-    times 0.2, 1 and 5, both signs where the bounds allow."""
+    times 0.3 and 3, both signs where the bounds allow (a parameter starting
+    where it has no effect may sit on a bound or a flat spot)."""
     if not spec_rows:
         return []
     name, initial, low, high, scale = spec_rows[0][:5]
     out = []
-    for f in (0.2, 1.0, 5.0):
+    for f in (0.3, 3.0):
         for s in (1.0, -1.0):
             v = s * f * abs(scale)
             if low <= v <= high and v != initial:
@@ -225,17 +226,19 @@ def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
     lib_name = lib.name
 
     with open_executor(scheduler, workers) as ex:
-        calls = [(fit_task, (model_path, data_folder, lib_name, None, None, [], free,
-                             max_nfev))]
-        calls += [(fit_task, (model_path, data_folder, lib_name, h, l, spec_rows[(h, l)],
-                              free, max_nfev)) for h, l, _ in cands]
-        results = _run_tasks(ex, calls, "fitting candidates", progress)
-        t_fit = time.perf_counter() - t_start
-        nominal = results[0]
+        # the nominal fit first: the candidates start from its calibrated values
+        nominal = _run_tasks(ex, [(fit_task, (model_path, data_folder, lib_name, None, None,
+                                              [], free, max_nfev))],
+                             "calibrating", progress)[0]
         if nominal["fit"] is None or not nominal["fit"].ok:
             raise DiagnosisError(f"the nominal model could not be fitted: "
                                  f"{nominal['error'] or nominal['fit'].message}")
         f0 = nominal["fit"]
+        warm = {n: (f0.values[n],) + v[1:] for n, v in free.items()}
+        calls = [(fit_task, (model_path, data_folder, lib_name, h, l, spec_rows[(h, l)],
+                             warm, max_nfev)) for h, l, _ in cands]
+        results = [nominal] + _run_tasks(ex, calls, "fitting candidates", progress)
+        t_fit = time.perf_counter() - t_start
         n = f0.n
         fitted = [r for r in results[1:] if r["fit"] is not None and r["fit"].ok
                   and math.isfinite(r["fit"].cost)]
@@ -321,9 +324,7 @@ def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
     if cause is not None:
         stem = Path(model_path).stem
         target = out_dir / f"{stem}_{cause['cause']}.py"
-        extended = lib.write_extended_model(model_path, cause["cause"], cause["location"],
-                                            dict(cause["fit"].values), str(target))
-        extended = str(extended)
+        extended = write_extended(lib, model_path, cause, target, list(free))
 
     if discrepancy:
         equivalent = [dict(cause=r["cause"], location=r["location"]) for r in cls
@@ -357,7 +358,73 @@ def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
     finally:
         ctx["timing"]["total_s"] = time.perf_counter() - t_start
     (out_dir / "diagnosis.json").write_text(json.dumps(summary, indent=1))
+    (out_dir / "candidates.json").write_text(json.dumps(_clean(_details(ctx)), indent=1))
     return summary
+
+
+def write_extended(lib, model_path, row, target, free_names):
+    """Write the extended model file: the library writes the original plus
+    the hypothesis with its fitted values; the calibrated values of the free
+    parameters are set on the model before the hypothesis is applied (a
+    hypothesis may rebind a parameter of the component it extends)."""
+    values = row["fit"].values
+    own = {k: v for k, v in values.items() if k not in free_names}
+    path = str(lib.write_extended_model(model_path, row["cause"], row["location"], own,
+                                        str(target)))
+    if not free_names:
+        return path
+    lines = ["# calibrated free parameters (acausal diagnose)"]
+    for name in free_names:
+        comp, _, pname = name.rpartition(".")
+        target_expr = f"model.find({comp!r})" if comp else "model"
+        lines.append(f"{target_expr}.set({pname}={float(values[name])!r})")
+    block = "\n".join(lines) + "\n\n"
+    text = Path(path).read_text()
+    marker = "\n# hypothesis "
+    i = text.find(marker)
+    if i < 0:
+        raise DiagnosisError(f"{path}: cannot place the calibrated values (no "
+                             f"'# hypothesis' line written by the library)")
+    Path(path).write_text(text[:i + 1] + block + text[i + 1:])
+    return path
+
+
+def _details(ctx):
+    """Every fit in full (for scripts and tests): the nominal model, then the
+    candidates in rank order, and the decision."""
+    def one(label, f, extra):
+        return dict(label, k=f.k, S=_num(f.cost), train_rmse=_num(f.rms()),
+                    values=f.values, ci95={k: [_num(a), _num(b)] for k, (a, b) in
+                                           f.ci95.items()},
+                    n_sim=f.n_sim, wall_s=f.wall_s, **extra)
+    f0 = ctx["f0"]
+    out = dict(nominal=one(dict(cause=None, location=None), f0,
+                           dict(aicc=_num(ctx["a0"]))),
+               candidates=[one(dict(cause=r["cause"], location=r["location"]), r["fit"],
+                               dict(aicc=_num(r["aicc"]), heldout_rmse=_num(r["heldout_rmse"]),
+                                    lr_p=_num(r["lr_p"])))
+                           for r in ctx["rows"]],
+               failed=[dict(cause=r["hyp"], location=r["location"], error=r["error"] or
+                            (r["fit"].message if r["fit"] is not None else ""))
+                       for r in ctx["failed"]],
+               decision=ctx["decision"], overdispersion=ctx["c_hat"],
+               weak_evidence=ctx["weak"], timing=ctx["timing"])
+    return out
+
+
+def _clean(obj):
+    """JSON-safe copy: non-finite floats -> None, numpy scalars -> Python."""
+    if isinstance(obj, dict):
+        return {str(k): _clean(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_clean(v) for v in obj]
+    if isinstance(obj, (bool, np.bool_)):
+        return bool(obj)
+    if isinstance(obj, (int, np.integer)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        return _num(obj)
+    return obj
 
 
 def _num(x):

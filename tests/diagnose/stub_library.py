@@ -113,5 +113,14 @@ def build_extended(path, hyp_id, location, values=None):
 
 def write_extended_model(path, hyp_id, location, values, out_path):
     with open(out_path, "w") as f:
-        f.write(f"# stub extended model of {path}: {hyp_id} at {location} {values}\n")
+        f.write(f"""from acausal.modelfile import load_model_file as _load
+_base = _load({os.path.abspath(path)!r})
+model = _base.model
+experiment = _base.experiment
+measures = dict(_base.measures)
+
+# hypothesis {hyp_id} at {location}
+from tests.diagnose.stub_library import HYPOTHESES as _H
+_H[{hyp_id!r}].apply(model, {location!r}, {dict(values)!r})
+""")
     return str(out_path)

@@ -96,3 +96,15 @@ def test_command_line_bad_input(tmp_path):
     r = CliRunner().invoke(main, ["diagnose", LATCH, str(tmp_path / "data"), "--workers",
                                   "0", "--library", STUB, "--no-progress"])
     assert r.exit_code == 2 and "workers" in r.output
+
+
+def test_extended_model_runs_with_the_fitted_values(blind):
+    """The written model file reproduces the fitted model's simulation."""
+    from acausal.modelfile import compile_file, run_file
+    truth, out, folder = blind
+    mf, cm = compile_file(out["extended_model"])
+    vals = {p.name: p.default for p in cm.params}
+    for name, d in out["parameters"].items():
+        assert vals[name] == pytest.approx(d["value"], rel=1e-12)
+    res, meas = run_file(out["extended_model"], params={"F_coil": 32.0})
+    assert meas["trip_time"] > 0
