@@ -46,16 +46,14 @@ def model_dataset(path, folder):
     return load_dataset(folder, parameters=params, measures=measures, variables=variables)
 
 
-def simulate_experiment(path, params, conditions, output_times=None):
+def simulate_experiment(path, params, conditions, options=None):
     """(result, measures) for one experiment with fitted ``params``;
-    ``output_times`` replaces the experiment's output step."""
+    ``options``: further keyword arguments of ``simulate`` (``max_steps``)."""
     mf, cm = resolve(path)
     over = dict(params)
     over.update(conditions)
     opts = mf.experiment.run_options()
-    if output_times is not None:
-        opts.pop("output_step", None)
-        opts["output_times"] = output_times
+    opts.update(options or {})
     res = cm.simulate(params=over, **opts)
     return res, evaluate_measures(mf, res)
 
@@ -121,18 +119,14 @@ def _nominal(dataset, measures, name=None):
     raise CalibrationError(f"no experiment measures all of {measures}")
 
 
-def residual_vector(path, dataset, params, signals=None, trace_times=False):
+def residual_vector(path, dataset, params, signals=None, options=None):
     """Weighted residuals (simulated - measured)/sigma over every experiment:
     measures first, then trace samples. Returns (vector, labels, raw).
-    ``trace_times``: simulate an experiment that has a trace and no measures
-    with output at the trace's sample times (exact and cheaper than a fine
-    output step followed by interpolation)."""
+    ``options``: passed to :func:`simulate_experiment`."""
     path = resolve(path)
     vec, labels, raw = [], [], {}
     for exp in dataset.experiments:
-        tout = exp.trace.time if (trace_times and exp.trace is not None
-                                  and not exp.measures) else None
-        res, meas = simulate_experiment(path, params, exp.conditions, tout)
+        res, meas = simulate_experiment(path, params, exp.conditions, options)
         raw[exp.name] = {}
         for m, y in exp.measures.items():
             if signals and m not in signals:

@@ -21,6 +21,7 @@ from ..data import Dataset
 from ..errors import AcausalError
 
 PENALTY = 1e3   # weighted residual given to every sample of a failed simulation
+MAX_STEPS = 5000  # solver steps between two outputs beyond which a run counts as failed
 
 
 @dataclass
@@ -62,12 +63,17 @@ def subset(dataset: Dataset, names) -> Dataset:
 
 def weighted_residuals(model, dataset, params):
     """(vector, groups, signals) of weighted residuals for ``params``."""
-    vec, labels, _ = residual_vector(resolve(model), dataset, params, trace_times=True)
+    vec, labels, _ = residual_vector(resolve(model), dataset, params,
+                                     options={"max_steps": MAX_STEPS})
     return vec, [g for g, _ in labels], [s for _, s in labels]
 
 
+class _OutOfTime(Exception):
+    """The fit's time budget is spent (raised inside the optimiser)."""
+
+
 def fit(model, dataset, names, x0, low, high, scale, *, fixed=None, starts=None,
-        max_nfev=60, tol=1e-8) -> Fit:
+        max_nfev=60, tol=1e-8, budget_s=None) -> Fit:
     """Weighted output-error least squares over ``names``.
 
     ``x0``, ``low``, ``high``, ``scale``: per-name start, bounds and typical
@@ -75,7 +81,9 @@ def fit(model, dataset, names, x0, low, high, scale, *, fixed=None, starts=None,
     parameter overrides. ``starts``: extra starting points (dicts name ->
     value, merged into ``x0``); the one with the smallest cost is refined
     (a cheap guard against a local minimum when a hypothesis's parameter
-    starts where it has no effect).
+    starts where it has no effect). ``budget_s``: wall-time budget; when it
+    is spent the best point seen so far is kept (``message`` says so) and
+    the Jacobian is taken there by one more finite-difference pass.
     """
     t0 = time.perf_counter()
     pair = resolve(model)
@@ -89,19 +97,27 @@ def fit(model, dataset, names, x0, low, high, scale, *, fixed=None, starts=None,
     n_exp = len(dataset.experiments)
     size = [None]
 
+    seen = {"cost": np.inf, "x": None}
+    timed = [True]
+
     def evaluate(x):
+        if timed[0] and budget_s is not None and time.perf_counter() - t0 > budget_s:
+            raise _OutOfTime
         n_sim[0] += n_exp
         params = {**fixed, **dict(zip(names, x))}
         try:
             vec = weighted_residuals(pair, dataset, params)[0]
             size[0] = vec.size
-            return vec if np.all(np.isfinite(vec)) else np.nan_to_num(vec, nan=PENALTY,
-                                                                         posinf=PENALTY,
-                                                                         neginf=-PENALTY)
+            if not np.all(np.isfinite(vec)):
+                vec = np.nan_to_num(vec, nan=PENALTY, posinf=PENALTY, neginf=-PENALTY)
         except AcausalError:
             if size[0] is None:
                 raise
-            return np.full(size[0], PENALTY)
+            vec = np.full(size[0], PENALTY)
+        c = float(vec @ vec)
+        if c < seen["cost"]:
+            seen.update(cost=c, x=np.array(x, float))
+        return vec
 
     candidates = [np.clip(x0, lo, hi)]
     for st in starts or []:
@@ -116,6 +132,8 @@ def fit(model, dataset, names, x0, low, high, scale, *, fixed=None, starts=None,
             c = float(np.sum(evaluate(x) ** 2))
         except AcausalError:
             continue
+        except _OutOfTime:
+            break
         if c < best_cost:
             best, best_cost = x, c
     if best is None:
@@ -125,14 +143,20 @@ def fit(model, dataset, names, x0, low, high, scale, *, fixed=None, starts=None,
                    message="every starting point failed to simulate")
     ok, message = True, ""
     if names:
-        sol = optimize.least_squares(lambda z: evaluate(z * sc), best / sc,
-                                     bounds=(lo / sc, hi / sc), x_scale=1.0,
-                                     diff_step=1e-5, xtol=tol, ftol=tol, gtol=tol,
-                                     max_nfev=max_nfev)
-        x = sol.x * sc
-        message = sol.message
-        ok = sol.status > 0 or sol.status == 0  # 0: max_nfev reached (still usable)
-        J = sol.jac / sc
+        try:
+            sol = optimize.least_squares(lambda z: evaluate(z * sc), best / sc,
+                                         bounds=(lo / sc, hi / sc), x_scale=1.0,
+                                         diff_step=1e-5, xtol=tol, ftol=tol, gtol=tol,
+                                         max_nfev=max_nfev)
+            x = sol.x * sc
+            message = sol.message
+            ok = sol.status >= 0     # 0: max_nfev reached (still usable)
+            J = sol.jac / sc
+        except _OutOfTime:
+            timed[0] = False
+            x = seen["x"] if seen["x"] is not None else best
+            message = f"stopped at the time budget ({budget_s:.0f} s); best point kept"
+            J = _jacobian(evaluate, x, sc, lo, hi)
     else:
         x = best
         J = np.zeros((0, 0))
@@ -147,6 +171,19 @@ def fit(model, dataset, names, x0, low, high, scale, *, fixed=None, starts=None,
               wall_s=time.perf_counter() - t0, ok=bool(ok), message=str(message))
     out.ci95 = confidence(out)
     return out
+
+
+def _jacobian(fun, x, sc, lo, hi, rel=1e-5):
+    """Forward differences (backward at an upper bound), per parameter unit."""
+    r0 = fun(x)
+    J = np.empty((r0.size, x.size))
+    for i in range(x.size):
+        h = rel * sc[i]
+        step = h if x[i] + h <= hi[i] else -h
+        xx = x.copy()
+        xx[i] += step
+        J[:, i] = (fun(xx) - r0) / step
+    return J
 
 
 def confidence(f: Fit, level=0.95) -> dict:

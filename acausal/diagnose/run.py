@@ -48,6 +48,8 @@ __all__ = ["diagnose", "DiagnosisError"]
 
 FIT_TOL = 1e-6   # ftol/xtol of the candidate fits (S to about 1e-6 relative)
 LOO_TOL = 1e-4   # of the warm-started leave-one-out refits (predictions only)
+BUDGET_FACTOR = 6.0   # a candidate fit may take this many times the nominal fit ...
+BUDGET_MIN_S = 30.0   # ... but at least this long [s]; then its best point is kept
 
 
 class DiagnosisError(AcausalError):
@@ -94,7 +96,8 @@ def _starts(spec_rows):
     return out
 
 
-def fit_task(model_path, folder, library, hyp_id, location, spec_rows, free, max_nfev):
+def fit_task(model_path, folder, library, hyp_id, location, spec_rows, free, max_nfev,
+             budget_s=None):
     """Fit one candidate (``hyp_id`` None: the nominal model). ``spec_rows``:
     (name, initial, low, high, scale) of the extension's parameters;
     ``free``: name -> (start, low, high, scale) of the free parameters."""
@@ -108,7 +111,7 @@ def fit_task(model_path, folder, library, hyp_id, location, spec_rows, free, max
         hi = {n: v[2] for n, v in free.items()} | {r[0]: r[3] for r in spec_rows}
         sc = {n: v[3] for n, v in free.items()} | {r[0]: r[4] for r in spec_rows}
         f = fit(pair, ds, names, x0, lo, hi, sc, starts=_starts(spec_rows),
-                max_nfev=max_nfev, tol=FIT_TOL)
+                max_nfev=max_nfev, tol=FIT_TOL, budget_s=budget_s)
         return dict(hyp=hyp_id, location=location, fit=f, loo=linear_loo(f) if f.ok else {},
                     error=None, wall_s=time.perf_counter() - t0)
     except Exception as exc:  # noqa: BLE001 - a candidate that cannot be built is reported
@@ -117,13 +120,14 @@ def fit_task(model_path, folder, library, hyp_id, location, spec_rows, free, max
 
 
 def loo_task(model_path, folder, library, hyp_id, location, names, start, low, high, scale,
-             held, max_nfev):
+             held, max_nfev, budget_s=None):
     """Refit without experiment ``held`` (warm start), predict it."""
     ds = _dataset(model_path, folder)
     pair = _model(model_path, library, hyp_id, location)
     train = subset(ds, [e.name for e in ds.experiments if e.name != held])
     test = subset(ds, [held])
-    f = fit(pair, train, names, start, low, high, scale, max_nfev=max_nfev, tol=LOO_TOL)
+    f = fit(pair, train, names, start, low, high, scale, max_nfev=max_nfev, tol=LOO_TOL,
+            budget_s=budget_s)
     r = weighted_residuals(pair, test, f.values)[0]
     return dict(hyp=hyp_id, location=location, held=held, residuals=r, values=f.values,
                 n_sim=f.n_sim)
@@ -235,8 +239,9 @@ def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
                                  f"{nominal['error'] or nominal['fit'].message}")
         f0 = nominal["fit"]
         warm = {n: (f0.values[n],) + v[1:] for n, v in free.items()}
+        budget = max(BUDGET_MIN_S, BUDGET_FACTOR * nominal["wall_s"])
         calls = [(fit_task, (model_path, data_folder, lib_name, h, l, spec_rows[(h, l)],
-                             warm, max_nfev)) for h, l, _ in cands]
+                             warm, max_nfev, budget)) for h, l, _ in cands]
         results = [nominal] + _run_tasks(ex, calls, "fitting candidates", progress)
         t_fit = time.perf_counter() - t_start
         n = f0.n
@@ -296,7 +301,7 @@ def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
                 for e in ds.experiments:
                     calls.append((loo_task, (model_path, data_folder, lib_name, h, l,
                                              f.names, f.values, lo, hi, sc, e.name,
-                                             max(5, max_nfev // 4))))
+                                             max(5, max_nfev // 4), budget / 3)))
             for r in _run_tasks(ex, calls, "leave-one-out", progress):
                 loo_exact.setdefault((r["hyp"], r["location"]), {})[r["held"]] = r["residuals"]
     t_cv = time.perf_counter() - t_start - t_fit
@@ -396,7 +401,7 @@ def _details(ctx):
         return dict(label, k=f.k, S=_num(f.cost), train_rmse=_num(f.rms()),
                     values=f.values, ci95={k: [_num(a), _num(b)] for k, (a, b) in
                                            f.ci95.items()},
-                    n_sim=f.n_sim, wall_s=f.wall_s, **extra)
+                    n_sim=f.n_sim, wall_s=f.wall_s, message=f.message, **extra)
     f0 = ctx["f0"]
     out = dict(nominal=one(dict(cause=None, location=None), f0,
                            dict(aicc=_num(ctx["a0"]))),
