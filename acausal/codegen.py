@@ -89,8 +89,13 @@ def generate(dae, params, discretes, roots, observed):
     res = names.rename(dae.residuals, "a residual")
     g = names.rename(roots, "an event")
     obs = names.rename(observed, "an observed variable")
-    ysyms = [sp.Symbol(f"y{i}") for i in range(n)]
-    ypsyms = [sp.Symbol(f"yp{i}") if dae.yp[i] is not None else None for i in range(n)]
+    # differentiate over real symbols (every quantity is real): d|x|/dx is
+    # then sign(x), not an expression of re(x), im(x) the printer cannot write
+    real = {s: sp.Symbol(s.name, real=True) for s in names.allowed}
+    res = [r.xreplace(real) for r in res]
+    ysyms = [real.get(sp.Symbol(f"y{i}"), sp.Symbol(f"y{i}")) for i in range(n)]
+    ypsyms = [real.get(sp.Symbol(f"yp{i}"), sp.Symbol(f"yp{i}")) if dae.yp[i] is not None
+              else None for i in range(n)]
     cj = sp.Symbol("cj")
     jy, jyp, jcomb = [], [], []
     for i, r in enumerate(res):

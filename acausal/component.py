@@ -189,6 +189,37 @@ class Model(Component):
                 raise ModelError(f"connect(): {p!r} is not a connector")
         self._connections.append(tuple(ports))
 
+    def disconnect(self, port):
+        """Take ``port`` out of every connection made in this model or its
+        sub-models, keeping the other connectors of its node joined to each
+        other (what was connected only through ``port`` stays connected).
+        Returns the connectors ``port`` was joined to (one node, by path);
+        afterwards ``port`` is unconnected. Connectors exposed under another
+        name are the same object, so a connection made through the exposed
+        name is removed too."""
+        if not isinstance(port, Port):
+            raise ModelError(f"disconnect(): {port!r} is not a connector")
+        neighbours, reps = {}, []
+        for m in self.walk():
+            if not isinstance(m, Model):
+                continue
+            kept = []
+            for group in m._connections:
+                if not any(p is port for p in group):
+                    kept.append(group)
+                    continue
+                rest = tuple(p for p in group if p is not port)
+                for p in rest:
+                    neighbours[id(p)] = p
+                if rest:
+                    reps.append(rest[0])
+                if len(rest) >= 2:
+                    kept.append(rest)
+            m._connections[:] = kept
+        if len(reps) >= 2:       # the groups were joined through port: keep them joined
+            self._connections.append(tuple(reps))
+        return sorted(neighbours.values(), key=lambda p: p.path)
+
     def expose(self, name, port):
         """Make a sub-component's connector a connector of this model."""
         if not isinstance(port, Port):

@@ -30,6 +30,10 @@ def initial_point(cm, p, d, cb, t0):
     n, ns = len(dae.y), dae.n_states
     fixed = cm.fixed_starts(p)           # list of (var index, value, name)
     y0 = cm.guess_vector(p)
+    # start Newton at the fixed start values of the states (a fixed velocity
+    # is the value of the slot der(x), which the guess vector leaves at 0): a
+    # steep law near 0 (regularised friction) can stall it far from them
+    _snap_fixed_states(cm, y0, fixed)
     res_fn, observe = cb[0], cb[4]
     r = np.zeros(n)
 
@@ -151,7 +155,7 @@ def _newton(fun, jac, z, max_iter=50):
     for _ in range(max_iter):
         if not np.all(np.isfinite(r)):
             return None
-        dz = np.linalg.lstsq(jac(z), -r, rcond=None)[0]
+        dz = _lstsq_scaled(jac(z), -r)
         step = 1.0
         for _ in range(30):
             z2 = z + step * dz
@@ -166,6 +170,17 @@ def _newton(fun, jac, z, max_iter=50):
         if np.all(np.abs(step * dz) <= 1e-13 * (1 + np.abs(z))) or nr == 0.0:
             return z
     return z
+
+
+def _lstsq_scaled(J, b):
+    """Least-squares solution of ``J x = b`` with the columns of ``J``
+    scaled to unit norm first: the unknowns mix positions, velocities,
+    accelerations and forces whose columns can differ by many orders of
+    magnitude (a stiff spring next to a light body), and an unscaled
+    solve would cut the small columns off as rank deficiency."""
+    norms = np.linalg.norm(J, axis=0)
+    d = np.where(norms > 0, 1.0 / np.where(norms > 0, norms, 1.0), 1.0)
+    return d * np.linalg.lstsq(J * d, b, rcond=None)[0]
 
 
 def _consistent(cm, full, J, z, fixed, n):

@@ -17,7 +17,7 @@ from .partials import (PartialRotAbsoluteSensor, PartialRotCompliant,
                        PartialRotRelativeSensor, PartialRotRigid, PartialSource)
 
 __all__ = ["Fixed", "Inertia", "TorsionSpring", "RotationalDamper", "SpringDamper",
-           "Spring", "Damper", "Torque", "Angle", "AngleSensor", "SpeedSensor",
+           "Spring", "Damper", "Torque", "RelativeTorque", "Angle", "AngleSensor", "SpeedSensor",
            "AccSensor", "TorqueSensor", "RelAngleSensor", "RelSpeedSensor"]
 
 
@@ -136,6 +136,30 @@ class Torque(PartialSource):
 
     def equations(self):
         return [Eq(self.tau, self.law(self.flange.phi)), Eq(self.flange.tau, -self.tau)]
+
+
+class RelativeTorque(PartialSource, PartialRotCompliant):
+    """A torque between two rotational flanges given by a law of their
+    relative motion (a nonlinear torsion spring or damper):
+    ``tau = law(phi_rel)`` or ``tau = law(phi_rel, w_rel)``, signed as a
+    :class:`TorsionSpring`'s ``tau`` (``flange_b.tau = tau``,
+    ``flange_a.tau = -tau``; ``tau > 0`` twists flange_b back), with
+    ``phi_rel = flange_b.phi - flange_a.phi`` and ``w_rel = der(phi_rel)``.
+    The law is given as for :class:`Torque` (a number gives ``tau_const``).
+
+    Parameters: ``tau_const`` [N*m] (only when ``tau`` is a number).
+    States: ``phi_rel`` [rad], ``tau`` [N*m]. Connectors: ``flange_a``,
+    ``flange_b``.
+    """
+
+    quantity = ("tau", "N*m", "torque between the flanges (as a torsion spring's tau)")
+    across_name = "relative angle phi_rel"
+
+    def __init__(self, tau=0.0, **kw):
+        super().__init__(tau, **kw)
+
+    def equations(self):
+        return [Eq(self.tau, self.law(self.phi_rel))]
 
 
 class Angle(Component):

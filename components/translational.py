@@ -15,7 +15,8 @@ from acausal import Component, Flange, Parameter, ParameterError, Variable, der
 from .partials import (PartialAbsoluteSensor, PartialCompliant, PartialRelativeSensor,
                        PartialRigid, PartialSource)
 
-__all__ = ["Fixed", "Mass", "Spring", "Damper", "SpringDamper", "Force", "Position",
+__all__ = ["Fixed", "Mass", "Spring", "Damper", "SpringDamper", "Force", "RelativeForce",
+           "Position",
            "PositionSensor", "SpeedSensor", "AccSensor", "ForceSensor",
            "RelPositionSensor", "RelSpeedSensor"]
 
@@ -138,6 +139,32 @@ class Force(PartialSource):
 
     def equations(self):
         return [Eq(self.f, self.law(self.flange.s)), Eq(self.flange.f, -self.f)]
+
+
+class RelativeForce(PartialSource, PartialCompliant):
+    """A force between two flanges given by a law of their relative motion
+    (a nonlinear spring or damper): ``f = law(s_rel)`` or
+    ``f = law(s_rel, v_rel)``, tension positive as in :class:`Spring`
+    (``f > 0`` pulls the flanges together: ``flange_b.f = f``,
+    ``flange_a.f = -f``), with ``s_rel = flange_b.s - flange_a.s`` and
+    ``v_rel = der(s_rel)``. The law is given as for :class:`Force`::
+
+        RelativeForce(f=lambda s_rel: k3 * (s_rel - L0)**3)   # cubic (hardening) spring
+        RelativeForce(f=lambda s_rel, v: d2 * v * Abs(v))      # quadratic damper
+        RelativeForce(f=50.0)                                 # constant tension, f_const
+
+    Parameters: ``f_const`` [N] (only when ``f`` is a number). States:
+    ``s_rel`` [m], ``f`` [N]. Connectors: ``flange_a``, ``flange_b``.
+    """
+
+    quantity = ("f", "N", "force between the flanges (tension positive)")
+    across_name = "relative position s_rel"
+
+    def __init__(self, f=0.0, **kw):
+        super().__init__(f, **kw)
+
+    def equations(self):
+        return [Eq(self.f, self.law(self.s_rel))]
 
 
 class Position(Component):

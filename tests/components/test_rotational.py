@@ -9,7 +9,7 @@ from acausal import Model, ParameterError, compile_model, time
 from components.rotational import (AccSensor, Angle, AngleSensor, Damper, Fixed, Inertia,
                                    RelAngleSensor, RelSpeedSensor, RotationalDamper,
                                    SpeedSensor, Spring, SpringDamper, Torque, TorqueSensor,
-                                   TorsionSpring)
+                                   TorsionSpring, RelativeTorque)
 
 TOL = dict(rtol=1e-10, atol=1e-12)
 REL = 1e-7   # IDA at rtol 1e-10: measured <= 3e-8 relative to the amplitude
@@ -201,3 +201,26 @@ def test_validation_names_the_parameter():
         Torque(tau=[1.0])
     with pytest.raises(ParameterError, match=r"Angle\.phi must be"):
         Angle(phi=None)
+
+
+def test_relative_torque_cubic_against_solve_ivp():
+    """J phi'' = -c phi - k3 phi^3 - d2 w|w|: linear torsion spring, a
+    RelativeTorque cubic spring and a RelativeTorque quadratic damper."""
+    from scipy.integrate import solve_ivp
+    J, c, k3, d2, p0 = 0.01, 5.0, 300.0, 0.002, 0.4
+    model = Model()
+    model.ground = Fixed()
+    model.spring = TorsionSpring(c=c)
+    model.cubic = RelativeTorque(tau=lambda p: k3 * p ** 3)
+    model.drag = RelativeTorque(tau=lambda p, w: d2 * w * sp.Abs(w))
+    model.body = Inertia(J=J, phi=p0, w=0.0)
+    model.connect(model.ground.flange, model.spring.flange_a, model.cubic.flange_a,
+                  model.drag.flange_a)
+    model.connect(model.body.flange, model.spring.flange_b, model.cubic.flange_b,
+                  model.drag.flange_b)
+    res = run(model, t_end=0.5, step=1e-3)
+    ref = solve_ivp(lambda t, y: [y[1], -(c * y[0] + k3 * y[0] ** 3 + d2 * y[1] * abs(y[1])) / J],
+                    (0, 0.5), [p0, 0.0], t_eval=res.t, rtol=1e-12, atol=1e-14,
+                    method="DOP853")
+    assert maxerr(res, "body.phi", ref.y[0]) < REL
+    assert np.allclose(res["cubic.tau"], k3 * res["body.phi"] ** 3, rtol=1e-12, atol=1e-9)

@@ -9,6 +9,7 @@ import sympy as sp
 
 from acausal import Model, ParameterError, compile_model, time
 from components.translational import (AccSensor, Damper, Fixed, Force, ForceSensor, Mass,
+                                      RelativeForce,
                                       Position, PositionSensor, RelPositionSensor,
                                       RelSpeedSensor, SpeedSensor, Spring, SpringDamper)
 
@@ -286,3 +287,47 @@ def test_force_law_validation():
         Position(s="abc")
     with pytest.raises(ParameterError, match=r"has no parameter or variable 'k'"):
         Spring(k=3.0)
+
+
+def test_relative_force_cubic_spring_against_solve_ivp():
+    """Duffing oscillator m x'' = -c x - k3 x^3 with the cubic term as a
+    RelativeForce in parallel with a linear Spring (ground on flange_a)."""
+    from scipy.integrate import solve_ivp
+    m_, c, k3, x0 = 0.5, 200.0, 4.0e5, 0.03
+    model = Model()
+    model.ground = Fixed()
+    model.spring = Spring(c=c)
+    model.cubic = RelativeForce(f=lambda x: k3 * x ** 3)
+    model.mass = Mass(m=m_, s=x0, v=0.0)
+    model.connect(model.ground.flange, model.spring.flange_a, model.cubic.flange_a)
+    model.connect(model.mass.flange, model.spring.flange_b, model.cubic.flange_b)
+    res = compile_model(model).simulate(t_end=0.3, output_step=1e-3, rtol=1e-10, atol=1e-12)
+    ref = solve_ivp(lambda t, y: [y[1], -(c * y[0] + k3 * y[0] ** 3) / m_], (0, 0.3),
+                    [x0, 0.0], t_eval=res.t, rtol=1e-12, atol=1e-14, method="DOP853")
+    assert np.max(np.abs(res["mass.s"] - ref.y[0])) / x0 < 1e-7
+    # tension positive: flange_b.f = f = k3 s_rel^3 (the outside pulls b to keep it)
+    assert np.allclose(res["cubic.f"], k3 * res["mass.s"] ** 3, rtol=1e-12, atol=1e-9)
+    assert np.allclose(res["cubic.flange_a.f"], -res["cubic.f"], rtol=1e-12)
+
+
+def test_relative_force_velocity_law_and_constant():
+    """f = d2 v|v| between a mass and the ground: v = v0 / (1 + d2 v0 t / m);
+    a number is the run-time parameter f_const (constant tension)."""
+    model = Model()
+    model.ground = Fixed()
+    model.drag = RelativeForce(f=lambda x, v: 0.5 * v * sp.Abs(v))
+    model.mass = Mass(m=2.0, s=0.0, v=3.0)
+    model.connect(model.ground.flange, model.drag.flange_a)
+    model.connect(model.drag.flange_b, model.mass.flange)
+    res = compile_model(model).simulate(t_end=1.0, output_step=1e-2, rtol=1e-10, atol=1e-12)
+    assert np.max(np.abs(res["mass.v"] - 3.0 / (1 + 0.75 * res.t))) < 1e-8
+    model = Model()
+    model.ground = Fixed()
+    model.pull = RelativeForce(f=4.0)
+    model.mass = Mass(m=2.0, s=0.0, v=0.0)
+    model.connect(model.ground.flange, model.pull.flange_a)
+    model.connect(model.pull.flange_b, model.mass.flange)
+    cm = compile_model(model)
+    res = cm.simulate(t_end=1.0, output_step=0.1, rtol=1e-10, atol=1e-12,
+                      params={"pull.f_const": 8.0})
+    assert np.max(np.abs(res["mass.s"] + 2.0 * res.t ** 2)) < 1e-9   # pulled towards a
