@@ -73,7 +73,7 @@ class _OutOfTime(Exception):
 
 
 def fit(model, dataset, names, x0, low, high, scale, *, fixed=None, starts=None,
-        max_nfev=60, tol=1e-8, budget_s=None) -> Fit:
+        max_nfev=60, tol=1e-8, budget_s=None, absorb=None) -> Fit:
     """Weighted output-error least squares over ``names``.
 
     ``x0``, ``low``, ``high``, ``scale``: per-name start, bounds and typical
@@ -84,6 +84,13 @@ def fit(model, dataset, names, x0, low, high, scale, *, fixed=None, starts=None,
     starts where it has no effect). ``budget_s``: wall-time budget; when it
     is spent the best point seen so far is kept (``message`` says so) and
     the Jacobian is taken there by one more finite-difference pass.
+    ``absorb``: (names, jacobian) of parameters calibrated beforehand (the
+    nominal fit's free parameters and its Jacobian, rows as this dataset's
+    residuals): each starting point is then scored after a linearised
+    re-calibration of those parameters, and moved there. Without it a start
+    is scored with the free parameters as they are, which favours "no
+    effect" whenever they already absorb part of the effect (a viscous
+    coefficient absorbing quadratic drag).
     """
     t0 = time.perf_counter()
     pair = resolve(model)
@@ -127,13 +134,25 @@ def fit(model, dataset, names, x0, low, high, scale, *, fixed=None, starts=None,
                 x[i] = st[n]
         candidates.append(np.clip(x, lo, hi))
     best, best_cost = None, np.inf
+    a_idx, a_jac = None, None
+    if absorb is not None and absorb[0]:
+        a_idx = np.array([names.index(n) for n in absorb[0]])
+        a_jac = np.asarray(absorb[1], float)
     for x in candidates:
         try:
-            c = float(np.sum(evaluate(x) ** 2))
+            r = evaluate(x)
         except AcausalError:
             continue
         except _OutOfTime:
             break
+        c = float(r @ r)
+        if a_jac is not None and a_jac.shape[0] == r.size:
+            d = np.linalg.lstsq(a_jac, -r, rcond=None)[0]
+            moved = np.clip(x[a_idx] + d, lo[a_idx], hi[a_idx])
+            rr = r + a_jac @ (moved - x[a_idx])
+            c = float(rr @ rr)
+            x = x.copy()
+            x[a_idx] = moved
         if c < best_cost:
             best, best_cost = x, c
     if best is None:

@@ -82,13 +82,13 @@ def _model(model_path, library, hyp_id, location):
 
 def _starts(spec_rows):
     """Extra starting points along the first extension parameter: its scale
-    times 0.3 and 3, both signs where the bounds allow (a parameter starting
-    where it has no effect may sit on a bound or a flat spot)."""
+    times 0.1, 0.5 and 2.5, both signs where the bounds allow (a parameter
+    starting where it has no effect may sit on a bound or a flat spot)."""
     if not spec_rows:
         return []
     name, initial, low, high, scale = spec_rows[0][:5]
     out = []
-    for f in (0.3, 3.0):
+    for f in (0.1, 0.5, 2.5):
         for s in (1.0, -1.0):
             v = s * f * abs(scale)
             if low <= v <= high and v != initial:
@@ -97,7 +97,7 @@ def _starts(spec_rows):
 
 
 def fit_task(model_path, folder, library, hyp_id, location, spec_rows, free, max_nfev,
-             budget_s=None):
+             budget_s=None, absorb=None):
     """Fit one candidate (``hyp_id`` None: the nominal model). ``spec_rows``:
     (name, initial, low, high, scale) of the extension's parameters;
     ``free``: name -> (start, low, high, scale) of the free parameters."""
@@ -111,7 +111,7 @@ def fit_task(model_path, folder, library, hyp_id, location, spec_rows, free, max
         hi = {n: v[2] for n, v in free.items()} | {r[0]: r[3] for r in spec_rows}
         sc = {n: v[3] for n, v in free.items()} | {r[0]: r[4] for r in spec_rows}
         f = fit(pair, ds, names, x0, lo, hi, sc, starts=_starts(spec_rows),
-                max_nfev=max_nfev, tol=FIT_TOL, budget_s=budget_s)
+                max_nfev=max_nfev, tol=FIT_TOL, budget_s=budget_s, absorb=absorb)
         return dict(hyp=hyp_id, location=location, fit=f, loo=linear_loo(f) if f.ok else {},
                     error=None, wall_s=time.perf_counter() - t0)
     except Exception as exc:  # noqa: BLE001 - a candidate that cannot be built is reported
@@ -240,8 +240,9 @@ def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
         f0 = nominal["fit"]
         warm = {n: (f0.values[n],) + v[1:] for n, v in free.items()}
         budget = max(BUDGET_MIN_S, BUDGET_FACTOR * nominal["wall_s"])
+        absorb = (list(f0.names), f0.jacobian)
         calls = [(fit_task, (model_path, data_folder, lib_name, h, l, spec_rows[(h, l)],
-                             warm, max_nfev, budget)) for h, l, _ in cands]
+                             warm, max_nfev, budget, absorb)) for h, l, _ in cands]
         results = [nominal] + _run_tasks(ex, calls, "fitting candidates", progress)
         t_fit = time.perf_counter() - t_start
         n = f0.n
