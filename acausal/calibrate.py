@@ -26,10 +26,20 @@ class CalibrationError(AcausalError):
     """The calibration could not be carried out (no bracket, no data...)."""
 
 
+def resolve(model):
+    """(ModelFile, CompiledModel) for a model file path, or the pair itself.
+
+    Every function here taking ``path`` also accepts such a pair, e.g. the
+    model file extended with a hypothesis by :mod:`acausal.diagnose`."""
+    if isinstance(model, tuple) and len(model) == 2:
+        return model
+    return compile_file(model)
+
+
 def model_dataset(path, folder):
     """Load ``folder`` checking its columns against the model file's
     parameters, measures and variables (with their units)."""
-    mf, cm = compile_file(path)
+    mf, cm = resolve(path)
     params = {p.name: p.unit for p in cm.params}
     measures = {name: None for name in mf.measures}
     variables = {n: cm.flat.variables[n].unit for n in cm.var_names}
@@ -47,12 +57,15 @@ def subset(dataset, names):
     return dataclasses.replace(dataset, experiments=[dataset.experiment(n) for n in names])
 
 
-def simulate_experiment(path, params, conditions):
-    """(result, measures) for one experiment with fitted ``params``."""
-    mf, cm = compile_file(path)
+def simulate_experiment(path, params, conditions, options=None):
+    """(result, measures) for one experiment with fitted ``params``;
+    ``options``: further keyword arguments of ``simulate`` (``max_steps``)."""
+    mf, cm = resolve(path)
     over = dict(params)
     over.update(conditions)
-    res = cm.simulate(params=over, **mf.experiment.run_options())
+    opts = mf.experiment.run_options()
+    opts.update(options or {})
+    res = cm.simulate(params=over, **opts)
     return res, evaluate_measures(mf, res)
 
 
@@ -152,13 +165,14 @@ def _nominal(dataset, measures, name=None):
     raise CalibrationError(f"no experiment measures all of {measures}")
 
 
-def residual_vector(path, dataset, params, signals=None):
+def residual_vector(path, dataset, params, signals=None, options=None):
     """Weighted residuals (simulated - measured)/sigma over every experiment:
-    measures first, then trace samples. Returns (vector, labels, raw)."""
-    mf, _ = compile_file(path)
+    measures first, then trace samples. Returns (vector, labels, raw).
+    ``options``: passed to :func:`simulate_experiment`."""
+    path = resolve(path)
     vec, labels, raw = [], [], {}
     for exp in dataset.experiments:
-        res, meas = simulate_experiment(path, params, exp.conditions)
+        res, meas = simulate_experiment(path, params, exp.conditions, options)
         raw[exp.name] = {}
         for m, y in exp.measures.items():
             if signals and m not in signals:
@@ -197,7 +211,8 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None):
     and never crosses zero. Intervals use the Jacobian at the optimum, scaled
     by the reduced chi-square when it exceeds 1 (never narrower than the
     instrument model says), with Student t quantiles."""
-    mf, cm = compile_file(path)
+    path = resolve(path)
+    mf, cm = path
     entries = [cm.params[cm.param_index(n)] for n in names]
     start = np.array([(x0 or {}).get(e.name, e.default) for e in entries], float)
     lo, hi = np.empty(len(names)), np.empty(len(names))

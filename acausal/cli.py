@@ -217,5 +217,62 @@ def sweep(file, params, measures, out, plot, scheduler, workers, no_progress):
     click.echo(f"{len(rows)} points, {failed} failed; results in {out}")
 
 
+def _csv_list(text):
+    return None if text is None else [x.strip() for x in text.split(",") if x.strip()]
+
+
+@main.command()
+@click.argument("file", type=click.Path(dir_okay=False))
+@click.argument("data", type=click.Path(file_okay=False))
+@click.option("--json", "json_path", type=click.Path(dir_okay=False),
+              help="write the summary as one JSON object to this file")
+@click.option("--report", "report_dir", type=click.Path(file_okay=False), default="diagnosis",
+              show_default=True, help="folder for report.md, plots and the extended model")
+@click.option("--scheduler", help="Dask scheduler address (default: local processes)")
+@click.option("--workers", type=int, help="local worker processes (default: all cores)")
+@click.option("--hypotheses", metavar="ID,ID,...", help="only these hypotheses")
+@click.option("--locations", metavar="PATH,PATH,...",
+              help="only these locations (a path or a prefix of paths)")
+@click.option("--alpha", type=float, default=0.01, show_default=True,
+              help="family significance level of the discrepancy decision")
+@click.option("--no-progress", is_flag=True)
+@click.option("--library", hidden=True, help="module standing in for the hypothesis library")
+def diagnose(file, data, json_path, report_dir, scheduler, workers, hypotheses, locations,
+             alpha, no_progress, library):
+    """Show what a model gets wrong against measured data, name the cause,
+    extend the model and measure the gain."""
+    from .data import DataError
+    from .diagnose.run import diagnose as run_diagnosis
+    try:
+        if not 0 < alpha < 1:
+            raise click.BadParameter(f"--alpha {alpha}: must be between 0 and 1")
+        out = run_diagnosis(file, data, out_dir=report_dir, scheduler=scheduler,
+                            workers=workers, progress=not no_progress,
+                            hypotheses=_csv_list(hypotheses), locations=_csv_list(locations),
+                            alpha=alpha, library=library)
+    except (AcausalError, DataError, click.BadParameter, ValueError, ImportError) as exc:
+        _fail(exc)
+    if json_path:
+        with open(json_path, "w") as f:
+            json.dump(out, f, indent=1)
+    g = out["gain"]
+    if not out["discrepancy"]:
+        click.echo("no significant discrepancy between the calibrated model and the data")
+    elif out["cause"] is None:
+        click.echo("discrepancy, but the evidence is weak: no cause named"
+                   + (f" (best candidate: {out['ranking'][0]['cause']} at "
+                      f"{out['ranking'][0]['location']})" if out["ranking"] else ""))
+    else:
+        click.echo(f"discrepancy; cause: {out['cause']} at {out['location']}")
+        for e in out["equivalent_causes"]:
+            click.echo(f"  equivalent: {e['cause']} at {e['location']}")
+    click.echo(f"error [instrument floor units]: train {g['before']['train']:.3g} -> "
+               f"{g['after']['train']:.3g}, held-out {g['before']['heldout']:.3g} -> "
+               f"{g['after']['heldout']:.3g}")
+    if out["extended_model"]:
+        click.echo(f"extended model: {out['extended_model']}")
+    click.echo(f"report: {report_dir}/report.md" + (f"; JSON: {json_path}" if json_path else ""))
+
+
 if __name__ == "__main__":  # pragma: no cover
     main()

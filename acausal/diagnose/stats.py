@@ -1,0 +1,224 @@
+"""The statistics of the diagnosis: is there a discrepancy, which extension
+explains it best, how strong is the evidence.
+
+Every residual is weighted by the instrument floor of its signal
+(``Instrument.floor()`` = sqrt(noise_std^2 + resolution^2/12)), so under the
+instrument model a correct model leaves weighted residuals that are
+independent, zero-mean, unit-variance. The decisions below are tests of that
+null hypothesis and comparisons of fits made under it.
+
+Discrepancy decision (:func:`discrepancy_decision`), three tests at a family
+significance level ``alpha`` (default 0.01), each given ``alpha/3``
+(Bonferroni), so that the probability of a false "discrepancy" on data the
+nominal model explains is at most ``alpha`` whatever the dependence between
+the three:
+
+1. Goodness of fit, chi-square: S = sum of squared weighted residuals after
+   calibrating the k free parameters; under the null S ~ chi2(n - k)
+   (exactly for Gaussian noise and a model linear in its parameters, to
+   first order otherwise). Quantisation alone (uniform error) has a smaller
+   variance of S than Gaussian noise of the same sigma, so the test is then
+   conservative.
+2. Runs (Wald-Wolfowitz) on every trace signal of every experiment: a
+   systematic error makes long runs of one sign; the count of sign runs of
+   independent symmetric residuals has a known distribution whatever their
+   law (one-sided: too few runs). The smallest p-value over the m traces is
+   multiplied by m (Bonferroni). It catches a small but smooth misfit that
+   the chi-square, diluted over hundreds of samples, misses.
+3. Likelihood ratio against the library: 2 dlnL = S_nominal - S_extended ~
+   chi2(k_ext) for each of the M candidate extensions (nested: each adds k_ext
+   parameters that vanish at no effect). The best of the M is tested at
+   ``alpha/(3 M)`` (Bonferroni over candidates). This is the most powerful
+   of the three against the effects the library names. Parameters on a bound
+   under the null make chi2(k_ext) conservative (the true law is a mixture
+   with a point mass at 0).
+
+Why this controls false positives: each component has size at most its
+share of alpha under the null (up to the first-order approximations named
+above), and the union bound adds them. It is measured, not only argued: the
+slow test tier and ``benchmarks/detection_power.py`` count false positives
+on noise-only synthetic datasets. It relies on the instrument model: a noise
+level understated in ``instrument.csv`` is, to this test, a discrepancy.
+The quantisation error is treated as independent noise, which holds when the
+noise is at least about half a resolution step or the signal moves by more
+than a step between samples; a slowly varying, noise-free signal read by a
+coarse instrument makes correlated rounding errors.
+
+Model comparison: AICc = S/c + 2k + 2k(k+1)/(n-k-1) (known sigma, so
+-2 ln L = S + const), with c = max(1, S_best/(n - k_best)) the over-dispersion
+of the best fit (Burnham and Anderson's QAICc): when even the best extension
+leaves misfit beyond the instrument noise, every difference is scaled down
+by c instead of being read as overwhelming evidence.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy import stats
+
+ALPHA = 0.01          # family significance level of the discrepancy decision
+EQUIVALENCE = 2.0     # candidates within this many AICc units of the best: one class
+STRONG = 10.0         # dAICc vs no extension below which the evidence is weak
+RUNNER_UP = 4.0       # dAICc vs the best outside the class below which it is weak
+MIN_PER_PARAM = 3     # fewer data per fitted parameter: too few data
+HELDOUT_GAIN = 0.9    # held-out RMS must fall below this fraction of the nominal's
+CI_REL = 0.5          # a cause parameter's 95 % half-width above this fraction of it: weak
+OVERDISPERSION = 2.0  # best fit's S/(n-k) above this: the best extension leaves misfit
+
+
+def chi2_test(S: float, n: int, k: int, alpha: float) -> dict:
+    """Goodness of fit of S over n weighted residuals with k fitted parameters."""
+    dof = n - k
+    p = float(stats.chi2.sf(S, dof)) if dof > 0 else float("nan")
+    return dict(test="chi-square goodness of fit", statistic=float(S), dof=int(dof),
+                p_value=p, alpha=float(alpha),
+                reject=bool(dof > 0 and p < alpha))
+
+
+def runs_test(r: np.ndarray) -> dict:
+    """Wald-Wolfowitz runs test of the signs of ``r`` (zeros dropped);
+    one-sided p-value for too few runs (positive serial correlation).
+    Normal approximation with continuity correction; exact enough for
+    n1, n2 >= 10, and for fewer samples the p-value is set to 1."""
+    s = np.sign(np.asarray(r, float))
+    s = s[s != 0]
+    n1, n2 = int(np.sum(s > 0)), int(np.sum(s < 0))
+    n = n1 + n2
+    runs = int(1 + np.sum(s[1:] != s[:-1])) if n else 0
+    if n1 < 10 or n2 < 10:
+        return dict(runs=runs, expected=float("nan"), z=float("nan"), p_value=1.0, n=n,
+                    lag1=_lag1(r))
+    mu = 2.0 * n1 * n2 / n + 1
+    var = 2.0 * n1 * n2 * (2.0 * n1 * n2 - n) / (n * n * (n - 1))
+    z = (runs - mu + 0.5) / math.sqrt(var)
+    return dict(runs=runs, expected=mu, z=z, p_value=float(stats.norm.cdf(z)), n=n,
+                lag1=_lag1(r))
+
+
+def _lag1(r) -> float:
+    r = np.asarray(r, float)
+    if r.size < 3 or not np.any(r):
+        return float("nan")
+    r = r - r.mean()
+    d = float(r @ r)
+    return float(r[1:] @ r[:-1] / d) if d > 0 else float("nan")
+
+
+def lr_test(S0: float, S1: float, dk: int) -> float:
+    """p-value of the likelihood-ratio test of a nested extension adding
+    ``dk`` parameters: 2 dlnL = S0 - S1 ~ chi2(dk) under the smaller model."""
+    if dk <= 0:
+        return float("nan")
+    return float(stats.chi2.sf(max(S0 - S1, 0.0), dk))
+
+
+def aicc(S: float, n: int, k: int, c: float = 1.0) -> float:
+    """AICc = S/c + 2k + 2k(k+1)/(n-k-1) (notes.md; -2 ln L = S + const with
+    known sigma; c >= 1 the over-dispersion factor). Infinite if n <= k + 1."""
+    if not math.isfinite(S):
+        return float("inf")
+    if n - k - 1 <= 0:
+        return float("inf")
+    return S / c + 2 * k + 2 * k * (k + 1) / (n - k - 1)
+
+
+def overdispersion(fits) -> float:
+    """c = max(1, min over fits of S/(n - k)) for (S, n, k) tuples."""
+    vals = [S / (n - k) for S, n, k in fits if n - k > 0 and math.isfinite(S)]
+    return max(1.0, min(vals)) if vals else 1.0
+
+
+def discrepancy_decision(chi2: dict, runs: list, lr: dict | None, alpha: float = ALPHA
+                         ) -> dict:
+    """Combine the three tests (module docstring) at family level ``alpha``.
+
+    ``chi2``: :func:`chi2_test` output computed at any alpha; ``runs``: list of
+    dicts with ``p_value`` (one per trace signal and experiment); ``lr``: dict
+    with ``p_value`` (best candidate) and ``m`` (candidates tried), or None."""
+    share = alpha / 3.0
+    parts = []
+    p_chi = chi2["p_value"]
+    chi_rej = bool(chi2["dof"] > 0 and p_chi < share)
+    parts.append(dict(name="chi-square", p_value=p_chi, threshold=share, reject=chi_rej,
+                      detail=f"S = {chi2['statistic']:.4g} on {chi2['dof']} dof"))
+    if runs:
+        m = len(runs)
+        pmin = min(r["p_value"] for r in runs)
+        parts.append(dict(name="runs", p_value=min(1.0, pmin * m), threshold=share,
+                          reject=bool(pmin * m < share),
+                          detail=f"smallest of {m} one-sided runs p-values x {m}"))
+    if lr is not None and lr.get("m"):
+        p_adj = min(1.0, lr["p_value"] * lr["m"])
+        parts.append(dict(name="likelihood ratio", p_value=p_adj, threshold=share,
+                          reject=bool(p_adj < share),
+                          detail=f"best of {lr['m']} candidates, p x {lr['m']}"))
+    return dict(alpha=alpha, parts=parts, discrepancy=any(p["reject"] for p in parts))
+
+
+def equivalence_classes(rows: list, threshold: float = EQUIVALENCE) -> list:
+    """Group ranked rows (dicts with ``aicc``, ``heldout_rmse``, sorted by
+    aicc) into classes: a row joins the class of the best remaining row when
+    its AICc is within ``threshold`` of it, or within 2.5 * threshold with a
+    held-out error no worse (the two criteria disagree: the data do not
+    decide). Returns lists of row indices, the first class containing the
+    best row."""
+    left = list(range(len(rows)))
+    classes = []
+    while left:
+        head = left[0]
+        a0, h0 = rows[head]["aicc"], rows[head]["heldout_rmse"]
+        cls = [i for i in left
+               if rows[i]["aicc"] - a0 <= threshold
+               or (rows[i]["aicc"] - a0 <= 2.5 * threshold
+                   and rows[i]["heldout_rmse"] <= h0 * (1 + 1e-9))]
+        classes.append(cls)
+        left = [i for i in left if i not in cls]
+    return classes
+
+
+def akaike_weights(aiccs) -> np.ndarray:
+    a = np.asarray(aiccs, float)
+    a = a - np.min(a)
+    w = np.exp(-0.5 * a)
+    return w / w.sum()
+
+
+def weak_evidence(*, n: int, k: int, d_null: float, d_runner: float | None,
+                  heldout_nominal: float, heldout_best: float, ci_rel: float | None,
+                  c_hat: float, coarse: float | None) -> list:
+    """Reasons (sentences with their numbers) why a named cause would not be
+    trustworthy; empty when the evidence is strong. Arguments: data count n,
+    parameters of the best model k, its dAICc below no extension (d_null) and
+    below the best candidate outside its class (d_runner), held-out RMS of the
+    nominal and of the best (noise-floor units), the relative 95 % half-width
+    of its main parameter, the over-dispersion, and the nominal misfit's RMS in
+    resolution steps (coarse; None if the data have no resolution)."""
+    out = []
+    if n < MIN_PER_PARAM * k:
+        out.append(f"too few data: {n} values for {k} fitted parameters "
+                   f"(fewer than {MIN_PER_PARAM} per parameter)")
+    if d_null <= 0:
+        out.append(f"no extension is better than none by AICc: the best is {-d_null:.1f} "
+                   f"units worse than the model as it is (strong evidence needs "
+                   f"{STRONG:g} better)")
+    elif d_null < STRONG:
+        out.append(f"the best extension improves AICc by only {d_null:.1f} over no "
+                   f"extension (strong evidence needs more than {STRONG:g})")
+    if d_runner is not None and d_runner < RUNNER_UP:
+        out.append(f"the runner-up outside its class is only {d_runner:.1f} AICc units "
+                   f"behind (needs {RUNNER_UP:g})")
+    if not (heldout_best < HELDOUT_GAIN * heldout_nominal):
+        out.append(f"held-out error does not fall enough: {heldout_best:.3g} against "
+                   f"{heldout_nominal:.3g} without extension (needs below "
+                   f"{HELDOUT_GAIN:g}x)")
+    if ci_rel is not None and not (ci_rel < CI_REL):
+        out.append(f"the cause's parameter is poorly determined: 95 % half-width "
+                   f"{ci_rel:.0%} of its value (needs below {CI_REL:.0%})")
+    if c_hat > OVERDISPERSION:
+        out.append(f"the best extension still leaves {math.sqrt(c_hat):.2g}x the noise "
+                   f"floor (RMS), so part of the discrepancy is not explained")
+    if coarse is not None and coarse < 1.0:
+        out.append(f"coarse data: the nominal model's misfit is {coarse:.2f} resolution "
+                   f"steps RMS, less than one step")
+    return out

@@ -1,0 +1,221 @@
+"""Synthetic measured data with a hidden effect, for blind tests of the
+diagnosis and for its detection-power benchmark.
+
+The truth is a model file plus (optionally) one extension of the hypothesis
+library at one location, with a magnitude drawn at random. It is simulated
+over several experiments (conditions such as ``v_impact``) and read like a
+real instrument: traces sampled at a fixed rate from t = 0 to the end of the
+run, Gaussian noise added, then rounded to the instrument's resolution;
+measures get noise and rounding too. The result is written in the dataset
+format (:func:`acausal.data.write_dataset`) with an ``instrument.csv``
+describing exactly that noise and resolution. The truth is returned, not
+written next to the data: the diagnosis sees only the nominal model and the
+folder.
+
+Magnitude: give the extension's parameter ``values`` outright, or a range
+``magnitude=(lo, hi)`` for its first parameter (drawn log-uniformly), or an
+``effect=(lo, hi)`` range in noise-floor units: the first parameter is then
+solved for so that the RMS change the extension makes to the data (before
+any recalibration), divided by the instrument floor, equals a value drawn
+log-uniformly in that range. ``effect`` makes "big enough to matter against
+the noise" the same statement for every hypothesis and mechanism.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+from scipy import optimize
+
+from ..data import Dataset, Experiment, Instrument, Trace, write_dataset
+from ..modelfile import compile_file, evaluate_measures
+from .library import load_library
+
+
+@dataclass
+class Truth:
+    """What the synthetic data were made from (kept from the diagnosis)."""
+
+    hypothesis: str | None
+    location: str | None
+    values: dict = field(default_factory=dict)     # extension parameters
+    free: dict = field(default_factory=dict)       # free parameters of the truth
+    effect: float = 0.0          # RMS data change of the extension / noise floor
+    seed: int = 0
+    experiments: list = field(default_factory=list)
+
+    def to_dict(self):
+        return asdict(self)
+
+
+def _conditions(conditions):
+    """list of dicts from a dict name -> list, or a list of dicts."""
+    if isinstance(conditions, dict):
+        names = list(conditions)
+        n = {len(v) for v in conditions.values()}
+        if len(n) != 1:
+            raise ValueError("every condition needs the same number of values")
+        return [{k: float(conditions[k][i]) for k in names} for i in range(n.pop())]
+    return [dict(c) for c in conditions]
+
+
+def _simulate(pair, params, conds):
+    mf, cm = pair
+    out = []
+    for c in conds:
+        res = cm.simulate(params={**params, **c}, **mf.experiment.run_options())
+        out.append((res, evaluate_measures(mf, res) if mf.measures else {}))
+    return out
+
+
+def _floors(signals, noise, resolution):
+    return {s: Instrument(s, (resolution or {}).get(s, 0.0), (noise or {}).get(s, 0.0)).floor()
+            for s in signals}
+
+
+def _effect(runs, ref, measures, traces, floors, rate):
+    """RMS over every data value of (extended - nominal) / floor."""
+    acc = []
+    for (res, meas), (r0, m0) in zip(runs, ref):
+        for m in measures:
+            acc.append((meas[m] - m0[m]) / floors[m])
+        if traces:
+            t = np.arange(0.0, res.t[-1] + 1e-15, 1.0 / rate)
+            for v in traces:
+                acc.extend((np.interp(t, res.t, res[v]) - np.interp(t, r0.t, r0[v]))
+                           / floors[v])
+    a = np.asarray(acc)
+    return float(np.sqrt(np.mean(a ** 2))) if a.size else 0.0
+
+
+def synthesize(model_path, folder, *, conditions, hypothesis=None, location=None,
+               values=None, magnitude=None, effect=None, sign=1.0, free=None,
+               free_jitter=0.0, measures=(), traces=(), sample_rate=None, noise=None,
+               resolution=None, units=None, names=None, seed=0, library=None) -> Truth:
+    """Write a synthetic dataset to ``folder``; return the :class:`Truth`.
+
+    ``conditions``: dict name -> list of values (one experiment per index) or
+    a list of dicts. ``hypothesis``/``location``: the hidden extension (None:
+    a null dataset, only noise). ``values``/``magnitude``/``effect``: its size
+    (module doc); ``sign`` the sign of a drawn first parameter. ``free``:
+    values of the model's free parameters in the truth (default: the model's
+    values, each multiplied by exp(free_jitter * N(0, 1)) and kept in its
+    bounds). ``measures``: measure names to record; ``traces``: variables to
+    sample at ``sample_rate`` Hz. ``noise``/``resolution``: signal -> SI value.
+    ``units``: how to write columns (``{"time": "ms", "hook.phi": "deg"}``).
+    """
+    rng = np.random.default_rng(seed)
+    conds = _conditions(conditions)
+    measures, traces = list(measures), list(traces)
+    if not measures and not traces:
+        raise ValueError("record at least one measure or trace")
+    if traces and not sample_rate:
+        raise ValueError("traces need a sample_rate")
+    mf, cm = compile_file(model_path)
+    for m in measures:
+        if m not in mf.measures:
+            raise ValueError(f"the model file has no measure {m!r}")
+    truth_free = {}
+    for name, (lo, hi) in mf.free.items():
+        v = (free or {}).get(name)
+        if v is None:
+            v = cm.params[cm.param_index(name)].default * math.exp(free_jitter * rng.normal())
+            v = float(np.clip(v, lo, hi))
+        truth_free[name] = float(v)
+    floors = _floors(measures + traces, noise, resolution)
+    ext_values = {}
+    achieved = 0.0
+    pair = (mf, cm)
+    if hypothesis is not None:
+        lib = load_library(library)
+        hyp = lib.HYPOTHESES[hypothesis]
+        graph = lib.ModelGraph(mf.model)
+        if location is None:
+            location = hyp.candidates(graph)[0]
+        specs = hyp.params(graph, location)
+        ext_values = {s.name: float(s.initial) for s in specs}
+        ext_values.update(values or {})
+        pair = lib.build_extended(model_path, hypothesis, location)
+        first = specs[0]
+        if not values or first.name not in values:
+            if magnitude is not None:
+                lo, hi = sorted(abs(float(x)) for x in magnitude)
+                ext_values[first.name] = sign * math.exp(rng.uniform(math.log(lo),
+                                                                     math.log(hi)))
+            elif effect is not None:
+                lo, hi = sorted(float(x) for x in effect)
+                target = math.exp(rng.uniform(math.log(lo), math.log(hi)))
+                ref = _simulate((mf, cm), truth_free, conds)
+                ext_values[first.name] = _solve_effect(
+                    pair, truth_free, ext_values, first, sign, target, conds, ref,
+                    measures, traces, floors, sample_rate)
+            else:
+                raise ValueError("give values, magnitude or effect for the hidden extension")
+    runs = _simulate(pair, {**truth_free, **ext_values}, conds)
+    if hypothesis is not None:
+        ref = _simulate((mf, cm), truth_free, conds)
+        achieved = _effect(runs, ref, measures, traces, floors, sample_rate)
+    names = list(names or [f"E{i + 1:02d}" for i in range(len(conds))])
+    experiments = []
+    for name, c, (res, meas) in zip(names, conds, runs):
+        mvals = {m: _read(meas[m], m, noise, resolution, rng) for m in measures}
+        trace = None
+        if traces:
+            t = np.arange(0.0, res.t[-1] + 1e-15, 1.0 / sample_rate)
+            trace = Trace(t, {v: _read(np.interp(t, res.t, res[v]), v, noise, resolution, rng)
+                              for v in traces})
+        experiments.append(Experiment(name, dict(c), mvals, trace))
+    instrument = {s: Instrument(s, (resolution or {}).get(s, 0.0), (noise or {}).get(s, 0.0))
+                  for s in measures + traces}
+    write_dataset(folder, Dataset(None, experiments, instrument), units)
+    return Truth(hypothesis, location, ext_values, truth_free, achieved, seed, names)
+
+
+def _read(x, signal, noise, resolution, rng):
+    """The instrument's reading of x: Gaussian noise, then rounding."""
+    x = np.asarray(x, float)
+    s = (noise or {}).get(signal, 0.0)
+    q = (resolution or {}).get(signal, 0.0)
+    y = x + (rng.normal(0.0, s, x.shape) if s > 0 else 0.0)
+    if q > 0:
+        y = q * np.round(y / q)
+    return float(y) if y.ndim == 0 else y
+
+
+def _solve_effect(pair, free, values, spec, sign, target, conds, ref, measures, traces,
+                  floors, rate):
+    """First-parameter value whose effect equals ``target`` (bisection in log)."""
+    lo_b, hi_b = float(spec.low), float(spec.high)
+    limit = hi_b if sign > 0 else -lo_b
+    if not limit > 0:
+        raise ValueError(f"{spec.name}: no room for sign {sign:+g} in "
+                         f"[{spec.low}, {spec.high}]")
+
+    def eff(logm):
+        v = sign * math.exp(logm)
+        runs = _simulate(pair, {**free, **values, spec.name: v}, conds)
+        return _effect(runs, ref, measures, traces, floors, rate) - target
+
+    top = math.log(limit)
+    a = math.log(min(abs(spec.scale) or 1.0, limit))
+    fa = eff(a)
+    step = math.log(3.0)
+    b, fb = a, fa
+    if fa > 0:                      # too strong already: go down
+        for _ in range(40):
+            b, fb = a, fa
+            a -= step
+            fa = eff(a)
+            if fa <= 0:
+                break
+        else:
+            return sign * math.exp(a)
+    else:                           # too weak: go up to the bound
+        while fb <= 0:
+            if b >= top - 1e-12:
+                return sign * limit
+            a, fa = b, fb
+            b = min(b + step, top)
+            fb = eff(b)
+    return sign * math.exp(optimize.brentq(eff, a, b, xtol=0.01))

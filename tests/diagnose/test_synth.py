@@ -1,0 +1,90 @@
+"""The synthetic-data generator: instrument reading (noise, rounding, rate),
+the dataset format, the hidden extension and its magnitude."""
+import os
+
+import numpy as np
+import pytest
+
+from acausal.calibrate import model_dataset
+from acausal.diagnose.synth import synthesize
+from acausal.modelfile import compile_file
+
+HERE = os.path.dirname(__file__)
+LATCH = os.path.join(HERE, "..", "..", "models", "latch_striker.py")
+STUB = "tests.diagnose.stub_library"
+COND = {"F_coil": [20.0, 30.0, 40.0]}
+
+
+def test_null_dataset_reads_like_the_instrument(tmp_path):
+    q, s = 4e-6, 6e-6
+    truth = synthesize(LATCH, tmp_path, conditions=COND, traces=["latch.s"],
+                       measures=["trip_time"], sample_rate=20e3,
+                       noise={"latch.s": s, "trip_time": 2e-5},
+                       resolution={"latch.s": q, "trip_time": 1e-5},
+                       units={"time": "ms", "latch.s": "mm", "trip_time": "ms"}, seed=4)
+    assert truth.hypothesis is None and truth.values == {} and truth.effect == 0.0
+    assert sorted(os.listdir(tmp_path)) == ["E01.csv", "E02.csv", "E03.csv",
+                                            "experiments.csv", "instrument.csv"]
+    ds = model_dataset(LATCH, tmp_path)
+    assert [e.conditions["F_coil"] for e in ds.experiments] == COND["F_coil"]
+    assert ds.instrument["latch.s"].resolution == pytest.approx(q)
+    assert ds.instrument["latch.s"].noise_std == pytest.approx(s)
+    mf, cm = compile_file(LATCH)
+    errs = []
+    for e in ds.experiments:
+        tr = e.trace
+        assert np.allclose(np.diff(tr.time), 5e-5)              # 20 kHz
+        y = tr.signals["latch.s"]
+        assert np.allclose(y / q, np.round(y / q), atol=1e-6)   # rounded to q
+        res = cm.simulate(params={**truth.free, **e.conditions}, **mf.experiment.run_options())
+        assert tr.time[-1] <= res.t[-1] + 1e-12
+        errs.append(y - np.interp(tr.time, res.t, res["latch.s"]))
+        assert e.measures["trip_time"] / 1e-5 == pytest.approx(
+            round(e.measures["trip_time"] / 1e-5), abs=1e-6)
+    err = np.concatenate(errs)
+    floor = ds.instrument["latch.s"].floor()
+    assert abs(np.mean(err)) < 4 * floor / np.sqrt(err.size)
+    assert np.std(err) == pytest.approx(floor, rel=0.15)
+
+
+def test_free_parameters_jittered_within_bounds(tmp_path):
+    t = synthesize(LATCH, tmp_path, conditions=COND, measures=["trip_time"],
+                   noise={"trip_time": 1e-5}, free_jitter=0.3, seed=5)
+    mf, _ = compile_file(LATCH)
+    for name, (lo, hi) in mf.free.items():
+        assert lo <= t.free[name] <= hi
+    assert t.free["latch_damper.d"] != 4.0
+
+
+def test_effect_is_solved_for(tmp_path):
+    t = synthesize(LATCH, tmp_path, conditions=COND, hypothesis="quadratic_damping",
+                   location="latch", effect=(4.0, 4.0), traces=["latch.s"],
+                   sample_rate=20e3, noise={"latch.s": 5e-6}, seed=6, library=STUB)
+    assert t.location == "latch"
+    assert t.effect == pytest.approx(4.0, rel=0.03)
+    assert t.values["quadratic_damping__latch"] > 0
+
+
+def test_magnitude_range_and_seed(tmp_path):
+    kw = dict(conditions=COND, hypothesis="constant_load", location="plunger",
+              magnitude=(0.5, 2.0), sign=-1.0, measures=["trip_time"],
+              noise={"trip_time": 1e-5}, seed=7, library=STUB)
+    a = synthesize(LATCH, tmp_path / "a", **kw)
+    b = synthesize(LATCH, tmp_path / "b", **kw)
+    v = a.values["constant_load__plunger"]
+    assert -2.0 <= v <= -0.5
+    assert a.values == b.values
+    assert (tmp_path / "a" / "experiments.csv").read_text() == \
+        (tmp_path / "b" / "experiments.csv").read_text()
+
+
+def test_bad_requests(tmp_path):
+    with pytest.raises(ValueError, match="at least one measure or trace"):
+        synthesize(LATCH, tmp_path, conditions=COND)
+    with pytest.raises(ValueError, match="sample_rate"):
+        synthesize(LATCH, tmp_path, conditions=COND, traces=["latch.s"])
+    with pytest.raises(ValueError, match="no measure 'thrt'"):
+        synthesize(LATCH, tmp_path, conditions=COND, measures=["thrt"])
+    with pytest.raises(ValueError, match="values, magnitude or effect"):
+        synthesize(LATCH, tmp_path, conditions=COND, measures=["trip_time"],
+                   hypothesis="constant_load", location="latch", library=STUB)
