@@ -103,7 +103,7 @@ def _markdown(ctx, fp, floors, raw0, raw1, figs):
     L = []
     L.append(f"# Diagnosis of `{os.path.basename(ctx['model_path'])}` against "
              f"`{os.path.basename(ctx['data_folder'])}`\n")
-    L.append(f"Model file: `{ctx['model_path']}`  \nData: `{ctx['data_folder']}` "
+    L.append(f"Model file: `{_rel(ctx['model_path'])}`  \nData: `{_rel(ctx['data_folder'])}` "
              f"({len(ds.experiments)} experiments, {f0.n} measured values)  \n"
              f"Errors are RMS of (simulated - measured) / instrument floor: 1 is what the "
              f"instrument's noise and resolution alone explain.\n")
@@ -174,9 +174,9 @@ def _markdown(ctx, fp, floors, raw0, raw1, figs):
              f"2k(k+1)/(n-k-1), n = {f0.n}, c = {c_hat:.3g} (over-dispersion of the best "
              f"fit; 1 = it reaches the instrument floor). No extension: k = {f0.k}, "
              f"S = {_fmt(f0.cost)}, AICc = {_fmt(ctx['a0'])}. Held-out: "
-             f"leave-one-experiment-out RMS (linearised from the Jacobian for the "
-             f"ranking; exact refits for the gain below). LR p: likelihood ratio "
-             f"against no extension, unadjusted.\n")
+             f"leave-one-experiment-out RMS, by exact refits where marked (e), "
+             f"else linearised from the Jacobian at the full fit (l). LR p: "
+             f"likelihood ratio against no extension, unadjusted.\n")
     if rows:
         w = st.akaike_weights([r["aicc"] for r in rows])
         L.append("| rank | cause | location | k | S | AICc | dAICc | weight | LR p | "
@@ -189,7 +189,8 @@ def _markdown(ctx, fp, floors, raw0, raw1, figs):
             ps = ", ".join(f"{nm} = {_fmt(r['fit'].values[nm], 3)}" for nm in own)
             L.append(f"| {i + 1} | {r['cause']} | {r['location']} | {r['k']} | "
                      f"{_fmt(r['S'])} | {_fmt(r['aicc'])} | {_fmt(r['aicc'] - a_best, 3)} | "
-                     f"{wi:.2g} | {_fmt(r['lr_p'], 2)} | {_fmt(r['heldout_rmse'], 3)} | "
+                     f"{wi:.2g} | {_fmt(r['lr_p'], 2)} | {_fmt(r['heldout_rmse'], 3)} "
+                     f"({'e' if r.get('heldout_exact') else 'l'}) | "
                      f"{_fmt(r['train_rmse'], 3)} | {ps} |")
         L.append("")
     for r in ctx["failed"]:
@@ -251,6 +252,12 @@ def _markdown(ctx, fp, floors, raw0, raw1, figs):
              f"{t['n_sim']} simulations for the candidate fits. Hypothesis library: "
              f"`{lib.name}`.\n")
     return "\n".join(L) + "\n"
+
+
+def _rel(path):
+    """``path`` relative to the working directory when it lies below it."""
+    rel = os.path.relpath(path)
+    return path if rel.startswith("..") else rel
 
 
 def _rms(r):
@@ -330,12 +337,12 @@ def _evidence(ctx):
         L.append(f"- equivalent within {st.EQUIVALENCE:g} AICc units (one class; the data "
                  f"cannot tell them apart):")
         for r in others:
-            h = lib.HYPOTHESES[r["cause"]]
             L.append(f"  - {r['cause']} at `{r['location']}` (dAICc "
                      f"{r['aicc'] - after['aicc']:.2f}, held-out "
-                     f"{_fmt(r['heldout_rmse'], 3)}); to tell apart: "
-                     f"{h.distinguishing_experiment}")
-        L.append(f"  - {after['cause']}: to tell apart: {hyp.distinguishing_experiment}")
+                     f"{_fmt(r['heldout_rmse'], 3)})")
+        L.append("- the experiments that would tell them apart:")
+        for hid in dict.fromkeys([after["cause"]] + [r["cause"] for r in others]):
+            L.append(f"  - {hid}: {lib.HYPOTHESES[hid].distinguishing_experiment}")
     if ctx["weak"]:
         L.append("- **evidence is weak**:")
         L.extend(f"  - {w}" for w in ctx["weak"])

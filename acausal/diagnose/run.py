@@ -50,6 +50,9 @@ FIT_TOL = 1e-6   # ftol/xtol of the candidate fits (S to about 1e-6 relative)
 LOO_TOL = 1e-4   # of the warm-started leave-one-out refits (predictions only)
 BUDGET_FACTOR = 6.0   # a candidate fit may take this many times the nominal fit ...
 BUDGET_MIN_S = 30.0   # ... but at least this long [s]; then its best point is kept
+SMALL_N = 100         # at most this many values and ...
+SMALL_EXPERIMENTS = 12  # ... experiments: exact leave-one-out for the SMALL_TOP ...
+SMALL_TOP = 6         # ... best candidates (the linearised shortcut is poor on few data)
 
 
 class DiagnosisError(AcausalError):
@@ -271,6 +274,36 @@ def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
         decision = st.discrepancy_decision(chi2, runs, lr, alpha)
         discrepancy = decision["discrepancy"]
 
+        # -- exact leave-one-out: the nominal model and the best candidate (the
+        # SMALL_TOP best when the dataset is small: the linearised shortcut is then poor)
+        loo_exact = {}
+        small = n <= SMALL_N and len(ds.experiments) <= SMALL_EXPERIMENTS
+        if exact_cv and len(ds.experiments) > 1:
+            jobs = [(None, None, f0)]
+            if small:
+                jobs += [(r["cause"], r["location"], r["fit"]) for r in rows[:SMALL_TOP]]
+            elif discrepancy and rows:
+                jobs.append((rows[0]["cause"], rows[0]["location"], rows[0]["fit"]))
+            calls = []
+            for h, l, f in jobs:
+                lo = {nm: v[1] for nm, v in free.items()}
+                hi = {nm: v[2] for nm, v in free.items()}
+                sc = {nm: v[3] for nm, v in free.items()}
+                for sp_ in (spec_rows.get((h, l)) or []):
+                    lo[sp_[0]], hi[sp_[0]], sc[sp_[0]] = sp_[2], sp_[3], sp_[4]
+                for e in ds.experiments:
+                    calls.append((loo_task, (model_path, data_folder, lib_name, h, l,
+                                             f.names, f.values, lo, hi, sc, e.name,
+                                             max(5, max_nfev // 4), budget / 3)))
+            for r in _run_tasks(ex, calls, "leave-one-out", progress):
+                loo_exact.setdefault((r["hyp"], r["location"]), {})[r["held"]] = r["residuals"]
+        for r in rows:
+            got = loo_exact.get((r["cause"], r["location"]))
+            r["heldout_exact"] = got is not None
+            if got is not None:
+                r["heldout_rmse"] = heldout_rms(got)
+        held0 = heldout_rms(loo_exact.get((None, None)) or nominal["loo"])
+
         # -- ranking, classes, evidence ---------------------------------------------
         classes = st.equivalence_classes(rows) if rows else []
         best = rows[0] if rows else None
@@ -281,30 +314,10 @@ def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
             weak = st.weak_evidence(
                 n=n, k=best["k"], d_null=a0 - best["aicc"],
                 d_runner=None if runner is None else runner["aicc"] - best["aicc"],
-                heldout_nominal=heldout_rms(nominal["loo"]),
-                heldout_best=best["heldout_rmse"], ci_rel=_ci_rel(best, specs_by),
-                c_hat=c_hat, coarse=_coarse(ds, f0))
+                heldout_nominal=held0, heldout_best=best["heldout_rmse"],
+                ci_rel=_ci_rel(best, specs_by), c_hat=c_hat, coarse=_coarse(ds, f0))
         cause = best if (discrepancy and best is not None and not weak) else None
         after = cause or (best if discrepancy else None)
-
-        # -- exact leave-one-out for the nominal and the model after -------------------
-        loo_exact = {}
-        if exact_cv and len(ds.experiments) > 1:
-            jobs = [(None, None, f0)] + ([(after["cause"], after["location"], after["fit"])]
-                                         if after is not None else [])
-            calls = []
-            for h, l, f in jobs:
-                lo = {nm: v[1] for nm, v in free.items()}
-                hi = {nm: v[2] for nm, v in free.items()}
-                sc = {nm: v[3] for nm, v in free.items()}
-                for s in (spec_rows.get((h, l)) or []):
-                    lo[s[0]], hi[s[0]], sc[s[0]] = s[2], s[3], s[4]
-                for e in ds.experiments:
-                    calls.append((loo_task, (model_path, data_folder, lib_name, h, l,
-                                             f.names, f.values, lo, hi, sc, e.name,
-                                             max(5, max_nfev // 4), budget / 3)))
-            for r in _run_tasks(ex, calls, "leave-one-out", progress):
-                loo_exact.setdefault((r["hyp"], r["location"]), {})[r["held"]] = r["residuals"]
     t_cv = time.perf_counter() - t_start - t_fit
 
     def held(h, l, linear):
