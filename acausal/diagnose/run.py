@@ -183,8 +183,7 @@ def candidates(model_path, library=None, hypotheses=None, locations=None):
     ``locations``: a list of paths (exact, or a prefix followed by '.') to
     keep."""
     lib = load_library(library)
-    mf, _ = compile_file(model_path)
-    graph = lib.ModelGraph(mf.model)
+    graph = lib.graph_of(model_path)
     out = []
     for hid in _select(lib.HYPOTHESES, hypotheses, "hypothesis"):
         hyp = lib.HYPOTHESES[hid]
