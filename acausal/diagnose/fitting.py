@@ -73,7 +73,7 @@ class _OutOfTime(Exception):
 
 
 def fit(model, dataset, names, x0, low, high, scale, *, fixed=None, starts=None,
-        max_nfev=60, tol=1e-8, budget_s=None, absorb=None) -> Fit:
+        max_nfev=60, tol=1e-8, budget_s=None, absorb=None, max_evals=None) -> Fit:
     """Weighted output-error least squares over ``names``.
 
     ``x0``, ``low``, ``high``, ``scale``: per-name start, bounds and typical
@@ -84,6 +84,8 @@ def fit(model, dataset, names, x0, low, high, scale, *, fixed=None, starts=None,
     starts where it has no effect). ``budget_s``: wall-time budget; when it
     is spent the best point seen so far is kept (``message`` says so) and
     the Jacobian is taken there by one more finite-difference pass.
+    ``max_evals``: the same after this many evaluations of the residuals
+    (counting finite-difference ones; deterministic, unlike the budget).
     ``absorb``: (names, jacobian) of parameters calibrated beforehand (the
     nominal fit's free parameters and its Jacobian, rows as this dataset's
     residuals): each starting point is then scored after a linearised
@@ -107,9 +109,14 @@ def fit(model, dataset, names, x0, low, high, scale, *, fixed=None, starts=None,
     seen = {"cost": np.inf, "x": None}
     timed = [True]
 
+    n_eval = [0]
+
     def evaluate(x):
         if timed[0] and budget_s is not None and time.perf_counter() - t0 > budget_s:
-            raise _OutOfTime
+            raise _OutOfTime(f"stopped at the time budget ({budget_s:.0f} s)")
+        if timed[0] and max_evals is not None and n_eval[0] >= max_evals:
+            raise _OutOfTime(f"stopped after {max_evals} evaluations")
+        n_eval[0] += 1
         n_sim[0] += n_exp
         params = {**fixed, **dict(zip(names, x))}
         try:
@@ -171,10 +178,10 @@ def fit(model, dataset, names, x0, low, high, scale, *, fixed=None, starts=None,
             message = sol.message
             ok = sol.status >= 0     # 0: max_nfev reached (still usable)
             J = sol.jac / sc
-        except _OutOfTime:
+        except _OutOfTime as stop:
             timed[0] = False
             x = seen["x"] if seen["x"] is not None else best
-            message = f"stopped at the time budget ({budget_s:.0f} s); best point kept"
+            message = f"{stop}; best point kept"
             J = _jacobian(evaluate, x, sc, lo, hi)
     else:
         x = best

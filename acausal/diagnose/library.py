@@ -18,4 +18,16 @@ def load_library(name: str | None = None) -> SimpleNamespace:
         graph = importlib.import_module("acausal.diagnose.graph").ModelGraph
     return SimpleNamespace(name=name or DEFAULT, HYPOTHESES=mod.HYPOTHESES, ModelGraph=graph,
                            build_extended=mod.build_extended,
-                           write_extended_model=mod.write_extended_model)
+                           write_extended_model=mod.write_extended_model,
+                           graph_of=lambda path: _graph_of(graph, path))
+
+
+def _graph_of(graph_cls, path):
+    """The graph of a model file with its nominal run attached when the
+    library can (``ModelGraph.from_file``): the hypotheses take their typical
+    magnitudes (parameter scales and bounds) from that run."""
+    from_file = getattr(graph_cls, "from_file", None)
+    if from_file is not None:
+        return from_file(path)
+    from ..modelfile import compile_file
+    return graph_cls(compile_file(path)[0].model)

@@ -48,8 +48,9 @@ __all__ = ["diagnose", "DiagnosisError"]
 
 FIT_TOL = 1e-6   # ftol/xtol of the candidate fits (S to about 1e-6 relative)
 LOO_TOL = 1e-4   # of the warm-started leave-one-out refits (predictions only)
-BUDGET_FACTOR = 6.0   # a candidate fit may take this many times the nominal fit ...
-BUDGET_MIN_S = 30.0   # ... but at least this long [s]; then its best point is kept
+EVALS_PER_PARAM = 25  # a fit stops after 25 (k + 1) residual evaluations (best point kept)
+BUDGET_FACTOR = 12.0  # and, a last resort, when it takes this many times the nominal fit
+BUDGET_MIN_S = 60.0   # ... but at least this long [s] (machine-dependent: rarely reached)
 SMALL_N = 100         # at most this many values and ...
 SMALL_EXPERIMENTS = 12  # ... experiments: exact leave-one-out for the SMALL_TOP ...
 SMALL_TOP = 6         # ... best candidates (the linearised shortcut is poor on few data)
@@ -114,7 +115,8 @@ def fit_task(model_path, folder, library, hyp_id, location, spec_rows, free, max
         hi = {n: v[2] for n, v in free.items()} | {r[0]: r[3] for r in spec_rows}
         sc = {n: v[3] for n, v in free.items()} | {r[0]: r[4] for r in spec_rows}
         f = fit(pair, ds, names, x0, lo, hi, sc, starts=_starts(spec_rows),
-                max_nfev=max_nfev, tol=FIT_TOL, budget_s=budget_s, absorb=absorb)
+                max_nfev=max_nfev, tol=FIT_TOL, budget_s=budget_s, absorb=absorb,
+                max_evals=EVALS_PER_PARAM * (len(names) + 1))
         return dict(hyp=hyp_id, location=location, fit=f, loo=linear_loo(f) if f.ok else {},
                     error=None, wall_s=time.perf_counter() - t0)
     except Exception as exc:  # noqa: BLE001 - a candidate that cannot be built is reported
@@ -130,7 +132,7 @@ def loo_task(model_path, folder, library, hyp_id, location, names, start, low, h
     train = subset(ds, [e.name for e in ds.experiments if e.name != held])
     test = subset(ds, [held])
     f = fit(pair, train, names, start, low, high, scale, max_nfev=max_nfev, tol=LOO_TOL,
-            budget_s=budget_s)
+            budget_s=budget_s, max_evals=EVALS_PER_PARAM * (len(names) + 1) // 3)
     r = weighted_residuals(pair, test, f.values)[0]
     return dict(hyp=hyp_id, location=location, held=held, residuals=r, values=f.values,
                 n_sim=f.n_sim)
@@ -181,8 +183,7 @@ def candidates(model_path, library=None, hypotheses=None, locations=None):
     ``locations``: a list of paths (exact, or a prefix followed by '.') to
     keep."""
     lib = load_library(library)
-    mf, _ = compile_file(model_path)
-    graph = lib.ModelGraph(mf.model)
+    graph = lib.graph_of(model_path)
     out = []
     for hid in _select(lib.HYPOTHESES, hypotheses, "hypothesis"):
         hyp = lib.HYPOTHESES[hid]

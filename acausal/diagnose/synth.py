@@ -130,7 +130,7 @@ def synthesize(model_path, folder, *, conditions, hypothesis=None, location=None
     if hypothesis is not None:
         lib = load_library(library)
         hyp = lib.HYPOTHESES[hypothesis]
-        graph = lib.ModelGraph(mf.model)
+        graph = lib.graph_of(model_path)
         if location is None:
             location = hyp.candidates(graph)[0]
         specs = hyp.params(graph, location)
