@@ -118,32 +118,38 @@ def test_extended_model_runs_with_the_fitted_values(blind):
 
 BREAKER = os.path.abspath(os.path.join(HERE, "..", "..", "models", "breaker_24kv.py"))
 SETUPS = {
+    # hook angle (0.02 deg steps) and armature travel (10 um steps) at 50 kHz
     "breaker": dict(path=BREAKER, conditions={"v_impact": [3.3, 3.5, 3.8, 4.0, 4.2, 4.5]},
-                    traces=["hook.phi"], sample_rate=50e3, noise={"hook.phi": 3e-4},
-                    resolution={"hook.phi": 3.5e-4}, units={"time": "ms", "hook.phi": "deg"}),
+                    traces=["hook.phi", "armature.mass.s"], sample_rate=50e3,
+                    noise={"hook.phi": 3e-4, "armature.mass.s": 1e-5},
+                    resolution={"hook.phi": 3.5e-4, "armature.mass.s": 1e-5},
+                    units={"time": "ms", "hook.phi": "deg", "armature.mass.s": "mm"}),
     "latch": dict(path=LATCH, conditions={"F_coil": [20.0, 28.0, 36.0, 45.0]},
                   traces=["plunger.s", "latch.s"], sample_rate=20e3,
                   noise={"plunger.s": 5e-6, "latch.s": 5e-6},
                   resolution={"plunger.s": 5e-6, "latch.s": 5e-6},
                   units={"time": "ms", "plunger.s": "mm", "latch.s": "mm"}),
 }
+# (model, hypothesis, location, effect): the effect is the RMS change the hidden
+# extension makes to the data in noise-floor units; where the library's bound
+# on the parameter caps it (a stiffer wipe spring, a flexible contact arm) 5.
 SLOW_CASES = [
-    ("breaker", "coulomb_friction", "hook.body"),
-    ("breaker", "quadratic_damping", "hook.body"),
-    ("breaker", "constant_load", "main_shaft.body"),
-    ("breaker", "hardening_spring", "main_shaft.open_spring"),
-    ("breaker", "clearance", "contact"),
-    ("breaker", "flexible_link", "hook.body:cam"),
-    ("breaker", "position_dependent_force", "armature.coil"),
-    ("breaker", "contact_damping_law", "contact"),
-    ("latch", "coulomb_friction", "latch"),
-    ("latch", "quadratic_damping", "plunger"),
-    ("latch", "constant_load", "plunger"),
-    ("latch", "hardening_spring", "latch_spring"),
-    ("latch", "clearance", "contact"),
-    ("latch", "flexible_link", "latch:contact"),
-    ("latch", "position_dependent_force", "coil"),
-    ("latch", "contact_damping_law", "contact"),
+    ("breaker", "coulomb_friction", "hook.body", 8.0),
+    ("breaker", "quadratic_damping", "hook.body", 8.0),
+    ("breaker", "constant_load", "armature.mass", 8.0),
+    ("breaker", "hardening_spring", "main_shaft.wipe_spring", 5.0),
+    ("breaker", "clearance", "contact", 8.0),
+    ("breaker", "flexible_link", "hook.body:hook.arm3", 5.0),
+    ("breaker", "position_dependent_force", "armature.coil", 8.0),
+    ("breaker", "contact_damping_law", "contact", 8.0),
+    ("latch", "coulomb_friction", "latch", 8.0),
+    ("latch", "quadratic_damping", "plunger", 8.0),
+    ("latch", "constant_load", "plunger", 8.0),
+    ("latch", "hardening_spring", "latch_spring", 8.0),
+    ("latch", "clearance", "contact", 8.0),
+    ("latch", "flexible_link", "latch:contact", 8.0),
+    ("latch", "position_dependent_force", "coil", 8.0),
+    ("latch", "contact_damping_law", "contact", 8.0),
 ]
 
 
@@ -160,17 +166,22 @@ def blind_case(tmp, model, hyp, loc, effect=8.0, seed=0, **kw):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("model,hyp,loc", SLOW_CASES,
-                         ids=[f"{m}-{h}" for m, h, _ in SLOW_CASES])
-def test_blind_every_hypothesis(tmp_path, model, hyp, loc):
-    truth, out, details = blind_case(tmp_path, model, hyp, loc,
-                                     seed=100 + SLOW_CASES.index((model, hyp, loc)))
+@pytest.mark.parametrize("model,hyp,loc,effect", SLOW_CASES,
+                         ids=[f"{m}-{h}" for m, h, _, _ in SLOW_CASES])
+def test_blind_every_hypothesis(tmp_path, model, hyp, loc, effect):
+    truth, out, details = blind_case(tmp_path, model, hyp, loc, effect=effect,
+                                     seed=100 + SLOW_CASES.index((model, hyp, loc, effect)))
+    first = next(iter(truth.values))
+    row = next(c for c in details["candidates"] if (c["cause"], c["location"]) == (hyp, loc))
+    print(f"BLIND {model} {hyp} at {loc}: effect {truth.effect:.2f}; named "
+          f"{out['cause']} at {out['location']}, class {out['equivalent_causes']}; "
+          f"{first} truth {truth.values[first]:.4g} fitted {row['values'][first]:.4g} "
+          f"ci {row['ci95'][first]}; held-out {out['gain']['before']['heldout']:.3f} -> "
+          f"{out['gain']['after']['heldout']:.3f}; {details['timing']['total_s']:.0f} s")
     assert out["discrepancy"] is True
     members = [(out["cause"], out["location"])] + [(e["cause"], e["location"])
                                                   for e in out["equivalent_causes"]]
     assert (hyp, loc) in members, (members, out["ranking"][:3])
-    row = next(c for c in details["candidates"] if (c["cause"], c["location"]) == (hyp, loc))
-    first = next(iter(truth.values))
     assert row["values"][first] == pytest.approx(truth.values[first], rel=0.25)
     assert out["gain"]["after"]["heldout"] <= 2.0
 
@@ -185,5 +196,9 @@ def test_false_positive_rate_on_null_datasets(tmp_path):
         _, out, _ = blind_case(d, "latch", None, None, seed=500 + seed, exact_cv=False,
                                plots=False)
         hits.append(out["discrepancy"])
+        print(f"NULL seed {500 + seed}: discrepancy {out['discrepancy']}, "
+              + ", ".join(f"{p['name']} p {p['p_value']:.3g}"
+                          for p in json.loads((d / "out" / "candidates.json").read_text())
+                          ["decision"]["parts"]))
         assert out["cause"] is None or out["discrepancy"]
     assert sum(hits) / len(hits) < 0.10, hits
