@@ -57,6 +57,42 @@ def subset(dataset, names):
     return dataclasses.replace(dataset, experiments=[dataset.experiment(n) for n in names])
 
 
+def split(dataset, experiments=None):
+    """(fitted, held back) datasets.
+
+    ``experiments``: None for the rows the data marks ``use = calibrate``
+    (every row when there is no ``use`` column), ``"all"`` for every row, or a
+    list of names.  The held-back dataset has the other rows (it may be
+    empty): :func:`validate` predicts them with the calibrated values."""
+    import dataclasses
+    if experiments == "all":
+        fit = [e.name for e in dataset.experiments]
+    elif experiments is None:
+        fit = [e.name for e in dataset.experiments if e.use == "calibrate"]
+        if not fit:
+            raise CalibrationError(f"{dataset.folder}: every experiment is marked "
+                                   "'validate'; nothing to calibrate to")
+    else:
+        fit = list(experiments)
+    held = [e for e in dataset.experiments if e.name not in fit]
+    return subset(dataset, fit), dataclasses.replace(dataset, experiments=held)
+
+
+def validate(path, dataset, values):
+    """Residuals (simulated - measured) of the measures of every experiment of
+    ``dataset`` predicted with ``values``: experiment -> {measure: residual}.
+    A prediction that fails records its error message instead."""
+    out = {}
+    for exp in dataset.experiments:
+        try:
+            _, meas = simulate_experiment(path, values, exp.conditions)
+        except AcausalError as exc:
+            out[exp.name] = {"error": str(exc)}
+            continue
+        out[exp.name] = {m: meas[m] - y for m, y in exp.measures.items()}
+    return out
+
+
 def simulate_experiment(path, params, conditions, options=None):
     """(result, measures) for one experiment with fitted ``params``;
     ``options``: further keyword arguments of ``simulate`` (``max_steps``)."""
@@ -79,12 +115,14 @@ class Calibration:
     cost: float = None
     dof: int = None
     n_sim: int = 0
+    validation: dict = field(default_factory=dict)  # held-back experiment -> residuals
 
     def to_dict(self):
         return dict(method=self.method, values=self.values,
                     ci95={k: list(v) for k, v in self.ci95.items()},
                     correlation=None if self.correlation is None else self.correlation.tolist(),
-                    residuals=self.residuals, cost=self.cost, dof=self.dof, n_sim=self.n_sim)
+                    residuals=self.residuals, cost=self.cost, dof=self.dof, n_sim=self.n_sim,
+                    validation=self.validation)
 
 
 def report_method(path, dataset, pairs, experiment=None, brackets=None, base=None,

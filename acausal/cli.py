@@ -132,8 +132,10 @@ def variables(file):
               help="parameters to fit; with --method report give PARAM:MEASURE pairs "
                    "in the order the report calibrates them (contact.K:contact_period,hook.bh:thrt)")
 @click.option("--method", type=click.Choice(["lsq", "report"]), default="lsq", show_default=True)
-@click.option("--experiments", metavar="E1,E2,...",
-              help="fit only these experiments (e.g. V110, as the report does)")
+@click.option("--experiments", metavar="E1,E2,...|all",
+              help="fit these experiments, or 'all' (default: the rows the data marks "
+                   "use=calibrate, every row without a use column); the others are "
+                   "predicted and compared")
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object")
 def calibrate(file, data, fit, method, experiments, as_json):
     """Fit parameters of a model file to a measured dataset."""
@@ -142,8 +144,11 @@ def calibrate(file, data, fit, method, experiments, as_json):
     try:
         mf, cm = compile_file(file)
         ds = cal.model_dataset(file, data)
+        chosen = None
         if experiments:
-            ds = cal.subset(ds, [x.strip() for x in experiments.split(",") if x.strip()])
+            chosen = "all" if experiments.strip() == "all" else [
+                x.strip() for x in experiments.split(",") if x.strip()]
+        ds, held = cal.split(ds, chosen)
         items = [x.strip() for x in fit.split(",") if x.strip()]
         if method == "report":
             pairs = []
@@ -158,12 +163,14 @@ def calibrate(file, data, fit, method, experiments, as_json):
             names = [it.split(":", 1)[0] for it in items]
             cal.check_names(cm, names)
             out = cal.least_squares(file, ds, names)
+        out.validation = cal.validate(file, held, out.values)
     except (AcausalError, click.BadParameter) as exc:
         _fail(exc)
     if as_json:
         click.echo(json.dumps(out.to_dict(), indent=1, default=float))
         return
-    click.echo(f"calibration ({out.method}) of {file} against {data}: {out.n_sim} simulations")
+    click.echo(f"calibration ({out.method}) of {file} against {data} "
+               f"({', '.join(e.name for e in ds.experiments)}): {out.n_sim} simulations")
     for name, v in out.values.items():
         ci = out.ci95.get(name)
         ci_s = f"  95% CI [{ci[0]:.6g}, {ci[1]:.6g}]" if ci else ""
@@ -175,6 +182,11 @@ def calibrate(file, data, fit, method, experiments, as_json):
     click.echo("  residuals (simulated - measured):")
     for exp, sig in out.residuals.items():
         click.echo(f"    {exp}: " + ", ".join(f"{k} {v:+.4g}" for k, v in sig.items()))
+    if out.validation:
+        click.echo("  held back, predicted with these values (simulated - measured):")
+        for exp, sig in out.validation.items():
+            click.echo(f"    {exp}: " + ", ".join(
+                f"{k} {v}" if k == "error" else f"{k} {v:+.4g}" for k, v in sig.items()))
 
 
 @main.command()

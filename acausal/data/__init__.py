@@ -18,6 +18,11 @@ Literal ``nan``/``inf`` cells are errors.  Every problem raises
     columns only.  Roles come from the ``parameters``/``measures`` mappings of
     :func:`load_dataset`; a column in neither is a measure when ``measures``
     is not given, a condition when only ``measures`` is given, else an error.
+    An optional column ``use`` says what ``acausal calibrate`` does with the
+    row: ``calibrate`` (fit it; the default, also for an empty cell) or
+    ``validate`` (hold it back and report the calibrated model's prediction
+    error on it), as a report fits at the rated condition and checks the
+    others.  The diagnosis uses every row (it cross-validates itself).
 ``instrument.csv`` (optional)
     Columns ``signal`` (a measure or a trace variable), ``resolution`` and
     ``noise_std`` (empty cell = 0), and either units in the two value headers

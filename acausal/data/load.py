@@ -16,6 +16,8 @@ EXPERIMENTS = "experiments.csv"
 INSTRUMENT = "instrument.csv"
 _RESERVED = {"experiments", "instrument"}
 _FIELDS = ("resolution", "noise_std")
+USE_COLUMN = "use"
+USES = ("calibrate", "validate")
 Units = Union[Mapping[str, Optional[str]], Iterable[str]]
 
 
@@ -53,13 +55,33 @@ def _experiment_names(table: Table) -> list[str]:
     return list(first)
 
 
+def _experiment_uses(table: Table) -> list[str]:
+    """The optional ``use`` column: 'calibrate' (default, also an empty cell)
+    or 'validate' for every row."""
+    k = table.column(USE_COLUMN, False)
+    if k is None:
+        return ["calibrate"] * len(table.rows)
+    if table.units[k] is not None:
+        raise DataError("the use column takes no unit", table.file, table.header_line,
+                        USE_COLUMN)
+    uses = []
+    for line, cells in table.rows:
+        use = cells[k] or "calibrate"
+        if use not in USES:
+            raise DataError(f"use {cells[k]!r}: expected 'calibrate' or 'validate'",
+                            table.file, line, USE_COLUMN)
+        uses.append(use)
+    return uses
+
+
 def _read_experiments(folder: Path, parameters, measures) -> list[Experiment]:
     """Experiments of ``experiments.csv``, values in SI, no traces yet."""
     table = read_table(folder / EXPERIMENTS)
     names = _experiment_names(table)
+    uses = _experiment_uses(table)
     columns = []  # (name, role, converter, index); headers checked first
     for k, name in enumerate(table.names):
-        if name != "name":
+        if name not in ("name", USE_COLUMN):
             where = (table.file, table.header_line, name)
             role = _role(name, parameters, measures, where)
             expected = (measures if role == "measure" else parameters) or {}
@@ -69,7 +91,7 @@ def _read_experiments(folder: Path, parameters, measures) -> list[Experiment]:
     values = {name: convert(table.numbers(k, role == "condition"))
               for name, role, convert, k in columns}
     return [Experiment(names[i], _row(columns, values, i, "condition"),
-                       _row(columns, values, i, "measure"), None, line)
+                       _row(columns, values, i, "measure"), None, line, uses[i])
             for i, (line, _) in enumerate(table.rows)]
 
 

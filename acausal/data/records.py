@@ -57,13 +57,17 @@ class Trace:
 
 @dataclass
 class Experiment:
-    """One experiment: SI ``conditions`` and measured-only SI ``measures``."""
+    """One experiment: SI ``conditions`` and measured-only SI ``measures``.
+
+    ``use`` is 'calibrate' (fitted by ``acausal calibrate``) or 'validate'
+    (held back: predicted with the calibrated values and compared)."""
 
     name: str
     conditions: dict[str, float]
     measures: dict[str, float] = field(default_factory=dict)
     trace: Optional[Trace] = None
     line: Optional[int] = None
+    use: str = "calibrate"
 
 
 @dataclass

@@ -53,7 +53,11 @@ def write_dataset(folder, dataset: Dataset, units: Optional[Mapping[str, str]] =
         values = [{**e.measures, **e.conditions}.get(n, math.nan)
                   for e in dataset.experiments]
         columns.append(_cells(values, units.get(n)))
-    _write_csv(folder / EXPERIMENTS, ["name"] + [_head(n, units) for n in names], columns)
+    header = ["name"] + [_head(n, units) for n in names]
+    if any(e.use != "calibrate" for e in dataset.experiments):
+        header.append("use")
+        columns.append([e.use for e in dataset.experiments])
+    _write_csv(folder / EXPERIMENTS, header, columns)
     if dataset.instrument:
         rows = list(dataset.instrument.values())
         unit = [units.get(i.signal) for i in rows]

@@ -164,6 +164,10 @@ CASES = {
     "instrument column": (dict(experiments=EXP + "a,1,2\n",
                                instrument="signal,precision\nthrt,1\n"), "instrument",
                           1, "precision", "unknown column"),
+    "bad use": (dict(experiments="name,v,thrt,use\na,1,2,\nb,1,2,check\n"), "experiments",
+                3, "use", "use 'check': expected 'calibrate' or 'validate'"),
+    "use with unit": (dict(experiments="name,v,thrt,use [s]\na,1,2,\n"), "experiments",
+                      1, "use", "the use column takes no unit"),
     "negative resolution": (dict(experiments=EXP + "a,1,2\n",
                                  instrument="signal,resolution\nthrt,-1\n"),
                             "instrument", 2, "resolution", "negative resolution"),
@@ -206,7 +210,8 @@ def _dataset() -> Dataset:
     experiments = [
         Experiment("V110", {"v_impact": 3.8, "contact.K": 6.25e8},
                    {"thrt": 1.9e-3, "contact_period": 3e-4}, trace),
-        Experiment("V120", {"v_impact": 4.0, "contact.K": 6.25e8}, {"thrt": 1.7e-3}),
+        Experiment("V120", {"v_impact": 4.0, "contact.K": 6.25e8}, {"thrt": 1.7e-3},
+                   use="validate"),
     ]
     instrument = {"thrt": Instrument("thrt", 1e-4),
                   "hook.phi": Instrument("hook.phi", math.radians(0.1), 1e-3)}
@@ -225,8 +230,8 @@ def test_round_trip(tmp_path, units):
     assert loaded.condition_names == original.condition_names
     assert loaded.measure_names == original.measure_names
     for a, b in zip(original.experiments, loaded.experiments):
-        assert (a.name, a.conditions, a.measures) == (
-            b.name, pytest.approx(b.conditions, rel=1e-14),
+        assert (a.name, a.use, a.conditions, a.measures) == (
+            b.name, b.use, pytest.approx(b.conditions, rel=1e-14),
             pytest.approx(b.measures, rel=1e-14))
         assert (a.trace is None) == (b.trace is None)
     a, b = original.experiments[0].trace, loaded.experiments[0].trace

@@ -45,6 +45,28 @@ def test_least_squares_cli_at_110V_prints_intervals():
     assert lo < bh < hi and hi - lo < 0.05
 
 
+def test_calibrate_command_fits_110V_and_predicts_the_other_voltages():
+    """The acceptance command: the data marks 110 V 'calibrate' and the other
+    voltages 'validate', as the report calibrates and checks (Table 2)."""
+    r = CliRunner().invoke(main, ["calibrate", MODEL, DATA, "--fit", "contact.K,hook.bh"])
+    assert r.exit_code == 0, r.output
+    assert "(V110)" in r.output and "95% CI" in r.output
+    r = CliRunner().invoke(main, ["calibrate", MODEL, DATA, "--fit", "contact.K,hook.bh",
+                                  "--json"])
+    out = json.loads(r.output)
+    assert abs(out["values"]["contact.K"] / 6.25e8 - 1) < 0.10
+    assert abs(out["values"]["hook.bh"] - 0.219) < 0.005
+    assert list(out["residuals"]) == ["V110"]
+    # measured THRT of Table 2 predicted within 1.5 reading steps (0.1 ms)
+    assert sorted(out["validation"]) == ["V090", "V100", "V120", "V130", "V140"]
+    for exp, sig in out["validation"].items():
+        assert abs(sig["thrt"]) < 1.5e-4, (exp, sig)
+    r = CliRunner().invoke(main, ["calibrate", MODEL, DATA, "--fit", "contact.K,hook.bh",
+                                  "--experiments", "all", "--json"])
+    out = json.loads(r.output)
+    assert len(out["residuals"]) == 6 and out["validation"] == {}
+
+
 def test_least_squares_over_all_voltages_is_consistent_with_the_instrument():
     ds = cal.model_dataset(MODEL, DATA)
     out = cal.least_squares(MODEL, ds, ["contact.K", "hook.bh"])
