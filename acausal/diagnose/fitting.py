@@ -195,7 +195,7 @@ def fit(model, dataset, names, x0, low, high, scale, *, fixed=None, starts=None,
     values = dict(zip(names, x.tolist()))
     out = Fit(names, values, float(r @ r), r, J, groups, signals, n_sim=n_sim[0],
               wall_s=time.perf_counter() - t0, ok=bool(ok), message=str(message))
-    out.ci95 = confidence(out)
+    out.ci95 = confidence(out, positive=[n for n, l in zip(names, lo) if l > 0])
     return out
 
 
@@ -212,10 +212,13 @@ def _jacobian(fun, x, sc, lo, hi, rel=1e-5):
     return J
 
 
-def confidence(f: Fit, level=0.95) -> dict:
+def confidence(f: Fit, level=0.95, positive=()) -> dict:
     """Intervals from the Jacobian at the optimum (Student t), the covariance
     scaled by max(1, S/(n-k)): never narrower than the instrument model says,
-    wider when the fit leaves misfit beyond the noise."""
+    wider when the fit leaves misfit beyond the noise. A parameter in
+    ``positive`` (its lower bound is above zero: a stiffness, a mass) gets its
+    interval on the logarithm, as :func:`acausal.calibrate.least_squares`
+    does: asymmetric, never crossing zero."""
     n, k = f.n, f.k
     if k == 0:
         return {}
@@ -241,8 +244,17 @@ def confidence(f: Fit, level=0.95) -> dict:
     s2 = f.cost / dof if dof > 0 else 1.0
     sd = np.sqrt(np.clip(np.diag(cov), 0, None) * max(s2, 1.0)) * sc
     q = stats.t.ppf(0.5 + level / 2, dof) if dof > 0 else stats.norm.ppf(0.5 + level / 2)
-    return {name: (float(f.values[name] - q * s), float(f.values[name] + q * s))
-            for name, s in zip(f.names, sd)}
+    out = {}
+    for name, s, scale in zip(f.names, sd, sc):
+        v = f.values[name]
+        if name in positive and v > 0:
+            # the columns of Js are derivatives per relative change, i.e. per
+            # unit of log(value): s / scale is the standard deviation of log(value)
+            w = q * s / scale
+            out[name] = (float(v * np.exp(-w)), float(v * np.exp(w)))
+        else:
+            out[name] = (float(v - q * s), float(v + q * s))
+    return out
 
 
 def linear_loo(f: Fit) -> dict:

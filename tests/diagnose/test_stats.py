@@ -158,3 +158,18 @@ def test_confidence_unidentifiable_parameter_gets_no_interval():
     ci = confidence(f)
     assert ci["b1"] == (-math.inf, math.inf)
     assert math.isfinite(ci["b0"][0]) and math.isfinite(ci["b2"][1])
+
+
+def test_confidence_of_a_positive_parameter_is_on_its_logarithm():
+    """A positive parameter's interval is exp(log b +- q sd(log b)), with
+    sd(log b) = sd(b) / b to first order: asymmetric, above zero."""
+    rng = np.random.default_rng(4)
+    X = np.c_[np.ones(30), np.linspace(0, 1, 30)]
+    y = X @ [2.0, 1.0] + 0.6 * rng.normal(size=30)      # b1 loosely determined
+    f, beta = _linear_fit(X, y, ["g"] * 30)
+    ci = confidence(f, positive=["b1"])
+    sd = np.sqrt(np.diag(np.linalg.inv(X.T @ X)) * max(1.0, f.cost / 28))
+    w = sps.t.ppf(0.975, 28) * sd[1] / beta[1]
+    assert ci["b1"] == pytest.approx((beta[1] * np.exp(-w), beta[1] * np.exp(w)), rel=1e-9)
+    assert ci["b1"][0] > 0 and beta[1] - ci["b1"][0] < ci["b1"][1] - beta[1]
+    assert ci["b0"][0] == pytest.approx(beta[0] - sps.t.ppf(0.975, 28) * sd[0], rel=1e-9)
