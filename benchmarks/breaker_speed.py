@@ -14,19 +14,12 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 sys.path.insert(0, os.path.join(ROOT, "benchmarks", "handwritten"))
+sys.path.insert(0, os.path.join(ROOT, "benchmarks"))
 
 import breaker_sundae as ref  # noqa: E402
+from timing import best_interleaved  # noqa: E402
 
 from acausal.modelfile import compile_file, evaluate_measures  # noqa: E402
-
-
-def best(fn, repeat):
-    out = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        out.append(time.perf_counter() - t0)
-    return min(out)
 
 
 def main(argv=None):
@@ -53,7 +46,7 @@ def main(argv=None):
     r = gen()
     m = evaluate_measures(mf, r)
     h = hand()
-    tg, th = best(gen, args.repeat), best(hand, args.repeat)
+    tg, th = best_interleaved([gen, hand], args.repeat)
     print(f"compile (once): {compile_s:.2f} s; states/unknowns: {cm.dae.n_states}/"
           f"{len(cm.dae.y)}")
     print(f"{'':12s} {'wall [ms]':>10s} {'nfev':>6s} {'thrt [ms]':>10s}")

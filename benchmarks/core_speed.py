@@ -6,7 +6,6 @@ shared and noisy). Target: ratio <= 1.5.
 """
 import argparse
 import os
-import statistics
 import sys
 import time
 
@@ -15,17 +14,10 @@ import sksundae as sun
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
+sys.path.insert(0, os.path.join(ROOT, "benchmarks"))
 
 from acausal.modelfile import compile_file  # noqa: E402
-
-
-def best_of(fn, repeat):
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times), statistics.median(times)
+from timing import best_interleaved  # noqa: E402
 
 
 # -- oscillator ------------------------------------------------------------------
@@ -117,8 +109,7 @@ def main(argv=None):
     print(f"{'model':16s} {'generated [ms]':>15s} {'hand [ms]':>10s} {'ratio':>6s} "
           f"{'nfev gen/hand':>14s}")
     for name, gen, hand, nf_g, nf_h in rows:
-        tg, _ = best_of(gen, args.repeat)
-        th, _ = best_of(hand, args.repeat)
+        tg, th = best_interleaved([gen, hand], args.repeat)
         print(f"{name:16s} {tg * 1e3:15.2f} {th * 1e3:10.2f} {tg / th:6.2f} "
               f"{nf_g:>7d}/{nf_h:<6d}")
 
