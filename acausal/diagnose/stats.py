@@ -58,7 +58,8 @@ import numpy as np
 from scipy import stats
 
 ALPHA = 0.01          # family significance level of the discrepancy decision
-EQUIVALENCE = 2.0     # candidates within this many AICc units of the best: one class
+EQUIVALENCE = 4.0     # candidates within this many AICc units of the best: one class
+EQUIVALENCE_HELDOUT = 7.0  # ... or within this many with a held-out error no worse
 STRONG = 10.0         # dAICc vs no extension below which the evidence is weak
 RUNNER_UP = 4.0       # dAICc vs the best outside the class below which it is weak
 MIN_PER_PARAM = 3     # fewer data per fitted parameter: too few data
@@ -159,10 +160,12 @@ def discrepancy_decision(chi2: dict, runs: list, lr: dict | None, alpha: float =
 def equivalence_classes(rows: list, threshold: float = EQUIVALENCE) -> list:
     """Group ranked rows (dicts with ``aicc``, ``heldout_rmse``, sorted by
     aicc) into classes: a row joins the class of the best remaining row when
-    its AICc is within ``threshold`` of it, or within 2.5 * threshold with a
-    held-out error no worse (the two criteria disagree: the data do not
-    decide). Returns lists of row indices, the first class containing the
-    best row."""
+    its AICc is within ``threshold`` of it (Burnham and Anderson: below 4
+    units both models keep substantial support), or within
+    ``EQUIVALENCE_HELDOUT`` (the end of their "considerably less support"
+    range) with a held-out error no worse (the two criteria disagree: the
+    data do not decide). Returns lists of row indices, the first class
+    containing the best row."""
     left = list(range(len(rows)))
     classes = []
     while left:
@@ -170,7 +173,7 @@ def equivalence_classes(rows: list, threshold: float = EQUIVALENCE) -> list:
         a0, h0 = rows[head]["aicc"], rows[head]["heldout_rmse"]
         cls = [i for i in left
                if rows[i]["aicc"] - a0 <= threshold
-               or (rows[i]["aicc"] - a0 <= 2.5 * threshold
+               or (rows[i]["aicc"] - a0 <= threshold + EQUIVALENCE_HELDOUT - EQUIVALENCE
                    and rows[i]["heldout_rmse"] <= h0 * (1 + 1e-9))]
         classes.append(cls)
         left = [i for i in left if i not in cls]

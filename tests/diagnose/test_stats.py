@@ -91,8 +91,8 @@ def test_family_false_positive_rate_linear_null():
 
 def test_equivalence_classes():
     rows = [dict(aicc=a, heldout_rmse=h) for a, h in
-            [(0.0, 1.0), (1.5, 1.2), (4.0, 0.9), (6.0, 2.0), (30.0, 1.0)]]
-    # 1.5 within 2; 4.0 within 5 with a better held-out error; 6.0 neither
+            [(0.0, 1.0), (3.5, 1.2), (6.5, 0.9), (7.5, 0.8), (30.0, 1.0)]]
+    # 3.5 within 4; 6.5 within 7 with a better held-out error; 7.5 neither
     assert st.equivalence_classes(rows) == [[0, 1, 2], [3], [4]]
 
 
