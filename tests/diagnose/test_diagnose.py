@@ -145,7 +145,10 @@ SLOW_CASES = [
     ("latch", "coulomb_friction", "latch", 8.0),
     ("latch", "quadratic_damping", "plunger", 8.0),
     ("latch", "constant_load", "plunger", 8.0),
-    ("latch", "hardening_spring", "latch_spring", 8.0),
+    # the return spring: within the library's bound (cubic force at most the
+    # linear force at the typical deflection) the latch spring's cubic term
+    # changes the data by only 0.9 floor units, too little for a blind case
+    ("latch", "hardening_spring", "ret", 8.0),
     ("latch", "clearance", "contact", 8.0),
     ("latch", "flexible_link", "latch:contact", 8.0),
     ("latch", "position_dependent_force", "coil", 8.0),
@@ -178,6 +181,7 @@ def test_blind_every_hypothesis(tmp_path, model, hyp, loc, effect):
           f"{first} truth {truth.values[first]:.4g} fitted {row['values'][first]:.4g} "
           f"ci {row['ci95'][first]}; held-out {out['gain']['before']['heldout']:.3f} -> "
           f"{out['gain']['after']['heldout']:.3f}; {details['timing']['total_s']:.0f} s")
+    assert truth.effect > 4.0            # the hidden effect matters against the noise
     assert out["discrepancy"] is True
     members = [(out["cause"], out["location"])] + [(e["cause"], e["location"])
                                                   for e in out["equivalent_causes"]]
