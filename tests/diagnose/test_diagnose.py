@@ -246,3 +246,27 @@ def test_report_data_diagnosis_restricted(tmp_path):
 def test_report_data_diagnosis_full_library(tmp_path):
     out = _report_diagnosis(tmp_path)
     assert len(out["ranking"]) == 20
+
+
+def test_candidate_fits_on_a_dask_cluster_match_local_processes(tmp_path):
+    """``--scheduler ADDRESS``: the same fits through Dask give the same
+    diagnosis as the local process pool (the fits are deterministic)."""
+    distributed = pytest.importorskip("distributed")
+    _latch_data(tmp_path / "data", 14, hypothesis="constant_load", location="plunger",
+                effect=(6.0, 6.0))
+    kw = dict(progress=False, hypotheses=["constant_load", "quadratic_damping"],
+              locations=["plunger"], plots=False)
+    local = diagnose(LATCH, tmp_path / "data", out_dir=tmp_path / "local", workers=2, **kw)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster:
+        r = CliRunner().invoke(main, ["diagnose", LATCH, str(tmp_path / "data"), "--json",
+                                      str(tmp_path / "dask.json"), "--report",
+                                      str(tmp_path / "dask"), "--scheduler",
+                                      cluster.scheduler_address, "--no-progress",
+                                      "--hypotheses", "constant_load,quadratic_damping",
+                                      "--locations", "plunger"])
+    assert r.exit_code == 0, r.output
+    remote = json.loads((tmp_path / "dask.json").read_text())
+    assert remote["cause"] == local["cause"] == "constant_load"
+    assert remote["ranking"] == local["ranking"]
+    assert remote["parameters"] == local["parameters"]
