@@ -383,6 +383,14 @@ def _failure(run, cm, sol, cb):
     nonfinite = [nm for nm, v in zip(cm.var_names, _safe_obs(cb, t, r)) if not np.isfinite(v)]
     where = f" in {comp}" if comp else ""
     extra = f"; non-finite values: {', '.join(nonfinite[:5])}" if nonfinite else ""
+    atol = np.broadcast_to(np.asarray(run.opts["atol"], float), (n,))
+    if (getattr(sol, "status", None) == -3 and not nonfinite and n > cm.dae.n_states
+            and not np.any(atol[cm.dae.n_states:] > atol[:cm.dae.n_states].max())):
+        extra += (f"; the step size collapsed in the error test, which also covers the "
+                  f"{n - cm.dae.n_states} algebraic unknowns (forces, torques): if one of "
+                  "them is a small difference of large terms, give them their own absolute "
+                  "tolerance (Experiment(atol_algebraic=...) or simulate(atol_algebraic=...), "
+                  "in their SI units)")
     return SolverError(f"IDA failed at t = {t:.9g} s{where}: {r.message}{extra}", t=t,
                        component=comp, result=run.result("failed", r.message))
 

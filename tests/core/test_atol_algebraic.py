@@ -50,3 +50,24 @@ def test_loose_algebraic_tolerance_keeps_the_solution_accurate():
     E = 0.5 * 0.00044 * res["hook.w"]**2 + 0.5 * 0.02 * res["shaft.w"]**2 \
         + 0.5 * c * (res["shaft.phi"] + 0.035)**2
     assert np.max(np.abs(E / E[0] - 1)) < 1e-8
+
+
+def test_error_test_failure_suggests_the_algebraic_tolerance():
+    """IDA's 'error test failed' (status -3) with the algebraic unknowns held
+    to the states' atol: the message says what to try, with the option's
+    name; with atol_algebraic given it does not repeat the advice."""
+    from acausal.simulate import _Run, _failure
+    _, cm = compile_file(EXAMPLE)
+    p = cm.param_vector({})
+    d = cm.discrete_start()
+    cb = cm.callbacks(p, d)
+    n = len(cm.dae.y)
+    sol = type("Sol", (), dict(t=np.array([0.0, 1e-3]), y=np.zeros((2, n)),
+                               yp=np.zeros((2, n)), status=-3,
+                               message="Error tests failed too many times, or reached "
+                                       "min step size."))
+    for atol, advised in [(1e-10, True), (_atol_vector(cm, 1e-10, 1e-2), False)]:
+        run = _Run(cm, p, 0.0, 1.0, 1e-8, atol, None, 1000)
+        err = _failure(run, cm, sol, cb)
+        assert "IDA failed at t = 0.001 s" in str(err)
+        assert ("atol_algebraic" in str(err)) is advised
