@@ -77,7 +77,7 @@ def run_case(model, hyp, effect, seed, library, quick):
     right = hyp is not None and (hyp, loc) in members
     return dict(hyp=hyp, effect=effect, seed=seed, location=loc,
                 achieved=truth.effect, discrepancy=out["discrepancy"],
-                named=out["cause"] == hyp and out["location"] == loc,
+                named=hyp is not None and out["cause"] == hyp and out["location"] == loc,
                 right=bool(right and out["discrepancy"]),
                 weak=out["discrepancy"] and out["cause"] is None,
                 cause=out["cause"], wall_s=time.perf_counter() - t0)
