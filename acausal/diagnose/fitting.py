@@ -16,20 +16,19 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import optimize, stats
 
-from ..calibrate import resolve, residual_vector
+from ..calibrate import FD_STEP, ForwardDifferences, resolve, residual_vector
 from ..data import Dataset
 from ..errors import AcausalError
 
 PENALTY = 1e3   # weighted residual given to every sample of a failed simulation
 MAX_STEPS = 5000  # solver steps between two outputs beyond which a run counts as failed
-# Finite-difference step, relative to each parameter's scale. The residuals of
-# an adaptive, event-located simulation are not smooth below about 1e-6
-# relative (the step sequence changes discretely with the parameters): on the
-# breaker, dS/d(bh) from forward differences changes sign between steps 1e-6
-# and 1e-5 and settles only from 1e-4 (within 2 % from 1e-4 to 1e-2). With a
-# step of 1e-5 the trust region collapsed on that noise and a quadratic-drag
-# fit stopped at a tenth of its true value.
-FD_STEP = 1e-3
+# Finite differences (FD_STEP of each parameter's scale, absolute; see
+# acausal.calibrate): the residuals of an adaptive, event-located simulation
+# are not smooth below about 1e-6 relative. On the breaker, dS/d(bh) from
+# forward differences changes sign between steps 1e-6 and 1e-5 and settles
+# only from 1e-4 (within 2 % from 1e-4 to 1e-2). With scipy's relative step
+# of 1e-5 the trust region collapsed on that noise and a quadratic-drag fit
+# stopped at a tenth of its true value.
 
 
 @dataclass
@@ -178,10 +177,10 @@ def fit(model, dataset, names, x0, low, high, scale, *, fixed=None, starts=None,
     ok, message = True, ""
     if names:
         try:
-            sol = optimize.least_squares(lambda z: evaluate(z * sc), best / sc,
+            fd = ForwardDifferences(lambda z: evaluate(z * sc), FD_STEP, hi / sc)
+            sol = optimize.least_squares(fd, best / sc, jac=fd.jac,
                                          bounds=(lo / sc, hi / sc), x_scale=1.0,
-                                         diff_step=FD_STEP, xtol=tol, ftol=tol, gtol=tol,
-                                         max_nfev=max_nfev)
+                                         xtol=tol, ftol=tol, gtol=tol, max_nfev=max_nfev)
             x = sol.x * sc
             message = sol.message
             ok = sol.status >= 0     # 0: max_nfev reached (still usable)
