@@ -305,7 +305,8 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None):
     # log-parameters as log(x / ref): z is about 0 at the start, so that the
     # relative finite-difference step (FD_STEP, of max(1, |z|)) is 1e-3 of
     # the parameter, not 1e-3 of log(x) ~ 20
-    ref = np.where(logp, np.clip(start, np.where(logp, lo, 1.0), hi), 1.0)
+    inside = np.clip(start, lo, hi)
+    ref = np.where(logp, inside, 1.0)
 
     def to_x(z):
         return np.where(logp, ref * np.exp(z), z * scale)
@@ -329,7 +330,7 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None):
     zlo, zhi = to_z(lo), to_z(hi)
     zlo = np.where(np.isfinite(lo), zlo, -np.inf)
     zhi = np.where(np.isfinite(hi), zhi, np.inf)
-    z0 = np.clip(to_z(np.clip(start, lo, hi)), zlo, zhi)
+    z0 = np.clip(to_z(inside), zlo, zhi)
     fd = ForwardDifferences(fun, FD_STEP, zhi)
     sol = optimize.least_squares(fd, z0, jac=fd.jac, bounds=(zlo, zhi),
                                  xtol=1e-12, ftol=1e-12, gtol=1e-12)

@@ -189,7 +189,7 @@ def fit(model, dataset, names, x0, low, high, scale, *, fixed=None, starts=None,
             timed[0] = False
             x = seen["x"] if seen["x"] is not None else best
             message = f"{stop}; best point kept"
-            J = _jacobian(evaluate, x, sc, lo, hi)
+            J = fd.jac(x / sc) / sc      # the same differences, at the kept point
     else:
         x = best
         J = np.zeros((0, 0))
@@ -204,20 +204,6 @@ def fit(model, dataset, names, x0, low, high, scale, *, fixed=None, starts=None,
               wall_s=time.perf_counter() - t0, ok=bool(ok), message=str(message))
     out.ci95 = confidence(out, positive=[n for n, l in zip(names, lo) if l > 0])
     return out
-
-
-def _jacobian(fun, x, sc, lo, hi, rel=None):
-    """Forward differences (backward at an upper bound), per parameter unit."""
-    rel = FD_STEP if rel is None else rel
-    r0 = fun(x)
-    J = np.empty((r0.size, x.size))
-    for i in range(x.size):
-        h = rel * sc[i]
-        step = h if x[i] + h <= hi[i] else -h
-        xx = x.copy()
-        xx[i] += step
-        J[:, i] = (fun(xx) - r0) / step
-    return J
 
 
 def confidence(f: Fit, level=0.95, positive=()) -> dict:

@@ -157,12 +157,13 @@ def discrepancy_decision(chi2: dict, runs: list, lr: dict | None, alpha: float =
     return dict(alpha=alpha, parts=parts, discrepancy=any(p["reject"] for p in parts))
 
 
-def equivalence_classes(rows: list, threshold: float = EQUIVALENCE) -> list:
+def equivalence_classes(rows: list, threshold: float = EQUIVALENCE,
+                        heldout_threshold: float = EQUIVALENCE_HELDOUT) -> list:
     """Group ranked rows (dicts with ``aicc``, ``heldout_rmse``, sorted by
     aicc) into classes: a row joins the class of the best remaining row when
     its AICc is within ``threshold`` of it (Burnham and Anderson: below 4
     units both models keep substantial support), or within
-    ``EQUIVALENCE_HELDOUT`` (the end of their "considerably less support"
+    ``heldout_threshold`` (the end of their "considerably less support"
     range) with a held-out error no worse (the two criteria disagree: the
     data do not decide). Returns lists of row indices, the first class
     containing the best row."""
@@ -173,7 +174,7 @@ def equivalence_classes(rows: list, threshold: float = EQUIVALENCE) -> list:
         a0, h0 = rows[head]["aicc"], rows[head]["heldout_rmse"]
         cls = [i for i in left
                if rows[i]["aicc"] - a0 <= threshold
-               or (rows[i]["aicc"] - a0 <= threshold + EQUIVALENCE_HELDOUT - EQUIVALENCE
+               or (rows[i]["aicc"] - a0 <= heldout_threshold
                    and rows[i]["heldout_rmse"] <= h0 * (1 + 1e-9))]
         classes.append(cls)
         left = [i for i in left if i not in cls]
