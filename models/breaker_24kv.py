@@ -141,22 +141,34 @@ def build(v_impact=3.8, K=8.3e9, bh=0.219):
 K_CAL, BH_CAL = 6.17e8, 0.219
 model = build(K=K_CAL, bh=BH_CAL)
 # what calibration and diagnosis fit when not told otherwise (the report's two)
-free_parameters = {"contact.K": (1e8, 1e10), "hook.bh": (0.0, 1.0)}
-
-experiment = Experiment(t_end=0.02, rtol=1e-8, atol=1e-11, output_step=2e-6,
-                        stop=Stop(model.hook.phi, "<=", -model.Ra_sym, name="release"))
+FREE_PARAMETERS = {"contact.K": (1e8, 1e10), "hook.bh": (0.0, 1.0)}
 
 
-def _t_first_contact(res):
+def release_experiment(model, **options):
+    """The run of this file and its variants: from first contact until the
+    hook reaches its release angle Ra (the terminal event ``release``);
+    ``options`` add to or override the Experiment's settings."""
+    settings = dict(t_end=0.02, rtol=1e-8, atol=1e-11, output_step=2e-6,
+                    stop=Stop(model.hook.phi, "<=", -model.Ra_sym, name="release"))
+    settings.update(options)
+    return Experiment(**settings)
+
+
+def t_first_contact(res):
     return ct.impacts(res, "contact")[0].t_onset
 
 
-measures = {
-    "thrt": lambda res: res.event_times("release")[0] - _t_first_contact(res),
+# the measures of this file; the variants add their own to these
+MEASURES = {
+    "thrt": lambda res: res.event_times("release")[0] - t_first_contact(res),
     "contact_period": lambda res: ct.contact_period(res, "contact"),
     "peak_force": lambda res: ct.peak_force(res, "contact"),
     "impact_velocity": lambda res: ct.impact_velocity(res, "contact"),
 }
+
+free_parameters = dict(FREE_PARAMETERS)
+experiment = release_experiment(model)
+measures = dict(MEASURES)
 
 
 def plot(res, path):
@@ -164,7 +176,7 @@ def plot(res, path):
     armature velocity, with the contact period and THRT marked."""
     import numpy as np
     from acausal.plot import plot_result
-    t0 = _t_first_contact(res)
+    t0 = t_first_contact(res)
     imp = ct.impacts(res, "contact")[0]
     t_rel = res.event_times("release")[0]
     s3 = float(res["hook.s3"][0])

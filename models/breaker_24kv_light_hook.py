@@ -24,30 +24,22 @@ Same sign convention, run and measures as the base file, plus ``n_impacts``
 (impacts of the armature on the hook before release).
 Run: ``acausal simulate models/breaker_24kv_light_hook.py --plot FILE``.
 """
-from breaker_24kv import BH_CAL, K_CAL, build
+from breaker_24kv import (BH_CAL, FREE_PARAMETERS, K_CAL, MEASURES, build,
+                         release_experiment, t_first_contact)
 
-from acausal import Experiment, Stop
 from components import contact as ct
-
-def _t_first_contact(res):
-    return ct.impacts(res, "contact")[0].t_onset
-
 
 JH_LIGHT = 0.30e-3     # [kg*m^2] base 0.44e-3
 KH_STIFF = 1428.0      # [N/m] base 714
 
 model = build(K=K_CAL, bh=BH_CAL)
 model.hook.set(Jh=JH_LIGHT, kh=KH_STIFF)
-free_parameters = {"contact.K": (1e8, 1e10), "hook.bh": (0.0, 1.0)}
+free_parameters = dict(FREE_PARAMETERS)
 
-experiment = Experiment(t_end=0.02, rtol=1e-8, atol=1e-11, output_step=2e-6,
-                        stop=Stop(model.hook.phi, "<=", -model.Ra_sym, name="release"))
+experiment = release_experiment(model)
 
 measures = {
-    "thrt": lambda res: res.event_times("release")[0] - _t_first_contact(res),
-    "contact_period": lambda res: ct.contact_period(res, "contact"),
-    "peak_force": lambda res: ct.peak_force(res, "contact"),
-    "impact_velocity": lambda res: ct.impact_velocity(res, "contact"),
+    **MEASURES,
     "n_impacts": lambda res: ct.n_impacts(res, "contact"),
 }
 
@@ -57,7 +49,7 @@ def plot(res, path):
     contact end and release marked (as the base file's Fig. 7/10)."""
     import numpy as np
     from acausal.plot import plot_result
-    t0 = _t_first_contact(res)
+    t0 = t_first_contact(res)
     imp = ct.impacts(res, "contact")
     t_rel = res.event_times("release")[0]
     s3 = float(res["hook.s3"][0])

@@ -26,19 +26,16 @@ Run: ``acausal simulate models/breaker_24kv_rotary_armature.py --plot FILE``.
 import math
 
 import sympy as sp
-from breaker_24kv import BH_CAL, GAP0, K_CAL, THETA1_0, MainShaft, TriggerHook
+from breaker_24kv import (BH_CAL, FREE_PARAMETERS, GAP0, K_CAL, MEASURES, MainShaft,
+                         THETA1_0, TriggerHook, release_experiment, t_first_contact)
 
-from acausal import Experiment, Model, Stop, guess
+from acausal import Model, guess
 from components import contact as ct
 from components.contact import Contact
 from components.fourbar import FourBar, fourbar_angles
 from components.levers import IdealLever
 from components.rotational import Fixed as RotFixed
 from components.rotational import Inertia, Torque, TorsionSpring
-
-
-def _t_first_contact(res):
-    return ct.impacts(res, "contact")[0].t_onset
 
 
 class RotaryArmature(Model):
@@ -99,16 +96,12 @@ def build(v_impact=3.8, K=K_CAL, bh=BH_CAL, exact=True):
 
 
 model = build()
-free_parameters = {"contact.K": (1e8, 1e10), "hook.bh": (0.0, 1.0)}
+free_parameters = dict(FREE_PARAMETERS)
 
-experiment = Experiment(t_end=0.02, rtol=1e-8, atol=1e-11, output_step=2e-6,
-                        stop=Stop(model.hook.phi, "<=", -model.Ra_sym, name="release"))
+experiment = release_experiment(model)
 
 measures = {
-    "thrt": lambda res: res.event_times("release")[0] - _t_first_contact(res),
-    "contact_period": lambda res: ct.contact_period(res, "contact"),
-    "peak_force": lambda res: ct.peak_force(res, "contact"),
-    "impact_velocity": lambda res: ct.impact_velocity(res, "contact"),
+    **MEASURES,
     "n_impacts": lambda res: ct.n_impacts(res, "contact"),
 }
 
@@ -118,7 +111,7 @@ def plot(res, path):
     clapper angle; contact ends and release marked."""
     import numpy as np
     from acausal.plot import plot_result
-    t0 = _t_first_contact(res)
+    t0 = t_first_contact(res)
     imp = ct.impacts(res, "contact")
     t_rel = res.event_times("release")[0]
     s3 = float(res["hook.s3"][0])
