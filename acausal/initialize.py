@@ -90,13 +90,16 @@ def initial_point(cm, p, d, cb, t0):
         raise
     if violated:
         raise InitializationError(violated)
-    if _snap_fixed_states(cm, y, fixed):
-        # least squares meets a fixed start only to ~1e-16: impose it exactly
-        # (a body that starts at rest must be exactly at rest) and recompute
-        # the algebraic unknowns and y' for the exact states
-        y, yp = reinitialize(cm, cb, t0, y, yp)
-        z = np.concatenate([y, yp[:ns]])
-        _check(cm, residual(z, []), jac(z, []), z, fixed, n)
+    _snap_fixed_states(cm, y, fixed)
+    # least squares meets a fixed start only to ~1e-16 and leaves round-off
+    # (1e-30) in unknowns that are exactly zero: impose the fixed states
+    # exactly (a body that starts at rest must be exactly at rest) and
+    # recompute the algebraic unknowns and y' for them by Newton refined to
+    # its floor, so that a stuck friction mode (der(v) = 0) integrates an
+    # exact zero and holds v = 0 exactly, not at 1e-78
+    y, yp = reinitialize(cm, cb, t0, y, yp)
+    z = np.concatenate([y, yp[:ns]])
+    _check(cm, residual(z, []), jac(z, []), z, fixed, n)
     return y, _algebraic_rates(cm, cb, t0, y, yp)
 
 
@@ -222,19 +225,28 @@ def reinitialize(cm, cb, t, y, yp):
     y = np.array(y, dtype=float)
     yp = np.array(yp, dtype=float)
     z = np.concatenate([y[ns:], yp[:ns]])
+    converged, last = False, np.inf
     for _ in range(50):
         cb[0](t, y, yp, r)
+        if not r.any():
+            break                     # exact: a further solve only adds round-off
         Jy, Jyp = _jacobians(cb, t, y, yp, n)
         J = np.hstack([Jy[:, ns:], Jyp[:, :ns]])
         try:
             dz = scipy.linalg.solve(J, -r)
         except (scipy.linalg.LinAlgError, ValueError):
             dz = np.linalg.lstsq(J, -r, rcond=None)[0]
+        size = float(np.max(np.abs(dz))) if dz.size else 0.0
+        if converged and not size < last:
+            break                     # refined to the round-off floor
         z = z + dz
         y[ns:] = z[:n - ns]
         yp[:ns] = z[n - ns:]
-        if np.all(np.abs(dz) <= 1e-12 * (1 + np.abs(z))):
-            break
+        # converged: then refine while the corrections still shrink (they
+        # fall by ~1e-16 per step and reach exact zeros where the solution
+        # is an exact zero)
+        converged = converged or bool(np.all(np.abs(dz) <= 1e-12 * (1 + np.abs(z))))
+        last = size
     return y, _algebraic_rates(cm, cb, t, y, yp)
 
 

@@ -78,8 +78,8 @@ def hertz_handwritten(rtol=1e-8, atol=1e-12, m=0.1, K=1e9, v0=1.0):
 
 def hertz_generated(peak_event):
     from acausal import Model, compile_model
-    from components.contact import Contact
-    from components.translational import Fixed, Mass
+    from acausal.mechanics.contact import Contact
+    from acausal.mechanics.translational import Fixed, Mass
     model = Model()
     model.mass = Mass(m=0.1, s=S0, v=1.0)
     model.wall = Fixed(s0=0.0)

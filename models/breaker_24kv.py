@@ -21,13 +21,13 @@ event) and stops when the hook reaches its release angle. Measures:
 import math
 
 from acausal import Experiment, Model, Stop, guess
-from components import contact as ct
-from components.contact import Contact
-from components.fourbar import FourBar, fourbar_angles
-from components.levers import IdealLever
-from components.rotational import Fixed as RotFixed
-from components.rotational import Inertia, RotationalDamper
-from components.translational import Fixed, Force, Mass, Spring
+from acausal.mechanics import contact as ct
+from acausal.mechanics.contact import Contact
+from acausal.mechanics.fourbar import FourBar, fourbar_angles
+from acausal.mechanics.levers import IdealLever
+from acausal.mechanics.rotational import Fixed as RotFixed
+from acausal.mechanics.rotational import Inertia, RotationalDamper
+from acausal.mechanics.translational import Fixed, Force, Mass, Spring
 
 GAP0 = 1e-6          # [m] armature-hook distance at t = 0 (first contact at ~0.26 us)
 THETA1_0 = 0.0       # [rad] hook angle at first contact (report's figures start at 0)

@@ -27,7 +27,7 @@ Run: ``acausal simulate models/breaker_24kv_light_hook.py --plot FILE``.
 from breaker_24kv import (BH_CAL, FREE_PARAMETERS, K_CAL, MEASURES, build,
                          release_experiment, t_first_contact)
 
-from components import contact as ct
+from acausal.mechanics import contact as ct
 
 JH_LIGHT = 0.30e-3     # [kg*m^2] base 0.44e-3
 KH_STIFF = 1428.0      # [N/m] base 714

@@ -6,7 +6,7 @@ Design change: the trip magnet pulls a clapper plate on a pivot (moment of
 inertia ``Ja`` about the pivot, magnetic torque ``Te``, reset torsion spring
 ``kr``); a striking pin on the clapper at arm ``la`` hits the hook's contact
 point. The pin moves on a circle: the lever is exact, ``s = la*sin(phi)``,
-force ratio ``la*cos(phi)`` (components.levers.IdealLever(exact=True)), with
+force ratio ``la*cos(phi)`` (acausal.mechanics.levers.IdealLever(exact=True)), with
 ``phi`` = 0 (the arm perpendicular to the strike line) 1 um before first
 contact. Default values: a steel clapper of about 0.1 kg and 50 mm swinging
 about one end (Ja = 1.0e-4 kg*m^2), pin at la = 25 mm, i.e. an effective mass
@@ -30,12 +30,12 @@ from breaker_24kv import (BH_CAL, FREE_PARAMETERS, GAP0, K_CAL, MEASURES, MainSh
                          THETA1_0, TriggerHook, release_experiment, t_first_contact)
 
 from acausal import Model, guess
-from components import contact as ct
-from components.contact import Contact
-from components.fourbar import FourBar, fourbar_angles
-from components.levers import IdealLever
-from components.rotational import Fixed as RotFixed
-from components.rotational import Inertia, Torque, TorsionSpring
+from acausal.mechanics import contact as ct
+from acausal.mechanics.contact import Contact
+from acausal.mechanics.fourbar import FourBar, fourbar_angles
+from acausal.mechanics.levers import IdealLever
+from acausal.mechanics.rotational import Fixed as RotFixed
+from acausal.mechanics.rotational import Inertia, Torque, TorsionSpring
 
 
 class RotaryArmature(Model):

@@ -34,12 +34,12 @@ from breaker_24kv import (Armature, BH_CAL, FREE_PARAMETERS, K_CAL, MEASURES, Ma
                          THETA1_0, TriggerHook, release_experiment, t_first_contact)
 
 from acausal import Model, guess
-from components import contact as ct
-from components.contact import Contact
-from components.fourbar import FourBar, fourbar_angles
-from components.levers import IdealLever
-from components.rotational import Fixed as RotFixed
-from components.rotational import Inertia, RotationalDamper, TorsionSpring
+from acausal.mechanics import contact as ct
+from acausal.mechanics.contact import Contact
+from acausal.mechanics.fourbar import FourBar, fourbar_angles
+from acausal.mechanics.levers import IdealLever
+from acausal.mechanics.rotational import Fixed as RotFixed
+from acausal.mechanics.rotational import Inertia, RotationalDamper, TorsionSpring
 
 
 class TripLever(Model):

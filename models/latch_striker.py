@@ -16,9 +16,9 @@ The free parameters are the contact stiffness and the latch damping, the two
 numbers a designer would calibrate.
 """
 from acausal import Experiment, Model, Stop
-from components import contact as ct
-from components.contact import Contact
-from components.translational import Damper, Fixed, Force, Mass, Spring
+from acausal.mechanics import contact as ct
+from acausal.mechanics.contact import Contact
+from acausal.mechanics.translational import Damper, Fixed, Force, Mass, Spring
 
 GAP = 1e-3       # [m] plunger travel before it strikes the latch
 TRIP = 2e-3      # [m] latch travel at which it trips

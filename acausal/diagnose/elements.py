@@ -31,7 +31,7 @@ def _capture(comp, across):
 
 class DisplacementForce(Component):
     """A force ``f = k * (flange.s - x_start)`` along +s, reacting on the
-    frame (``flange.f = -f``, as :class:`components.translational.Force`),
+    frame (``flange.f = -f``, as :class:`acausal.mechanics.translational.Force`),
     where ``x_start`` is the flange position at the start of the run.
     ``k > 0`` pushes the flange further the way it has moved (a force that
     grows with the stroke); ``k < 0`` pulls it back (a spring-like loss).
@@ -75,7 +75,7 @@ class DisplacementTorque(Component):
 
 
 class VelocityRestitution:
-    """Mixin for a :class:`components.contact.PartialContact`: the damping
+    """Mixin for a :class:`acausal.mechanics.contact.PartialContact`: the damping
     of each impact uses ``e(v_i) = clip(e - slope * v_i, E_MIN, 1)`` instead of
     ``e`` (``v_i`` the impact velocity captured at the onset, so ``e(v_i)`` is
     constant during an impact). ``slope`` [s/m] is the symbol stored in the
@@ -89,13 +89,13 @@ class VelocityRestitution:
     def _factor(self):
         if self.law == "beta":
             return super()._factor()
-        from components.contact import damping_chi
+        from acausal.mechanics.contact import damping_chi
         return 1 + damping_chi(self.law, self._e_eff()) * self.delta_dot / self.v_i
 
     def _factor_rate(self):
         if self.law == "beta":
             return super()._factor_rate()
-        from components.contact import damping_chi
+        from acausal.mechanics.contact import damping_chi
         return damping_chi(self.law, self._e_eff()) * self.a_rel / self.v_i
 
 

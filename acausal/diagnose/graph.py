@@ -53,7 +53,7 @@ class Site:
 def _lib():
     """The component classes the graph recognises (imported lazily: the
     component library is a separate package)."""
-    from components import contact, partials, rotational, translational
+    from acausal.mechanics import contact, partials, rotational, translational
     return dict(
         rigid=(partials.PartialRigid, partials.PartialRotRigid),
         compliant=(partials.PartialCompliant, partials.PartialRotCompliant),

@@ -216,8 +216,8 @@ class CoulombFriction(Hypothesis):
         # the law reads the body's own velocity (a state with its start value),
         # not der(flange position): the initialisation then starts the steep
         # tanh at the right speed
-        from components.rotational import Torque
-        from components.translational import Force
+        from acausal.mechanics.rotational import Torque
+        from acausal.mechanics.translational import Force
         body = model.find(location)
         if _rot(body):
             F = self._par(hyp, vals, "tau", "N*m", f"Coulomb friction torque at {location}",
@@ -260,8 +260,8 @@ class QuadraticDamping(Hypothesis):
                            f"quadratic drag coefficient on {location}")]
 
     def _extend(self, model, graph, hyp, location, vals):
-        from components.rotational import Torque
-        from components.translational import Force
+        from acausal.mechanics.rotational import Torque
+        from acausal.mechanics.translational import Force
         body = model.find(location)
         if _rot(body):
             c = self._par(hyp, vals, "c", "N*m*s^2/rad^2", f"quadratic drag on {location}",
@@ -301,8 +301,8 @@ class ConstantLoad(Hypothesis):
                            f"constant load on {location} along +{'phi' if rot else 's'}")]
 
     def _extend(self, model, graph, hyp, location, vals):
-        from components.rotational import Torque
-        from components.translational import Force
+        from acausal.mechanics.rotational import Torque
+        from acausal.mechanics.translational import Force
         body = model.find(location)
         if _rot(body):
             F = self._par(hyp, vals, "tau", "N*m", f"constant torque on {location} about +phi")
@@ -344,8 +344,8 @@ class HardeningSpring(Hypothesis):
                            f"when k3 = high)")]
 
     def _extend(self, model, graph, hyp, location, vals):
-        from components.rotational import RelativeTorque
-        from components.translational import RelativeForce
+        from acausal.mechanics.rotational import RelativeTorque
+        from acausal.mechanics.translational import RelativeForce
         spring = model.find(location)
         rot = _rot(spring)
         ref, pre = ("phi_rel0", "tau0") if rot else ("s_rel0", "f0")
@@ -384,7 +384,7 @@ class Clearance(Hypothesis):
                                  "a change of the contact law leaves the onset in place.")
 
     def _contacts(self, graph):
-        from components.contact import Clearance as ClearanceModel
+        from acausal.mechanics.contact import Clearance as ClearanceModel
         out = []
         for s in graph.contacts:
             c = s.component
@@ -415,7 +415,7 @@ class Clearance(Hypothesis):
                            f"extra clearance before {comp.path} closes")]
 
     def _extend(self, model, graph, hyp, location, vals):
-        from components.contact import Clearance as ClearanceModel
+        from acausal.mechanics.contact import Clearance as ClearanceModel
         comp = model.find(location)
         rot = domain_of(graph.components[[s.path for s in graph.contacts
                                            if s.path == location
@@ -456,8 +456,8 @@ class FlexibleLink(Hypothesis):
                                  "only the impact.")
 
     def candidates(self, graph):
-        from components.contact import Clearance as ClearanceModel
-        from components.contact import PartialContact
+        from acausal.mechanics.contact import Clearance as ClearanceModel
+        from acausal.mechanics.contact import PartialContact
         L = graph._lib
         out = []
         for j in graph.joints:
@@ -507,7 +507,7 @@ class FlexibleLink(Hypothesis):
                            "(0 = rigid up to T0)")]
 
     def _extend(self, model, graph, hyp, location, vals):
-        from components import rotational, translational
+        from acausal.mechanics import rotational, translational
         bpath, upath = location.split(":")
         body = model.find(bpath)
         rot = _rot(body)

@@ -22,8 +22,8 @@ hook turns to the release angle Ra = 5 deg.
 import math
 
 from acausal import Experiment, Model, Stop
-from components.fourbar import FourBar, fourbar_angles
-from components.rotational import Fixed, Inertia, TorsionSpring
+from acausal.mechanics.fourbar import FourBar, fourbar_angles
+from acausal.mechanics.rotational import Fixed, Inertia, TorsionSpring
 
 TABLE1 = dict(e=0.0002, f=0.125, r1=0.116, r2=0.036, r3=0.0533)
 JH = 0.00044                       # hook inertia [kg m^2], Table 1

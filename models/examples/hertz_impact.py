@@ -7,8 +7,8 @@ delta_max = (5 m v0^2 / (4 K))^(2/5) (t_c = 0.321807 ms here; the constant is
 K delta_max^1.5 = 1143.26 N. The mass starts 0.1 mm from the wall.
 """
 from acausal import Experiment, Model
-from components.contact import Contact, contact_period, peak_force, restitution
-from components.translational import Fixed, Mass
+from acausal.mechanics.contact import Contact, contact_period, peak_force, restitution
+from acausal.mechanics.translational import Fixed, Mass
 
 model = Model()
 model.mass = Mass(m=0.1, s=-1e-4, v=1.0)

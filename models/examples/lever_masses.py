@@ -5,8 +5,8 @@ resolved by index reduction (Pantelides + dummy derivatives).
 Exact: lever.phi = 0.1 cos(w t), w = sqrt(c a^2 / (m1 a^2 + m2 b^2)),
 m2.s = b * lever.phi."""
 from acausal import Experiment, Model
-from components.levers import TwoArmLever
-from components.translational import Fixed, Mass, Spring
+from acausal.mechanics.levers import TwoArmLever
+from acausal.mechanics.translational import Fixed, Mass, Spring
 
 model = Model()
 model.lever = TwoArmLever(a=0.1, b=0.3)

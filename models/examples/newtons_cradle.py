@@ -17,8 +17,8 @@ import math
 import os
 
 from acausal import Experiment, Model
-from components.contact import Contact, hertz_stiffness
-from components.translational import Mass
+from acausal.mechanics.contact import Contact, hertz_stiffness
+from acausal.mechanics.translational import Mass
 
 N = int(os.environ.get("CRADLE_N", "5"))
 R = 0.01            # ball radius [m]

@@ -2,7 +2,7 @@
 
 Exact solution: mass.s = 0.1 cos(10 t)."""
 from acausal import Experiment, Model
-from components.translational import Fixed, Mass, Spring
+from acausal.mechanics.translational import Fixed, Mass, Spring
 
 model = Model()
 model.mass = Mass(m=1.0, s=0.1, v=0.0)

@@ -21,8 +21,8 @@ import math
 import numpy as np
 
 from acausal import Experiment, Model, time
-from components.friction import GroundFriction
-from components.translational import Mass, Position, Spring
+from acausal.mechanics.friction import GroundFriction
+from acausal.mechanics.translational import Mass, Position, Spring
 
 M, K, V, MU_K, MU_S, G = 1.0, 200.0, 0.05, 0.4, 0.6, 9.81
 

@@ -9,7 +9,7 @@ import pytest
 from acausal import Experiment
 from acausal.modelfile import compile_file, run_file
 from acausal.simulate import _atol_vector
-from components.fourbar import fourbar_angles
+from acausal.mechanics.fourbar import fourbar_angles
 
 EXAMPLE = os.path.join(os.path.dirname(__file__), "..", "..", "models", "examples",
                        "fourbar.py")

@@ -92,7 +92,7 @@ def test_model_file_syntax_error_names_line(tmp_path):
 def test_model_file_exception_names_line(tmp_path):
     p = write(tmp_path, """\
         from acausal import Model
-        from components.translational import Mass
+        from acausal.mechanics.translational import Mass
         model = Model()
         model.mass = Mass(m=-2.0)
         """)
@@ -110,7 +110,7 @@ def test_model_file_without_model(tmp_path):
 def test_unconnected_flange_exits_2_and_names_it(tmp_path):
     p = write(tmp_path, """\
         from acausal import Model
-        from components.translational import Mass, Spring
+        from acausal.mechanics.translational import Mass, Spring
         model = Model()
         model.mass = Mass(m=1.0, s=0.1)
         model.spring = Spring(c=100.0)
@@ -124,7 +124,7 @@ def test_solver_failure_exits_3_names_time_and_keeps_partial_results(tmp_path):
     # m s'' = 1e3 s^3 from s = 1: s blows up at a finite time (~0.056 s)
     p = write(tmp_path, """\
         from acausal import Experiment, Model
-        from components.translational import Force, Mass
+        from acausal.mechanics.translational import Force, Mass
         model = Model()
         model.mass = Mass(m=1.0, s=1.0, v=0.0)
         model.push = Force(f=lambda s: 1e3 * s**3)

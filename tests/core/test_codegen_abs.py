@@ -4,7 +4,7 @@ import numpy as np
 import sympy as sp
 
 from acausal import Model, compile_model
-from components.translational import Force, Mass
+from acausal.mechanics.translational import Force, Mass
 
 
 def test_quadratic_drag_with_abs_closed_form():

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from acausal import Model, ModelError, compile_model
-from components.translational import Fixed, Force, Mass, Spring
+from acausal.mechanics.translational import Fixed, Force, Mass, Spring
 
 
 class Sub(Model):

@@ -1,6 +1,6 @@
 """Event actions read parameters that are bound to other parameters."""
 from acausal import Component, Discrete, Eq, Event, Flange, Model, Parameter, compile_model
-from components.translational import Mass
+from acausal.mechanics.translational import Mass
 
 
 class Marker(Component):

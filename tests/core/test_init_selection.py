@@ -1,4 +1,4 @@
-"""Core fixes found while building the four-bar (components/fourbar.py):
+"""Core fixes found while building the four-bar (acausal/mechanics/fourbar.py):
 start values given on eliminated aliases, state selection with a fixed
 velocity but a free position, initialisation going to the nearest solution,
 and assertions already violated at the initial point."""

@@ -11,7 +11,7 @@ import numpy as np
 
 from acausal import Eq, Model, compile_model, time
 from acausal.initialize import initial_point
-from components.translational import Fixed, Mass, Spring
+from acausal.mechanics.translational import Fixed, Mass, Spring
 
 
 def _cubic_model():
@@ -41,7 +41,7 @@ def test_algebraic_rates_at_start():
 
 
 def test_fixed_state_starts_are_exact():
-    from components.friction import GroundFriction
+    from acausal.mechanics.friction import GroundFriction
     from acausal import Component, Flange, Parameter
 
     class Load(Component):

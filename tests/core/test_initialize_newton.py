@@ -5,8 +5,8 @@ import sympy as sp
 
 from acausal import Model, compile_model
 from acausal.initialize import _lstsq_scaled
-from components.levers import TwoArmLever
-from components.translational import Force, Mass
+from acausal.mechanics.levers import TwoArmLever
+from acausal.mechanics.translational import Force, Mass
 
 
 def test_newton_starts_at_fixed_state_values():

@@ -5,7 +5,7 @@ import pytest
 import sympy as sp
 
 from acausal import Model, ModelError, compile_model, time
-from components.translational import Mass, Position
+from acausal.mechanics.translational import Mass, Position
 
 
 def test_fully_prescribed_model_gives_a_clear_error():

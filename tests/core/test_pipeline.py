@@ -7,8 +7,8 @@ from acausal import (Discrete, Eq, Event, Model, Parameter, Start, StructuralErr
                      der)
 from acausal.component import Component
 from acausal.connectors import Flange
-from components.translational import Fixed, Mass, Spring
-from components.levers import TwoArmLever
+from acausal.mechanics.translational import Fixed, Mass, Spring
+from acausal.mechanics.levers import TwoArmLever
 
 
 def oscillator(**mass):
@@ -242,7 +242,7 @@ def test_time_window_chattering_guard(monkeypatch):
     it and name the component, keeping what was computed."""
     from acausal import ChatteringError
     from acausal import simulate as sim
-    from components.contact import Clearance
+    from acausal.mechanics.contact import Clearance
     monkeypatch.setattr(sim, "CHATTER_SPAN", 0.5)
     m = Model()
     m.housing = Fixed(s0=0.0)
@@ -281,7 +281,7 @@ def test_sub_model_bindings_get_full_paths():
 
 def test_connecting_different_domains_is_named():
     from acausal import ModelError
-    from components.rotational import Inertia
+    from acausal.mechanics.rotational import Inertia
     m = Model()
     m.mass = Mass(m=1.0)
     m.wheel = Inertia(J=1.0)

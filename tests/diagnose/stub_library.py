@@ -10,8 +10,8 @@ import sympy as sp
 
 from acausal.compile import compile_model
 from acausal.modelfile import load_model_file
-from components.rotational import Inertia, Torque
-from components.translational import Force, Mass
+from acausal.mechanics.rotational import Inertia, Torque
+from acausal.mechanics.translational import Force, Mass
 
 
 @dataclass(frozen=True)

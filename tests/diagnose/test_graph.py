@@ -7,10 +7,10 @@ from acausal import Model, ModelError, compile_model
 from acausal.diagnose import ModelGraph, Site
 from acausal.diagnose.hypotheses import nominal_result
 from acausal.modelfile import load_model_file
-from components.contact import Clearance
-from components.fourbar import fourbar_angles
-from components.rotational import Inertia, Torque
-from components.translational import Fixed, Mass, Position
+from acausal.mechanics.contact import Clearance
+from acausal.mechanics.fourbar import fourbar_angles
+from acausal.mechanics.rotational import Inertia, Torque
+from acausal.mechanics.translational import Fixed, Mass, Position
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BREAKER = os.path.join(ROOT, "models", "breaker_24kv.py")

@@ -11,7 +11,7 @@ from acausal import ModelError
 from acausal.diagnose import HYPOTHESES, ModelGraph, build_extended, write_extended_model
 from acausal.diagnose.hypotheses import nominal_result
 from acausal.modelfile import compile_file, evaluate_measures, load_model_file, run_file
-from components.contact import impacts
+from acausal.mechanics.contact import impacts
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BREAKER = os.path.join(ROOT, "models", "breaker_24kv.py")
@@ -20,7 +20,7 @@ HERTZ = os.path.join(ROOT, "models", "examples", "hertz_impact.py")
 
 PUSH_SRC = '''"""A cart pushed by a constant force against a damper, until it has moved 0.5 m."""
 from acausal import Experiment, Model, Stop
-from components.translational import Damper, Fixed, Force, Mass
+from acausal.mechanics.translational import Damper, Fixed, Force, Mass
 
 model = Model()
 model.cart = Mass(m=2.0, s=0.0, v=0.0)

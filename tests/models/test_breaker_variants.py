@@ -19,7 +19,7 @@ import pytest
 
 from acausal import compile_model
 from acausal.modelfile import run_file
-from components import contact as ct
+from acausal.mechanics import contact as ct
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 MODELS = os.path.join(ROOT, "models")

@@ -1,4 +1,4 @@
-"""Impact contact (components/contact.py) against closed forms (undamped
+"""Impact contact (acausal/mechanics/contact.py) against closed forms (undamped
 Hertz impact, elastic collision, Hertz stiffness) and against an independent
 scipy ``solve_ivp`` integration (DOP853, rtol 1e-12) of the same hybrid ODE
 written by hand in indentation coordinates."""
@@ -15,9 +15,9 @@ from sympy import Eq, tanh
 from acausal import Component, Flange, Model, Parameter, ParameterError, compile_model
 from acausal import time as T
 from acausal.modelfile import run_file
-from components.contact import (Clearance, Contact, EndStop, contact_period, hertz_stiffness,
+from acausal.mechanics.contact import (Clearance, Contact, EndStop, contact_period, hertz_stiffness,
                                 impact_velocity, impacts, n_impacts, peak_force, restitution)
-from components.translational import Fixed, Mass
+from acausal.mechanics.translational import Fixed, Mass
 
 HERE = os.path.dirname(__file__)
 EXAMPLES = os.path.join(HERE, "..", "..", "models", "examples")
@@ -400,7 +400,7 @@ def test_impacts_on_a_spring_mounted_body(peak_event):
     wall, undamped: three impacts and separations (the light node bounces
     back and hits the mass again). Event times against solve_ivp of the
     4-state ODE with F = K max(delta, 0)^1.5 (no modes needed at e = 1)."""
-    from components.translational import Spring
+    from acausal.mechanics.translational import Spring
     m1, m2, v0, K, c = 0.1, 0.01, 1.0, 1e9, 1e6
     model = Model()
     model.mass = Mass(m=m1, s=-1e-4, v=v0)

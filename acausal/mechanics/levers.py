@@ -2,8 +2,8 @@
 
 All are massless, rigid and power conserving, with their pivot/support on
 the fixed frame (like Modelica's IdealGear with a grounded support): put the
-mass or inertia of a lever in an :class:`~components.rotational.Inertia`
-or :class:`~components.translational.Mass` on one of its flanges.
+mass or inertia of a lever in an :class:`~acausal.mechanics.rotational.Inertia`
+or :class:`~acausal.mechanics.translational.Mass` on one of its flanges.
 Sign convention: :mod:`acausal.connectors`.
 """
 from sympy import Eq, cos, sin

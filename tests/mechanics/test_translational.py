@@ -1,4 +1,4 @@
-"""components.translational against closed forms (IDA at rtol 1e-10).
+"""acausal.mechanics.translational against closed forms (IDA at rtol 1e-10).
 
 Each tolerance is a few times the error measured with the law as written;
 changing a law (sign, factor, preload) breaks the test by orders of
@@ -8,7 +8,7 @@ import pytest
 import sympy as sp
 
 from acausal import Model, ParameterError, compile_model, time
-from components.translational import (AccSensor, Damper, Fixed, Force, ForceSensor, Mass,
+from acausal.mechanics.translational import (AccSensor, Damper, Fixed, Force, ForceSensor, Mass,
                                       RelativeForce,
                                       Position, PositionSensor, RelPositionSensor,
                                       RelSpeedSensor, SpeedSensor, Spring, SpringDamper)

@@ -112,7 +112,7 @@ class Force(PartialSource):
     """A force ``f`` applied on ``flange`` along +s, reacting on the fixed
     frame: ``flange.f = -f`` (so a mass on that flange gets ``m*a = f``).
 
-    ``f`` is given as one of (see :class:`components.partials.PartialSource`)::
+    ``f`` is given as one of (see :class:`acausal.mechanics.partials.PartialSource`)::
 
         Force(f=100.0)                            # constant; run-time parameter f_const
         Force(f=200.0 * sympy.sin(50 * time))     # expression of acausal.time (and parameters)

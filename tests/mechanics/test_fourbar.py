@@ -7,8 +7,8 @@ import sympy as sp
 from scipy.integrate import solve_ivp
 
 from acausal import InitializationError, Model, ParameterError, SolverError, compile_model, guess
-from components.fourbar import FourBar, fourbar_angles, fourbar_ratio
-from components.rotational import Fixed, Inertia, TorsionSpring
+from acausal.mechanics.fourbar import FourBar, fourbar_angles, fourbar_ratio
+from acausal.mechanics.rotational import Fixed, Inertia, TorsionSpring
 
 REPORT = dict(e=0.0002, f=0.125, r1=0.116, r2=0.036, r3=0.0533)   # Table 1
 GENERIC = dict(e=0.04, f=0.1, r1=0.08, r2=0.03, r3=0.06)          # crank-rocker, large swing

@@ -12,9 +12,9 @@ import pytest
 from sympy import Eq
 
 from acausal import Component, Flange, Model, Parameter, ParameterError, compile_model, time
-from components.friction import BearingFriction, Friction, GroundFriction, RotFriction
-from components.rotational import Inertia
-from components.translational import Fixed, Mass, Spring
+from acausal.mechanics.friction import BearingFriction, Friction, GroundFriction, RotFriction
+from acausal.mechanics.rotational import Inertia
+from acausal.mechanics.translational import Fixed, Mass, Spring
 
 G = 9.81
 

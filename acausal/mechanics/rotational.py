@@ -120,7 +120,7 @@ class Torque(PartialSource):
     expression of ``acausal.time`` and parameters, or a function
     ``lambda phi: ...`` / ``lambda phi, w: ...`` of the flange angle (and
     angular velocity) returning a sympy expression — exactly as
-    :class:`components.translational.Force`.
+    :class:`acausal.mechanics.translational.Force`.
 
     Parameters: ``tau_const`` [N*m] (only when ``tau`` is a number). States:
     ``tau`` [N*m] the applied torque. Connectors: ``flange``.

@@ -1,14 +1,14 @@
-"""components.levers: closed forms (small angle) and scipy solve_ivp
+"""acausal.mechanics.levers: closed forms (small angle) and scipy solve_ivp
 references at rtol 1e-12 of hand-derived equations (exact kinematics)."""
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
 from acausal import Model, ParameterError, compile_model
-from components.levers import IdealGear, IdealLever, TwoArmLever
-from components.rotational import Fixed as RotFixed
-from components.rotational import Inertia, TorsionSpring
-from components.translational import Fixed, Mass, Spring
+from acausal.mechanics.levers import IdealGear, IdealLever, TwoArmLever
+from acausal.mechanics.rotational import Fixed as RotFixed
+from acausal.mechanics.rotational import Inertia, TorsionSpring
+from acausal.mechanics.translational import Fixed, Mass, Spring
 
 TOL = dict(rtol=1e-10, atol=1e-12)
 REL = 1e-7   # IDA at rtol 1e-10: measured <= 2e-8 relative to the amplitude

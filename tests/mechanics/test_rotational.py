@@ -1,4 +1,4 @@
-"""components.rotational against closed forms (IDA at rtol 1e-10).
+"""acausal.mechanics.rotational against closed forms (IDA at rtol 1e-10).
 
 Each tolerance is a few times the error measured with the law as written."""
 import numpy as np
@@ -6,7 +6,7 @@ import pytest
 import sympy as sp
 
 from acausal import Model, ParameterError, compile_model, time
-from components.rotational import (AccSensor, Angle, AngleSensor, Damper, Fixed, Inertia,
+from acausal.mechanics.rotational import (AccSensor, Angle, AngleSensor, Damper, Fixed, Inertia,
                                    RelAngleSensor, RelSpeedSensor, RotationalDamper,
                                    SpeedSensor, Spring, SpringDamper, Torque, TorqueSensor,
                                    TorsionSpring, RelativeTorque)

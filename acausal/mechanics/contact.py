@@ -25,7 +25,7 @@ Sign convention (:mod:`acausal.connectors`; positions along one +s axis)::
   * ``fc >= 0`` [N]: the contact force, pushing the bodies apart: on body A
     along -s, on body B along +s. In connector terms (force positive *into*
     the component) ``flange_a.f = +fc`` and ``flange_b.f = -fc``, i.e. the
-    tension ``f`` of :class:`~components.partials.PartialCompliant` is
+    tension ``f`` of :class:`~acausal.mechanics.partials.PartialCompliant` is
     ``-fc``.
 
 Modes and events (every switch happens where the force is zero, so the
