@@ -10,7 +10,7 @@ from .component import Component, Model
 from .compile import CompiledModel, compile_model
 from .connectors import Flange, Port, RotFlange
 from .declare import Assertion, Discrete, Event, Parameter, Start, Variable, guess
-from .experiment import Experiment, Stop
+from .experiment import Experiment, Measure, Stop
 from .errors import (AcausalError, ChatteringError, InitializationError, ModelError,
                      ParameterError, SolverError, StructuralError)
 from .symbols import der, time
@@ -18,6 +18,6 @@ from .symbols import der, time
 __all__ = [
     "Component", "Model", "CompiledModel", "compile_model", "Flange", "RotFlange", "Port",
     "Parameter", "Variable", "Discrete", "Event", "Assertion", "Start", "guess", "der",
-    "time", "Eq", "Experiment", "Stop", "AcausalError", "ModelError", "ParameterError", "StructuralError",
+    "time", "Eq", "Experiment", "Measure", "Stop", "AcausalError", "ModelError", "ParameterError", "StructuralError",
     "InitializationError", "SolverError", "ChatteringError",
 ]

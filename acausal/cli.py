@@ -52,7 +52,8 @@ def simulate(file, t_end, sets, out, plot, as_json, rtol, atol):
     try:
         params = _parse_sets(sets)
         mf, cm = compile_file(file)
-        opts = mf.experiment.run_options()
+        # a CSV or a plot needs the model file's dense grid; measures do not
+        opts = mf.experiment.run_options(dense=bool(out or plot))
         for k, v in dict(t_end=t_end, rtol=rtol, atol=atol).items():
             if v is not None:
                 opts[k] = v
@@ -71,20 +72,31 @@ def simulate(file, t_end, sets, out, plot, as_json, rtol, atol):
             _plot(mf, res, plot)
     except (AcausalError, click.BadParameter) as exc:
         _fail(exc)
+    _print_simulation(mf, cm, res, measures, as_json)
+
+
+def _print_simulation(mf, cm, res, measures, as_json):
+    """The result of ``simulate`` on stdout: one JSON object (values in SI
+    units, named in ``units``), or a summary with each measure in its
+    display unit."""
+    from .modelfile import measure_unit, show_measure
+    final = res.final()
     if as_json:
         click.echo(json.dumps({
-            "final": res.final(),
+            "final": final,
             "events": [{"t": t, "name": n} for t, n in res.events],
             "measures": measures,
+            "units": {"time": "s", "final": {n: res.unit(n) for n in final},
+                      "measures": {k: measure_unit(mf, k) for k in measures}},
             "stats": {k: res.stats.get(k) for k in ("nfev", "steps", "wall_s", "compile_s",
                                                     "njev", "events")},
         }, indent=1))
-    else:
-        click.echo(f"simulated {mf.path}: t = {res.t[0]:g} .. {res.t[-1]:g} s, "
-                   f"{len(res.events)} events, {res.stats['steps']} steps, "
-                   f"{res.stats['wall_s'] * 1e3:.1f} ms (compile {cm.compile_s:.2f} s)")
-        for k, v in measures.items():
-            click.echo(f"  {k} = {v:.6g}")
+        return
+    click.echo(f"simulated {mf.path}: t = {res.t[0]:g} .. {res.t[-1]:g} s, "
+               f"{len(res.events)} events, {res.stats['steps']} steps, "
+               f"{res.stats['wall_s'] * 1e3:.1f} ms (compile {cm.compile_s:.2f} s)")
+    for k, v in measures.items():
+        click.echo(f"  {k} = {show_measure(mf, k, v)}")
 
 
 def _plot(mf, res, path):
@@ -92,9 +104,7 @@ def _plot(mf, res, path):
     if callable(custom):
         custom(res, path)
         return
-    names = custom or [s.name for s in res.model.dae.y[:res.model.dae.n_states]
-                       if "." in s.name and not s.name.startswith("der(")][:6]
-    res.plot(names, path, title=mf.path.rsplit("/", 1)[-1])
+    res.plot(custom or None, path, title=mf.path.rsplit("/", 1)[-1])
 
 
 @main.command()

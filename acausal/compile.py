@@ -51,7 +51,7 @@ class CompiledModel:
         self.disc_syms = [d.symbol for d in self.discretes]
         g = self.graph = Graph(red.equations, red.unknowns)
         pantelides(g)
-        self._root_starts = _alias_starts(flat, red)
+        self._root_starts, self._root_via = _alias_starts(flat, red)
         values = self._start_values()
         fixed = {v.symbol for v in flat.variables.values() if v.start.fixed}
         fixed |= {r for r, st in self._root_starts.items() if st.fixed}
@@ -146,6 +146,30 @@ class CompiledModel:
             p[i] = value
         return p
 
+    def split_overrides(self, overrides):
+        """(parameter overrides, start overrides) from one dict of dotted path
+        -> value. A name of a variable with a fixed start value (``m2.v``,
+        ``armature.mass.v``) sets that start value for this run: start values
+        are runtime values, like parameters (the initialisation imposes them
+        by name; nothing is regenerated). Other names are left to
+        :meth:`param_vector`, which checks them as parameters."""
+        params, starts = {}, {}
+        free = {e.name for e in self.params}
+        for name, value in (overrides or {}).items():
+            info = self.flat.variables.get(name)
+            if name in free or info is None:
+                params[name] = value
+                continue
+            if not info.start.fixed:
+                raise ParameterError(
+                    f"{name} is a variable whose start value is only a guess (not fixed), "
+                    "so it cannot be set; fixed start values and parameters can")
+            value = float(value)
+            if not np.isfinite(value):
+                raise ParameterError(f"start value {name} = {value} is not finite [{info.unit}]")
+            starts[name] = value
+        return params, starts
+
     def _eval_start(self, value, p):
         """A start value, which may be an expression of parameters."""
         if isinstance(value, sp.Basic) and not value.is_number:
@@ -214,22 +238,36 @@ class CompiledModel:
             self._slot_names = names
         return names
 
-    def fixed_starts(self, p):
-        """(index in var_names, value, name) of every fixed start value."""
+    def fixed_starts(self, p, starts=None):
+        """(index in var_names, value, name) of every fixed start value;
+        ``starts`` (name -> value, see :meth:`split_overrides`) replaces the
+        declared ones."""
+        starts = starts or {}
         out = []
         for k, name in enumerate(self.var_names):
             st = self.flat.variables[name].start
             if st.fixed:
-                out.append((k, self._eval_start(st.value, p), name))
+                value = starts[name] if name in starts else self._eval_start(st.value, p)
+                out.append((k, float(value), name))
         return out
 
-    def guess_vector(self, p):
-        """Initial guess of y from the start values of the variables."""
+    def guess_vector(self, p, starts=None):
+        """Initial guess of y from the start values of the variables (with
+        the overridden ``starts``, also where they reach a slot through an
+        alias ``x = sign*root + off``)."""
+        starts = starts or {}
         y = np.zeros(len(self.dae.y))
         for i, s in enumerate(self.dae.y):
             base, k = base_and_order(s)
             info = self.flat.variables.get(base.name)
-            if k == 0 and info is not None:
+            if k != 0 or info is None:
+                continue
+            via = self._root_via.get(base)
+            if base.name in starts:
+                y[i] = starts[base.name]
+            elif via is not None and via[0] in starts:
+                y[i] = (starts[via[0]] - self._eval_start(via[2], p)) / via[1]
+            else:
                 st = self._root_starts.get(base, info.start)
                 y[i] = self._eval_start(st.value, p)
         return y
@@ -254,7 +292,8 @@ class CompiledModel:
 
 def _alias_starts(flat, red):
     """Start values given on variables eliminated as aliases, carried to the
-    variable that stays (``root``): root symbol -> :class:`Start`.
+    variable that stays (``root``): (root symbol -> :class:`Start`, root
+    symbol -> (alias name, sign, offset) of the alias it was taken from).
 
     A root without a fixed start takes the fixed start of an alias (first by
     name), else, if its own start is a zero guess, the first non-zero guess
@@ -272,20 +311,22 @@ def _alias_starts(flat, red):
         if sign not in (1, -1):
             continue
         groups.setdefault(r, []).append((x, sign, expr - sign * r))
-    out = {}
+    out, via = {}, {}
     for r, members in groups.items():
         own = flat.variables[r.name].start
         if own.fixed:
             continue
         members.sort(key=lambda m: m[0].name)
-        starts = [(flat.variables[x.name].start, sign, off) for x, sign, off in members]
+        starts = [(flat.variables[x.name].start, sign, off, x.name)
+                  for x, sign, off in members]
         pick = next((m for m in starts if m[0].fixed), None)
         if pick is None and _is_zero(own.value):
             pick = next((m for m in starts if not _is_zero(m[0].value)), None)
         if pick is not None:
-            st, sign, off = pick
+            st, sign, off, name = pick
             out[r] = Start((sp.sympify(st.value) - off) / sign, st.fixed)
-    return out
+            via[r] = (name, float(sign), off)
+    return out, via
 
 
 def _is_zero(v):

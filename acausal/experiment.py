@@ -1,8 +1,11 @@
-"""What a model file may declare besides its model: how to run it.
+"""What a model file may declare besides its model: how to run it, and
+what to measure.
 
 ``experiment = Experiment(t_end=..., stop=Stop("hook.phi", ">=", "Ra"))``
+``measures = {"thrt": Measure(lambda res: ..., "s", display="ms")}``
 """
 from dataclasses import dataclass, field
+from typing import Callable, Optional
 
 import sympy as sp
 
@@ -61,9 +64,50 @@ class Experiment:
     atol_algebraic: float = None   # see acausal.simulate.simulate
     stop: Stop = None
     options: dict = field(default_factory=dict)
+    dense_step: float = None
 
-    def run_options(self):
+    def run_options(self, dense=False):
+        """Keyword arguments of ``simulate``. ``output_step`` gives the output
+        of every run (0: the solver's internal steps plus both sides of every
+        event, all that event-based measures need); ``dense_step``, when set,
+        is the output grid of a run that needs a dense time series (a plot, a
+        CSV, samples compared with a measured trace): ``dense=True``. The
+        output times never change the solution (IDA interpolates them), only
+        the cost and what is stored."""
+        step = self.dense_step if dense and self.dense_step is not None else self.output_step
         return dict(t_end=self.t_end, t0=self.t0, rtol=self.rtol, atol=self.atol,
-                    output_step=self.output_step, max_step=self.max_step,
+                    output_step=step, max_step=self.max_step,
                     **({} if self.atol_algebraic is None
                        else {"atol_algebraic": self.atol_algebraic}))
+
+
+@dataclass(frozen=True)
+class Measure:
+    """A scalar computed from a result, with its unit: ``fn(result)`` returns
+    the value in the SI unit ``unit``; ``display`` is the unit it is printed
+    in (default: ``unit``), e.g. ``Measure(thrt, "s", display="ms")``.
+    A model file's ``measures`` may also hold plain functions (no unit)."""
+
+    fn: Callable
+    unit: str = "1"
+    display: Optional[str] = None
+    desc: str = ""
+
+    def __call__(self, result):
+        return self.fn(result)
+
+    def shown(self, value):
+        """(value in the display unit, display unit)."""
+        if not self.display or self.display == self.unit:
+            return value, self.unit
+        return value * unit_factor(self.unit, self.display), self.display
+
+
+def unit_factor(unit, target):
+    """The factor taking a value in ``unit`` to ``target`` (pint; raises a
+    ModelError naming both when the dimensions differ)."""
+    from .data.units import parse_unit
+    try:
+        return float((1.0 * parse_unit(unit)).to(parse_unit(target)).magnitude)
+    except Exception as exc:   # pint: undefined unit, dimensionality error
+        raise ModelError(f"cannot show a value in [{unit}] in [{target}]: {exc}") from None

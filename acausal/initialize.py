@@ -24,12 +24,13 @@ def _jacobians(cb, t, y, yp, n):
     return Jy, Jyp
 
 
-def initial_point(cm, p, d, cb, t0):
-    """Return (y0, yp0) consistent with the model and its fixed starts."""
+def initial_point(cm, p, d, cb, t0, starts=None):
+    """Return (y0, yp0) consistent with the model and its fixed starts
+    (``starts``: name -> value overriding declared fixed start values)."""
     dae = cm.dae
     n, ns = len(dae.y), dae.n_states
-    fixed = cm.fixed_starts(p)           # list of (var index, value, name)
-    y0 = cm.guess_vector(p)
+    fixed = cm.fixed_starts(p, starts)   # list of (var index, value, name)
+    y0 = cm.guess_vector(p, starts)
     # start Newton at the fixed start values of the states (a fixed velocity
     # is the value of the slot der(x), which the guess vector leaves at 0): a
     # steep law near 0 (regularised friction) can stall it far from them

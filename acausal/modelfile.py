@@ -3,7 +3,9 @@
 A model file binds a :class:`~acausal.Model` to the module-level name
 ``model``; it may define ``experiment`` (an :class:`~acausal.Experiment`),
 ``measures``, a dict of name -> function(result) -> float (a scalar
-computed from a result, such as a response time), ``free_parameters``, a
+computed from a result, such as a response time, in SI units; a
+:class:`~acausal.Measure` also gives its unit and the unit it is printed
+in), ``free_parameters``, a
 dict of parameter -> (low, high) that calibration and diagnosis may fit,
 and ``plot(result, path)``. A model file can import
 another one (``from breaker_24kv import build``): its folder is on the path.
@@ -17,7 +19,7 @@ from dataclasses import dataclass, field
 from .compile import compile_model
 from .component import Model
 from .errors import AcausalError, ModelFileError
-from .experiment import Experiment
+from .experiment import Experiment, Measure
 
 
 @dataclass
@@ -108,6 +110,22 @@ def evaluate_measures(mf, result):
             raise ModelFileError(f"{mf.path}: measure {name!r} failed: "
                                  f"{type(exc).__name__}: {exc}") from None
     return out
+
+
+def measure_unit(mf, name):
+    """The SI unit a measure declares (a :class:`~acausal.Measure`), or None."""
+    fn = mf.measures.get(name)
+    return fn.unit if isinstance(fn, Measure) else None
+
+
+def show_measure(mf, name, value):
+    """``value`` (SI) as text in the measure's display unit: ``'1.89987 ms'``
+    (a measure without a declared unit: the bare number)."""
+    fn = mf.measures.get(name)
+    if not isinstance(fn, Measure):
+        return f"{value:.6g}"
+    v, unit = fn.shown(value)
+    return f"{v:.6g} {unit}" if unit != "1" else f"{v:.6g}"
 
 
 def run_file(path, params=None, **overrides):

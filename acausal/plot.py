@@ -5,11 +5,28 @@ matplotlib.use("Agg", force=False)
 from matplotlib.figure import Figure  # noqa: E402
 
 
+MAX_PANELS = 8
+
+
+def state_variables(cm, limit=MAX_PANELS):
+    """Names of the model's states as the user declared them: for each state
+    slot of the solver the first variable that is (up to sign) that slot
+    (``armature.mass.v`` for the slot ``der(armature.mass.s)``), at most
+    ``limit`` of them."""
+    names = []
+    for slot in cm.slot_names()[:cm.dae.n_states]:
+        declared = [n for n in slot if n in cm.flat.variables]
+        if declared:
+            names.append(declared[0])
+    return names[:limit]
+
+
 def plot_result(res, names, path=None, title=None, scales=None, labels=None, marks=None):
     """One panel per variable in ``names`` (time in ms when the run is
     shorter than 0.1 s). ``scales``: name -> factor (e.g. rad -> deg);
     ``labels``: name -> axis label; ``marks``: list of (t, text) drawn as
-    vertical lines. Returns the figure; writes it to ``path`` if given."""
+    vertical lines. A panel without a label is labelled with the variable's
+    name and unit. Returns the figure; writes it to ``path`` if given."""
     t = res.t
     ms = (t[-1] - t[0]) < 0.1
     tt = t * 1e3 if ms else t
@@ -18,7 +35,8 @@ def plot_result(res, names, path=None, title=None, scales=None, labels=None, mar
     for ax, name in zip(axes, names):
         y = res[name] * (scales or {}).get(name, 1.0)
         ax.plot(tt, y, lw=1.2)
-        ax.set_ylabel((labels or {}).get(name, name), fontsize=8)
+        ax.set_ylabel((labels or {}).get(name) or _label(res, name, (scales or {}).get(name)),
+                      fontsize=8)
         ax.grid(alpha=0.3)
         for tm, text in marks or []:
             x = tm * 1e3 if ms else tm
@@ -35,3 +53,12 @@ def plot_result(res, names, path=None, title=None, scales=None, labels=None, mar
     if path:
         fig.savefig(path, dpi=120)
     return fig
+
+
+def _label(res, name, scale):
+    """``name [unit]`` (``name [unit x scale]`` when the panel is scaled)."""
+    try:
+        unit = res.unit(name)
+    except KeyError:
+        return name
+    return f"{name} [{unit}]" if scale in (None, 1.0) else f"{name} [{unit} x {scale:g}]"

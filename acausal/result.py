@@ -87,21 +87,41 @@ class Result:
         """Linear interpolation of a variable at time ``t``."""
         return float(np.interp(t, self.t, self[name]))
 
+    def unit(self, name):
+        """The declared unit of a variable, discrete value or parameter
+        (``"s"`` for time); the values in the result are in this unit."""
+        cm = self.model
+        if name in ("time", "t"):
+            return "s"
+        info = cm.flat.variables.get(name)
+        if info is not None:
+            return info.unit
+        for dsc in cm.discretes:
+            if dsc.symbol.name == name:
+                return dsc.unit
+        for prm in cm.params:
+            if prm.name == name:
+                return prm.unit
+        raise KeyError(f"no variable {name!r} in the result")
+
     # -- export --------------------------------------------------------------------
     def to_csv(self, path, names=None):
+        """Write ``names`` (default: every variable and discrete value) as
+        columns after ``time``; headers carry units: ``hook.phi [rad]``."""
         names = names or self.names
         cols = [self[n] for n in names]
         with open(path, "w", newline="") as fh:
             w = csv.writer(fh)
-            w.writerow(["time"] + list(names))
+            w.writerow(["time [s]"] + [f"{n} [{self.unit(n)}]" for n in names])
             for k in range(len(self.t)):
                 w.writerow([repr(float(self.t[k]))] + [repr(float(c[k])) for c in cols])
         return path
 
-    def plot(self, names, path=None, title=None):
-        """Stacked panels, one per variable; marks events. Returns the figure."""
-        from .plot import plot_result
-        return plot_result(self, names, path, title)
+    def plot(self, names=None, path=None, title=None):
+        """Stacked panels, one per variable (default: the states), labelled
+        with their units. Returns the figure."""
+        from .plot import plot_result, state_variables
+        return plot_result(self, names or state_variables(self.model), path, title)
 
     def __repr__(self):
         return (f"<Result {len(self.t)} points, t = {self.t[0]:g}..{self.t[-1]:g}, "

@@ -178,7 +178,9 @@ class _Run:
 def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_step=None,
              output_times=None, max_step=None, max_steps=100000, atol_algebraic=None):
     """Simulate a :class:`CompiledModel` from ``t0`` to ``t_end`` (or until a
-    terminal event). ``params`` overrides parameter values by dotted path.
+    terminal event). ``params`` overrides parameter values, and the start
+    values of variables whose start is fixed, by dotted path (both are
+    runtime values: nothing is recompiled).
 
     ``atol`` applies to every unknown unless ``atol_algebraic`` is given: then
     the algebraic unknowns (forces, torques, dummy derivatives, constrained
@@ -192,13 +194,14 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
     scikit-sundae does not expose); their accuracy then follows from the
     states'. Default ``None``: ``atol`` for all, as before."""
     wall0 = _time.perf_counter()
+    params, starts = cm.split_overrides(params)
     p = cm.param_vector(params)
     d = cm.discrete_start()
     run = _Run(cm, p, t0, t_end, rtol, _atol_vector(cm, atol, atol_algebraic), max_step,
                max_steps)
     cb = cm.callbacks(p, d)
     run.cb_d = list(d)
-    y, yp = initial_point(cm, p, d, cb, t0)
+    y, yp = initial_point(cm, p, d, cb, t0, starts)
     y, yp, d, cb, stop = _event_iteration(run, cb, t0, y, yp, d, initial=True)
     tout = _output_times(t0, t_end, output_step, output_times)
     run.record(t0, y, yp, d)

@@ -20,7 +20,7 @@ event) and stops when the hook reaches its release angle. Measures:
 """
 import math
 
-from acausal import Experiment, Model, Stop, guess
+from acausal import Experiment, Measure, Model, Stop, guess
 from acausal.mechanics import contact as ct
 from acausal.mechanics.contact import Contact
 from acausal.mechanics.fourbar import FourBar, fourbar_angles
@@ -147,8 +147,17 @@ FREE_PARAMETERS = {"contact.K": (1e8, 1e10), "hook.bh": (0.0, 1.0)}
 def release_experiment(model, **options):
     """The run of this file and its variants: from first contact until the
     hook reaches its release angle Ra (the terminal event ``release``);
-    ``options`` add to or override the Experiment's settings."""
-    settings = dict(t_end=0.02, rtol=1e-8, atol=1e-11, output_step=2e-6,
+    ``options`` add to or override the Experiment's settings.
+
+    Output at the solver's internal steps and both sides of every event
+    (``output_step=0``): the measures are event times and event-located
+    values, which the output times do not change (the same THRT and contact
+    period to round-off as on a 2 us grid, tests/models/
+    test_breaker_output.py), at about half the cost. A plot or a CSV gets
+    the 2 us grid (``dense_step``). The absolute tolerance stays 1e-11 on
+    every unknown: per-variable tolerances (benchmarks/breaker_speed.py) are
+    faster still but move THRT by up to 5e-7 ms."""
+    settings = dict(t_end=0.02, rtol=1e-8, atol=1e-11, output_step=0, dense_step=2e-6,
                     stop=Stop(model.hook.phi, "<=", -model.Ra_sym, name="release"))
     settings.update(options)
     return Experiment(**settings)
@@ -160,10 +169,14 @@ def t_first_contact(res):
 
 # the measures of this file; the variants add their own to these
 MEASURES = {
-    "thrt": lambda res: res.event_times("release")[0] - t_first_contact(res),
-    "contact_period": lambda res: ct.contact_period(res, "contact"),
-    "peak_force": lambda res: ct.peak_force(res, "contact"),
-    "impact_velocity": lambda res: ct.impact_velocity(res, "contact"),
+    "thrt": Measure(lambda res: res.event_times("release")[0] - t_first_contact(res),
+                    "s", display="ms", desc="trigger hook response time"),
+    "contact_period": Measure(lambda res: ct.contact_period(res, "contact"), "s",
+                              display="ms", desc="duration of the first impact"),
+    "peak_force": Measure(lambda res: ct.peak_force(res, "contact"), "N",
+                          desc="largest contact force of the first impact (>= 0)"),
+    "impact_velocity": Measure(lambda res: ct.impact_velocity(res, "contact"), "m/s",
+                               desc="approach speed at the first contact"),
 }
 
 free_parameters = dict(FREE_PARAMETERS)
@@ -173,7 +186,14 @@ measures = dict(MEASURES)
 
 def plot(res, path):
     """The report's Fig. 7/10: impact force, hook angle, hook velocity and
-    armature velocity, with the contact period and THRT marked."""
+    armature velocity, with the contact period and THRT marked.
+
+    The force is the contact force ``contact.fc`` >= 0, the value the
+    ``peak_force`` measure reports (acausal/mechanics/contact.py: it pushes
+    the bodies apart). The report's figures draw it negative (the force on
+    the hook points along -s, docs/breaker_model.md section 1); the
+    velocities and the angle keep the report's signs, since they are signed
+    coordinates, not magnitudes."""
     import numpy as np
     from acausal.plot import plot_result
     t0 = t_first_contact(res)
@@ -182,10 +202,10 @@ def plot(res, path):
     s3 = float(res["hook.s3"][0])
     return plot_result(
         res, ["contact.fc", "hook.phi", "hook.body.w", "armature.mass.v"], path,
-        title=f"24 kV breaker, v_impact = {res['v_impact'][0]:.2f} m/s: contact "
+        title=f"24 kV breaker, v_impact = {ct.impact_velocity(res, 'contact'):.2f} m/s: contact "
               f"{(imp.t_release - t0) * 1e3:.3f} ms, THRT {(t_rel - t0) * 1e3:.3f} ms",
-        scales={"contact.fc": -1.0, "hook.phi": 180 / np.pi, "hook.body.w": s3},
-        labels={"contact.fc": "impact force [N]", "hook.phi": "hook angle [deg]",
+        scales={"hook.phi": 180 / np.pi, "hook.body.w": s3},
+        labels={"contact.fc": "contact force\n(>= 0) [N]", "hook.phi": "hook angle [deg]",
                 "hook.body.w": "hook velocity\nat s3 [m/s]",
                 "armature.mass.v": "armature\nvelocity [m/s]"},
         marks=[(imp.t_release, "contact end"), (t_rel, "release (THRT)")])

@@ -27,6 +27,7 @@ Run: ``acausal simulate models/breaker_24kv_light_hook.py --plot FILE``.
 from breaker_24kv import (BH_CAL, FREE_PARAMETERS, K_CAL, MEASURES, build,
                          release_experiment, t_first_contact)
 
+from acausal import Measure
 from acausal.mechanics import contact as ct
 
 JH_LIGHT = 0.30e-3     # [kg*m^2] base 0.44e-3
@@ -40,7 +41,8 @@ experiment = release_experiment(model)
 
 measures = {
     **MEASURES,
-    "n_impacts": lambda res: ct.n_impacts(res, "contact"),
+    "n_impacts": Measure(lambda res: ct.n_impacts(res, "contact"), "1",
+                         desc="impacts between armature and hook"),
 }
 
 
@@ -58,10 +60,10 @@ def plot(res, path):
     return plot_result(
         res, ["contact.fc", "hook.phi", "hook.body.w", "armature.mass.v"], path,
         title=f"light hook (Jh {JH_LIGHT * 1e3:.2f}e-3, kh {KH_STIFF:.0f} N/m), "
-              f"v_impact = {res['v_impact'][0]:.2f} m/s: {len(imp)} impact(s), "
+              f"v_impact = {ct.impact_velocity(res, 'contact'):.2f} m/s: {len(imp)} impact(s), "
               f"THRT {(t_rel - t0) * 1e3:.3f} ms",
-        scales={"contact.fc": -1.0, "hook.phi": 180 / np.pi, "hook.body.w": s3},
-        labels={"contact.fc": "impact force [N]", "hook.phi": "hook angle [deg]",
+        scales={"hook.phi": 180 / np.pi, "hook.body.w": s3},
+        labels={"contact.fc": "contact force\n(>= 0) [N]", "hook.phi": "hook angle [deg]",
                 "hook.body.w": "hook velocity\nat s3 [m/s]",
                 "armature.mass.v": "armature\nvelocity [m/s]"},
         marks=marks + [(t_rel, "release")])

@@ -29,7 +29,7 @@ import sympy as sp
 from breaker_24kv import (BH_CAL, FREE_PARAMETERS, GAP0, K_CAL, MEASURES, MainShaft,
                          THETA1_0, TriggerHook, release_experiment, t_first_contact)
 
-from acausal import Model, guess
+from acausal import Measure, Model, guess
 from acausal.mechanics import contact as ct
 from acausal.mechanics.contact import Contact
 from acausal.mechanics.fourbar import FourBar, fourbar_angles
@@ -102,7 +102,8 @@ experiment = release_experiment(model)
 
 measures = {
     **MEASURES,
-    "n_impacts": lambda res: ct.n_impacts(res, "contact"),
+    "n_impacts": Measure(lambda res: ct.n_impacts(res, "contact"), "1",
+                         desc="impacts between armature and hook"),
 }
 
 
@@ -121,11 +122,11 @@ def plot(res, path):
         res, ["contact.fc", "hook.phi", "hook.body.w", "armature.v", "armature.body.phi"],
         path,
         title=f"rotary armature (Ja {res['armature.Ja'][0]:.2e}, la "
-              f"{res['armature.la'][0] * 1e3:.0f} mm), v_impact = {res['v_impact'][0]:.2f} "
+              f"{res['armature.la'][0] * 1e3:.0f} mm), v_impact = {ct.impact_velocity(res, 'contact'):.2f} "
               f"m/s: {len(imp)} impact(s), THRT {(t_rel - t0) * 1e3:.3f} ms",
-        scales={"contact.fc": -1.0, "hook.phi": 180 / np.pi, "hook.body.w": s3,
+        scales={"hook.phi": 180 / np.pi, "hook.body.w": s3,
                 "armature.body.phi": 180 / np.pi},
-        labels={"contact.fc": "impact force [N]", "hook.phi": "hook angle [deg]",
+        labels={"contact.fc": "contact force\n(>= 0) [N]", "hook.phi": "hook angle [deg]",
                 "hook.body.w": "hook velocity\nat s3 [m/s]",
                 "armature.v": "pin velocity [m/s]",
                 "armature.body.phi": "clapper angle [deg]"},

@@ -33,7 +33,7 @@ import math
 from breaker_24kv import (Armature, BH_CAL, FREE_PARAMETERS, K_CAL, MEASURES, MainShaft,
                          THETA1_0, TriggerHook, release_experiment, t_first_contact)
 
-from acausal import Model, guess
+from acausal import Measure, Model, guess
 from acausal.mechanics import contact as ct
 from acausal.mechanics.contact import Contact
 from acausal.mechanics.fourbar import FourBar, fourbar_angles
@@ -112,9 +112,12 @@ experiment = release_experiment(model, atol_algebraic=1e-2)
 
 measures = {
     **MEASURES,
-    "latch_peak_force": lambda res: ct.peak_force(res, "latch_contact"),
-    "n_impacts": lambda res: ct.n_impacts(res, "contact"),
-    "n_latch_impacts": lambda res: ct.n_impacts(res, "latch_contact"),
+    "latch_peak_force": Measure(lambda res: ct.peak_force(res, "latch_contact"), "N",
+                                desc="largest lever/hook contact force (>= 0)"),
+    "n_impacts": Measure(lambda res: ct.n_impacts(res, "contact"), "1",
+                         desc="impacts between armature and hook"),
+    "n_latch_impacts": Measure(lambda res: ct.n_impacts(res, "latch_contact"), "1",
+                               desc="impacts between lever and hook"),
 }
 
 
@@ -131,12 +134,12 @@ def plot(res, path):
     return plot_result(
         res, ["contact.fc", "latch_contact.fc", "hook.phi", "hook.body.w",
               "trip_lever.body.w", "armature.mass.v"], path,
-        title=f"two-stage latch, v_impact = {res['v_impact'][0]:.2f} m/s: {n1} + {n2} "
+        title=f"two-stage latch, v_impact = {ct.impact_velocity(res, 'contact'):.2f} m/s: {n1} + {n2} "
               f"impacts, THRT {(t_rel - t0) * 1e3:.3f} ms",
-        scales={"contact.fc": -1.0, "latch_contact.fc": -1.0, "hook.phi": 180 / np.pi,
+        scales={"hook.phi": 180 / np.pi,
                 "hook.body.w": s3, "trip_lever.body.w": b1},
-        labels={"contact.fc": "armature/lever\nforce [N]",
-                "latch_contact.fc": "lever/hook\nforce [N]", "hook.phi": "hook angle [deg]",
+        labels={"contact.fc": "armature/lever\nforce (>= 0) [N]",
+                "latch_contact.fc": "lever/hook\nforce (>= 0) [N]", "hook.phi": "hook angle [deg]",
                 "hook.body.w": "hook velocity\nat s3 [m/s]",
                 "trip_lever.body.w": "lever velocity\nat b1 [m/s]",
                 "armature.mass.v": "armature\nvelocity [m/s]"},

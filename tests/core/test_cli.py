@@ -21,7 +21,8 @@ def test_simulate_json_oscillator_matches_closed_form():
     r = run("simulate", os.path.join(EX, "oscillator.py"), "--json")
     assert r.exit_code == 0, r.output
     out = json.loads(r.output)
-    assert set(out) == {"final", "events", "measures", "stats"}
+    assert set(out) == {"final", "events", "measures", "units", "stats"}
+    assert out["units"]["final"]["mass.s"] == "m" and out["units"]["time"] == "s"
     assert {"nfev", "steps", "wall_s", "compile_s"} <= set(out["stats"])
     exact = 0.1 * np.cos(10.0)
     assert abs(out["final"]["mass.s"] / exact - 1) < 1e-6
@@ -52,9 +53,9 @@ def test_set_writes_csv_and_plot(tmp_path):
             "--t-end", "0.5", "--out", csv, "--plot", png)
     assert r.exit_code == 0, r.output
     head = csv.read_text().splitlines()
-    assert head[0].startswith("time,") and "mass.s" in head[0]
+    assert head[0].startswith("time [s],") and "mass.s [m]" in head[0].split(",")
     last = dict(zip(head[0].split(","), map(float, head[-1].split(","))))
-    assert abs(last["mass.s"] - 0.1 * np.cos(20 * 0.5)) < 1e-6
+    assert abs(last["mass.s [m]"] - 0.1 * np.cos(20 * 0.5)) < 1e-6
     assert png.stat().st_size > 1000
 
 
