@@ -18,6 +18,7 @@ from .symbols import der, time
 __all__ = [
     "Component", "Model", "CompiledModel", "compile_model", "Flange", "RotFlange", "Port",
     "Parameter", "Variable", "Discrete", "Event", "Assertion", "Start", "guess", "der",
-    "time", "Eq", "Experiment", "Measure", "Stop", "AcausalError", "ModelError", "ParameterError", "StructuralError",
+    "time", "Eq", "Experiment", "Measure", "Stop", "AcausalError", "ModelError",
+    "ParameterError", "StructuralError",
     "InitializationError", "SolverError", "ChatteringError",
 ]

@@ -251,7 +251,10 @@ def residual_vector(path, dataset, params, signals=None, options=None):
     path = resolve(path)
     vec, labels, raw = [], [], {}
     for exp in dataset.experiments:
-        res, meas = simulate_experiment(path, params, exp.conditions, options)
+        opts = options
+        if exp.trace is not None:   # samples compared with a trace: the dense grid
+            opts = {**path[0].experiment.run_options(dense=True), **(options or {})}
+        res, meas = simulate_experiment(path, params, exp.conditions, opts)
         raw[exp.name] = {}
         for m, y in exp.measures.items():
             if signals and m not in signals:

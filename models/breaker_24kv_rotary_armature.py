@@ -122,8 +122,9 @@ def plot(res, path):
         res, ["contact.fc", "hook.phi", "hook.body.w", "armature.v", "armature.body.phi"],
         path,
         title=f"rotary armature (Ja {res['armature.Ja'][0]:.2e}, la "
-              f"{res['armature.la'][0] * 1e3:.0f} mm), v_impact = {ct.impact_velocity(res, 'contact'):.2f} "
-              f"m/s: {len(imp)} impact(s), THRT {(t_rel - t0) * 1e3:.3f} ms",
+              f"{res['armature.la'][0] * 1e3:.0f} mm), "
+              f"v_impact = {ct.impact_velocity(res, 'contact'):.2f} m/s: {len(imp)} impact(s), "
+              f"THRT {(t_rel - t0) * 1e3:.3f} ms",
         scales={"hook.phi": 180 / np.pi, "hook.body.w": s3,
                 "armature.body.phi": 180 / np.pi},
         labels={"contact.fc": "contact force\n(>= 0) [N]", "hook.phi": "hook angle [deg]",

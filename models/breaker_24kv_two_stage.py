@@ -134,8 +134,8 @@ def plot(res, path):
     return plot_result(
         res, ["contact.fc", "latch_contact.fc", "hook.phi", "hook.body.w",
               "trip_lever.body.w", "armature.mass.v"], path,
-        title=f"two-stage latch, v_impact = {ct.impact_velocity(res, 'contact'):.2f} m/s: {n1} + {n2} "
-              f"impacts, THRT {(t_rel - t0) * 1e3:.3f} ms",
+        title=f"two-stage latch, v_impact = {ct.impact_velocity(res, 'contact'):.2f} m/s: "
+              f"{n1} + {n2} impacts, THRT {(t_rel - t0) * 1e3:.3f} ms",
         scales={"hook.phi": 180 / np.pi,
                 "hook.body.w": s3, "trip_lever.body.w": b1},
         labels={"contact.fc": "armature/lever\nforce (>= 0) [N]",

@@ -672,7 +672,7 @@ def nominal_result(path):
     if key not in _NOMINAL:
         try:
             mf, cm = compile_file(apath)
-            _NOMINAL[key] = cm.simulate(**mf.experiment.run_options())
+            _NOMINAL[key] = cm.simulate(**mf.experiment.run_options(dense=True))
         except AcausalError:
             _NOMINAL[key] = None
     return _NOMINAL[key]

@@ -20,7 +20,7 @@ def _simulate_all(pair, ds, values):
     for e in ds.experiments:
         try:
             out[e.name] = cm.simulate(params={**values, **e.conditions},
-                                      **mf.experiment.run_options())
+                                      **mf.experiment.run_options(dense=True))
         except AcausalError:
             out[e.name] = None
     return out

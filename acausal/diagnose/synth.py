@@ -64,7 +64,7 @@ def _simulate(pair, params, conds):
     mf, cm = pair
     out = []
     for c in conds:
-        res = cm.simulate(params={**params, **c}, **mf.experiment.run_options())
+        res = cm.simulate(params={**params, **c}, **mf.experiment.run_options(dense=True))
         out.append((res, evaluate_measures(mf, res) if mf.measures else {}))
     return out
 
