@@ -46,7 +46,7 @@ class Topology:
 
 
 @st.composite
-def topologies(draw, max_clusters=3, max_springs=3):
+def topologies(draw, max_clusters=2, max_springs=3):
     kinds = tuple(draw(st.lists(st.sampled_from(KINDS), min_size=1, max_size=max_clusters)))
     n = sum(N_POINTS[k] for k in kinds)
     ends = st.tuples(st.integers(GROUND, n - 1), st.integers(0, n - 1)).filter(
