@@ -123,7 +123,7 @@ def variables(file):
         click.echo(f"  {name:32s} = {val!r:<12} (structural)")
     for name, val in cm.bound.items():
         click.echo(f"  {name:32s} = {val} (bound)")
-    click.echo("VARIABLES")
+    click.echo("VARIABLES (a fixed start value is settable with --set)")
     states = {s.name for s in cm.dae.y[:cm.dae.n_states]}
     for name in cm.var_names:
         info = cm.flat.variables[name]
