@@ -21,7 +21,7 @@ hook turns to the release angle Ra = 5 deg.
 """
 import math
 
-from acausal import Experiment, Model, Stop
+from acausal import Experiment, Measure, Model, Stop
 from acausal.mechanics.fourbar import FourBar, fourbar_angles
 from acausal.mechanics.rotational import Fixed, Inertia, TorsionSpring
 
@@ -55,9 +55,9 @@ def _released_at(res):
 
 
 measures = {
-    "t_release_s": _released_at,
-    "theta3_at_release_rad": lambda res: res.final()["shaft.phi"],
-    "max_abs_ratio": lambda res: max(abs(res["cam.ratio"])),
-    "Fc_start_N": lambda res: res["cam.Fc"][0],
-    "hook_w_at_release": lambda res: res.final()["hook.w"],
+    "t_release_s": Measure(_released_at, "s", display="ms"),
+    "theta3_at_release_rad": Measure(lambda res: res.final()["shaft.phi"], "rad"),
+    "max_abs_ratio": Measure(lambda res: max(abs(res["cam.ratio"])), "1"),
+    "Fc_start_N": Measure(lambda res: res["cam.Fc"][0], "N"),
+    "hook_w_at_release": Measure(lambda res: res.final()["hook.w"], "rad/s"),
 }

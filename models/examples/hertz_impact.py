@@ -6,7 +6,7 @@ delta_max = (5 m v0^2 / (4 K))^(2/5) (t_c = 0.321807 ms here; the constant is
 (4/5) B(2/5, 1/2)); the mass leaves at -1 m/s; the peak force is
 K delta_max^1.5 = 1143.26 N. The mass starts 0.1 mm from the wall.
 """
-from acausal import Experiment, Model
+from acausal import Experiment, Measure, Model
 from acausal.mechanics.contact import Contact, contact_period, peak_force, restitution
 from acausal.mechanics.translational import Fixed, Mass
 
@@ -20,8 +20,8 @@ model.connect(model.contact.flange_b, model.wall.flange)
 experiment = Experiment(t_end=6e-4, rtol=1e-10, atol=1e-14, output_step=1e-6)
 
 measures = {
-    "contact_period": lambda res: contact_period(res, "contact"),
-    "rebound_velocity": lambda res: -res.final()["mass.v"],
-    "restitution": lambda res: restitution(res, "contact"),
-    "peak_force": lambda res: peak_force(res, "contact"),
+    "contact_period": Measure(lambda res: contact_period(res, "contact"), "s", display="ms"),
+    "rebound_velocity": Measure(lambda res: -res.final()["mass.v"], "m/s"),
+    "restitution": Measure(lambda res: restitution(res, "contact"), "1"),
+    "peak_force": Measure(lambda res: peak_force(res, "contact"), "N"),
 }

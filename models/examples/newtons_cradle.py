@@ -16,7 +16,7 @@ binary exchanges and the last ball leaves with exactly v0.
 import math
 import os
 
-from acausal import Experiment, Model
+from acausal import Experiment, Measure, Model
 from acausal.mechanics.contact import Contact, hertz_stiffness
 from acausal.mechanics.translational import Mass
 
@@ -59,9 +59,10 @@ model = build(N)
 experiment = Experiment(t_end=3e-3, rtol=1e-10, atol=1e-13, output_step=1e-5)
 
 measures = {
-    "momentum_error": lambda res: float(abs(momentum(res) - M * V0).max() / (M * V0)),
-    "energy_error": lambda res: float(abs(energy(res)[-1] - 0.5 * M * V0 ** 2)
-                                      / (0.5 * M * V0 ** 2)),
-    "v_last": lambda res: res.final()[f"ball{N - 1}.v"],
-    "v_first": lambda res: res.final()["ball0.v"],
+    "momentum_error": Measure(lambda res: float(abs(momentum(res) - M * V0).max() / (M * V0)),
+                              "1"),
+    "energy_error": Measure(lambda res: float(abs(energy(res)[-1] - 0.5 * M * V0 ** 2)
+                                              / (0.5 * M * V0 ** 2)), "1"),
+    "v_last": Measure(lambda res: res.final()[f"ball{N - 1}.v"], "m/s"),
+    "v_first": Measure(lambda res: res.final()["ball0.v"], "m/s"),
 }

@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from acausal import Experiment, Model, time
+from acausal import Experiment, Measure, Model, time
 from acausal.mechanics.friction import GroundFriction
 from acausal.mechanics.translational import Mass, Position, Spring
 
@@ -72,9 +72,9 @@ def _slip(res):
 
 
 measures = {
-    "period": _period,                      # stick-slip period [s]
-    "dwell": _dwell,                        # time stuck per cycle [s]
-    "slip_time": _slip,                     # time sliding per cycle [s]
-    "first_break": lambda res: float(_times(res, "break_forward")[0]),
-    "max_speed": lambda res: float(np.max(res["block.v"])),   # [m/s]
+    "period": Measure(_period, "s", desc="stick-slip period"),
+    "dwell": Measure(_dwell, "s", desc="time stuck per cycle"),
+    "slip_time": Measure(_slip, "s", desc="time sliding per cycle"),
+    "first_break": Measure(lambda res: float(_times(res, "break_forward")[0]), "s"),
+    "max_speed": Measure(lambda res: float(np.max(res["block.v"])), "m/s"),
 }
