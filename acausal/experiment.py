@@ -52,8 +52,10 @@ class Stop:
 
 @dataclass
 class Experiment:
-    """How to simulate a model: time span, tolerances, output step, and an
-    optional terminal :class:`Stop` condition."""
+    """How to simulate a model: time span, tolerances, output step (0: the
+    solver's internal steps and events; None: 500 intervals), the output
+    step of runs that need a dense time series (``dense_step``, see
+    :meth:`run_options`), and an optional terminal :class:`Stop` condition."""
 
     t_end: float = 1.0
     t0: float = 0.0
