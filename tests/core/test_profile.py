@@ -1,0 +1,120 @@
+"""Profile-likelihood intervals (acausal.profile) against closed forms and a
+brute-force grid."""
+import numpy as np
+import pytest
+from scipy import stats
+
+from acausal.profile import profile_likelihood, threshold
+
+Q95 = stats.chi2.ppf(0.95, 1)
+
+
+def _quadratic_data(seed=3, sigma=0.2):
+    rng = np.random.default_rng(seed)
+    t = np.linspace(0.0, 2.0, 15)
+    X = np.column_stack([np.ones_like(t), t, t ** 2])
+    y = X @ np.array([1.0, -0.5, 0.3]) + sigma * rng.standard_normal(t.size)
+    return X, y, sigma
+
+
+@pytest.mark.parametrize("index", [0, 1, 2])
+def test_linear_model_profile_equals_closed_form_wald(index):
+    X, y, sigma = _quadratic_data()
+    beta = np.linalg.lstsq(X, y, rcond=None)[0]
+    sd = sigma * np.sqrt(np.diag(np.linalg.inv(X.T @ X)))
+    p = profile_likelihood(lambda b: (X @ b - y) / sigma, beta, index)
+    half = np.sqrt(Q95) * sd[index]
+    assert p.lower == pytest.approx(beta[index] - half, abs=1e-4 * half)
+    assert p.upper == pytest.approx(beta[index] + half, abs=1e-4 * half)
+    assert p.wald[0] == pytest.approx(beta[index] - half, abs=1e-4 * half)
+    assert not (p.open_lower or p.open_upper)
+    assert p.trustworthy
+    # every traced point lies on the exact quadratic profile
+    expected = ((p.values - beta[index]) / sd[index]) ** 2
+    np.testing.assert_allclose(p.delta_chi2, expected, atol=1e-6)
+
+
+def test_linear_model_with_estimated_noise_is_the_student_t_interval():
+    X, y, _ = _quadratic_data(seed=5)
+    n, k = X.shape
+    beta = np.linalg.lstsq(X, y, rcond=None)[0]
+    r = X @ beta - y
+    s2 = float(r @ r) / (n - k)        # unit weights: the noise is estimated
+    sd = np.sqrt(s2 * np.diag(np.linalg.inv(X.T @ X)))
+    p = profile_likelihood(lambda b: X @ b - y, beta, 1, dispersion=s2, dof=n - k)
+    half = stats.t.ppf(0.975, n - k) * sd[1]
+    assert p.threshold == pytest.approx(threshold(0.95, s2, n - k))
+    assert (p.lower, p.upper) == pytest.approx((beta[1] - half, beta[1] + half), abs=1e-4 * half)
+
+
+def _decay(sigma, seed=1):
+    rng = np.random.default_rng(seed)
+    t = np.linspace(0.0, 1.0, 8)
+    y = 1.0 * np.exp(-3.0 * t) + sigma * rng.standard_normal(t.size)
+    return t, y
+
+
+def _brute_force_interval(t, y, sigma):
+    """k on a fine grid, the amplitude at its exact optimum for each k."""
+    ks = np.linspace(0.5, 12.0, 230001)
+    E = np.exp(-np.outer(ks, t))
+    amp = (E @ y) / np.einsum("ij,ij->i", E, E)
+    chi = (((amp[:, None] * E - y) / sigma) ** 2).sum(axis=1)
+    inside = ks[chi - chi.min() <= Q95]
+    return inside.min(), inside.max(), ks[1] - ks[0]
+
+
+def test_exponential_rate_gives_asymmetric_interval_matching_a_grid():
+    from scipy import optimize
+    t, y = _decay(0.15)
+    sigma = 0.15
+
+    def res(x):
+        return (x[0] * np.exp(-x[1] * t) - y) / sigma
+    opt = optimize.least_squares(res, [1.0, 1.0], xtol=1e-14, ftol=1e-14, gtol=1e-14).x
+    p = profile_likelihood(res, opt, 1, bounds=([0.0, 0.0], [np.inf, np.inf]), name="k")
+    lo, hi, step = _brute_force_interval(t, y, sigma)
+    assert p.lower == pytest.approx(lo, abs=2 * step)
+    assert p.upper == pytest.approx(hi, abs=2 * step)
+    # clearly asymmetric: the upper side is much longer, so the Wald interval
+    # (symmetric) is not trustworthy
+    assert (p.upper - p.estimate) > 1.3 * (p.estimate - p.lower)
+    assert not p.trustworthy
+    assert p.wald[1] < hi - 0.2       # the linearised interval misses the upper end
+
+
+def test_one_over_p_parameter_profile_on_log_scale_matches_grid():
+    """y = 1 / (1 + t / tau): tau profiled on its logarithm."""
+    rng = np.random.default_rng(7)
+    t = np.linspace(0.0, 3.0, 10)
+    sigma = 0.05
+    y = 1.0 / (1.0 + t / 0.8) + sigma * rng.standard_normal(t.size)
+
+    def res(x):
+        return (1.0 / (1.0 + t / x[0]) - y) / sigma
+    taus = np.exp(np.linspace(np.log(0.2), np.log(5.0), 400001))
+    chi = (((1.0 / (1.0 + np.outer(1.0 / taus, t)) - y) / sigma) ** 2).sum(axis=1)
+    best = taus[chi.argmin()]
+    inside = taus[chi - chi.min() <= Q95]
+    p = profile_likelihood(res, [best], 0, bounds=([1e-6], [np.inf]), log=True)
+    assert p.lower == pytest.approx(inside.min(), rel=1e-4)
+    assert p.upper == pytest.approx(inside.max(), rel=1e-4)
+
+
+def test_unidentifiable_parameter_gives_open_profile():
+    rng = np.random.default_rng(2)
+    t = np.linspace(0.0, 1.0, 12)
+    y = 2.0 * t + 0.1 * rng.standard_normal(t.size)
+    # only the product a*b is identifiable: the profile of a is flat to its bounds
+    prod = float(t @ y / (t @ t))       # the least-squares product
+    p = profile_likelihood(lambda x: (x[0] * x[1] * t - y) / 0.1, [1.0, prod], 0,
+                           bounds=([0.1, 0.01], [10.0, 100.0]), log=True)
+    assert p.open_lower and p.open_upper
+    assert (p.lower, p.upper) == pytest.approx((0.1, 10.0))
+    assert not p.trustworthy
+    assert np.all(np.abs(p.delta_chi2) < 0.05 * p.threshold)
+    # without bounds the open ends are None
+    q = profile_likelihood(lambda x: ((x[0] + x[1]) * t - y) / 0.1, [1.0, prod - 1.0], 0,
+                           max_points=25)
+    assert q.lower is None and q.upper is None and q.open_lower and q.open_upper
+    assert q.to_dict()["lower"] is None
