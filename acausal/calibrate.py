@@ -130,10 +130,12 @@ class Calibration:
     dof: int = None
     n_sim: int = 0
     validation: dict = field(default_factory=dict)  # held-back experiment -> residuals
+    profile_ci95: dict = field(default_factory=dict)  # name -> acausal.profile.Profile
 
     def to_dict(self):
         return dict(method=self.method, values=self.values,
                     ci95={k: list(v) for k, v in self.ci95.items()},
+                    profile_ci95={k: p.to_dict() for k, p in self.profile_ci95.items()},
                     correlation=None if self.correlation is None else self.correlation.tolist(),
                     residuals=self.residuals, cost=self.cost, dof=self.dof, n_sim=self.n_sim,
                     validation=self.validation)
@@ -254,7 +256,7 @@ def _sigma(dataset, signal, values):
     return s
 
 
-def least_squares(path, dataset, names, bounds=None, x0=None, signals=None):
+def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, profile="none"):
     """Output-error least squares over parameters ``names``.
 
     Bounds come from ``bounds``, else the model file's ``free_parameters``,
@@ -262,7 +264,12 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None):
     positive is fitted on its logarithm, so its 95 % interval is asymmetric
     and never crosses zero. Intervals use the Jacobian at the optimum, scaled
     by the reduced chi-square when it exceeds 1 (never narrower than the
-    instrument model says), with Student t quantiles."""
+    instrument model says), with Student t quantiles.
+
+    ``profile``: "auto" adds profile-likelihood intervals
+    (:mod:`acausal.profile`, ``Calibration.profile_ci95``) for the parameters
+    whose linearised interval fails :func:`acausal.profile.linear_check`;
+    "all" for every fitted parameter; "none" (default) for none."""
     path = resolve(path)
     mf, cm = path
     entries = [cm.params[cm.param_index(n)] for n in names]
@@ -325,8 +332,33 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None):
     except np.linalg.LinAlgError:
         ci = {n: (float("nan"), float("nan")) for n in names}
     raw = residual_vector(path, dataset, values, signals)[2]
-    return Calibration("least_squares", values, ci, corr, raw, float(2 * sol.cost), dof,
-                       n_sim[0])
+    out = Calibration("least_squares", values, ci, corr, raw, float(2 * sol.cost), dof,
+                      n_sim[0])
+    if profile != "none" and names:
+        fit = dict(x=xs, jac=sol.jac, lo=lo, hi=hi, log=logp, scale=scale, dof=dof,
+                   dispersion=max(2 * sol.cost / dof, 1.0) if dof > 0 else 1.0)
+        out.profile_ci95 = _profiles(lambda x: fun(to_z(x)), names, fit, profile == "all")
+        out.n_sim = n_sim[0]
+    return out
+
+
+def _profiles(residuals, names, fit, every):
+    """name -> Profile for the fitted parameters (all of them when ``every``,
+    else those whose linearised interval fails the linear check). The profile
+    works in the fit's own variables (log for a positive range, value/scale
+    otherwise), so its Wald interval is the one of :func:`least_squares`."""
+    from .profile import linear_check, profile_likelihood, threshold
+    thr = threshold(0.95, fit["dispersion"], fit["dof"] or None)
+    common = dict(log=fit["log"], scale=fit["scale"], bounds=(fit["lo"], fit["hi"]))
+    out = {}
+    for k, name in enumerate(names):
+        if not every and linear_check(residuals, fit["x"], k, thresh=thr, jacobian=fit["jac"],
+                                      fd_step=FD_STEP, **common)[0]:
+            continue
+        out[name] = profile_likelihood(residuals, fit["x"], k, dispersion=fit["dispersion"],
+                                       dof=fit["dof"] or None, name=name, fd_step=FD_STEP,
+                                       jacobian=fit["jac"], inner_max_nfev=20, **common)
+    return out
 
 
 def check_names(cm, names):

@@ -301,3 +301,43 @@ def _assemble(obj, sides, hw, thr, level, chi0, name, rel_tol) -> Profile:
         trust = False
     return Profile(name or f"x[{i}]", i, float(c.x0[i]), ends[0], ends[1], open_lo, open_hi,
                    wald, bool(trust), thr, level, full[:, i], d, full, obj.n, "; ".join(msgs))
+
+
+def linear_check(residuals: Residuals, x_opt: Sequence[float], index: int, *,
+                 log: bool | Sequence[bool] = False, scale: Sequence[float] | None = None,
+                 bounds: tuple | None = None, thresh: float = 3.84, jacobian=None,
+                 fd_step: float = 1e-6, band: float = 0.25) -> tuple:
+    """A cheap screen for a Wald interval (two evaluations): (ok, ratios).
+
+    At both ends of the Wald interval of parameter ``index``, moves the
+    others along the linearised profile path (the least-squares response of
+    the others to the change of x_index, from the Jacobian) and compares the
+    actual delta chi^2 there with ``thresh``, which it equals for a model
+    linear in its parameters. ``ok`` is False when either ratio falls outside
+    [1 - band, 1 / (1 - band)], when an end lies beyond a bound, or when the
+    Jacobian cannot determine the parameter: then trace the profile."""
+    c = _Coords(x_opt, log, scale, bounds)
+    k = c.x0.size
+    if jacobian is None:
+        fd = ForwardDifferences(lambda u: residuals(c.to_x(u)), fd_step, np.full(k, np.inf))
+        jacobian = fd.jac(np.zeros(k))
+    hw = float(wald_halfwidths(residuals, x_opt, log=log, scale=scale, thresh=thresh,
+                               jacobian=jacobian)[index])
+    if not np.isfinite(hw):
+        return False, (np.nan, np.nan)
+    others = [j for j in range(k) if j != index]
+    path = np.zeros(k)
+    path[index] = 1.0
+    if others:
+        Jo = jacobian[:, others]
+        path[others] = -np.linalg.lstsq(Jo, jacobian[:, index], rcond=None)[0]
+    r0 = np.asarray(residuals(c.x0), float)
+    ratios = []
+    for s in (-1.0, 1.0):
+        u = s * hw * path
+        if np.any(u < c.lo) or np.any(u > c.hi):
+            return False, (np.nan, np.nan)
+        r = np.asarray(residuals(c.to_x(u)), float)
+        ratios.append(float((r @ r - r0 @ r0) / thresh))
+    ok = all(1 - band <= q <= 1 / (1 - band) for q in ratios)
+    return bool(ok), tuple(ratios)

@@ -118,3 +118,19 @@ def test_unidentifiable_parameter_gives_open_profile():
                            max_points=25)
     assert q.lower is None and q.upper is None and q.open_lower and q.open_upper
     assert q.to_dict()["lower"] is None
+
+
+def test_linear_check_accepts_linear_and_rejects_asymmetric():
+    from acausal.profile import linear_check
+    from scipy import optimize
+    X, y, sigma = _quadratic_data()
+    beta = np.linalg.lstsq(X, y, rcond=None)[0]
+    ok, ratios = linear_check(lambda b: (X @ b - y) / sigma, beta, 1, thresh=Q95)
+    assert ok and ratios == pytest.approx((1.0, 1.0), rel=1e-6)
+    t, y = _decay(0.15)
+
+    def res(x):
+        return (x[0] * np.exp(-x[1] * t) - y) / 0.15
+    opt = optimize.least_squares(res, [1.0, 1.0], xtol=1e-14, ftol=1e-14, gtol=1e-14).x
+    ok, ratios = linear_check(res, opt, 1, thresh=Q95)
+    assert not ok
