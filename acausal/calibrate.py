@@ -357,7 +357,8 @@ def _profiles(residuals, names, fit, every):
             continue
         out[name] = profile_likelihood(residuals, fit["x"], k, dispersion=fit["dispersion"],
                                        dof=fit["dof"] or None, name=name, fd_step=FD_STEP,
-                                       jacobian=fit["jac"], inner_max_nfev=20, **common)
+                                       jacobian=fit["jac"], inner_max_nfev=20, inner_tol=1e-6,
+                                       crossing_tol=1e-2, **common)
     return out
 
 

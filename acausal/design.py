@@ -42,6 +42,7 @@ from scipy import optimize
 from scipy.stats import qmc
 
 from .errors import AcausalError
+from .modelfile import compile_file, evaluate_measures
 
 Rival = Callable[[Mapping[str, float]], "Mapping[str, np.ndarray] | None"]
 
@@ -217,20 +218,32 @@ def _result(ev: _Evaluator, key, best: _Score, base) -> NextExperiment:
                           best.predictions, ev.n, base)
 
 
+def signals_of(dataset, names: Sequence[str]) -> list:
+    """:class:`Signal` list for ``names`` with the floors of a dataset's
+    instrument (``acausal.data.Dataset``; a signal it does not describe is
+    an error: its floor would be a guess)."""
+    out = []
+    for n in names:
+        inst = dataset.instrument.get(n)
+        if inst is None or not inst.floor() > 0:
+            raise AcausalError(f"experiment design: the instrument description has no noise "
+                               f"floor for {n!r} (instrument.csv)")
+        out.append(Signal(n, float(inst.floor())))
+    return out
+
+
 class ModelRival:
     """A rival from a model file (path or (ModelFile, CompiledModel) pair)
     and its fitted parameters: conditions -> {signal: samples at ``times``}
     by ``CompiledModel.simulate`` (the model file's run options, ``t_end``
     at least the last sample time) and linear interpolation of the
-    ``Result``. A run that fails (an AcausalError) predicts nothing (None)."""
+    ``Result``; a signal that is one of the model file's ``measures`` (a
+    response time) is that scalar, one sample. A run that fails (an
+    AcausalError) predicts nothing (None)."""
 
     def __init__(self, model, params: Mapping[str, float], signals: Sequence[str],
                  times: np.ndarray, options: Mapping | None = None):
-        if isinstance(model, tuple):
-            self.mf, self.cm = model
-        else:
-            from .modelfile import compile_file
-            self.mf, self.cm = compile_file(model)
+        self.mf, self.cm = model if isinstance(model, tuple) else compile_file(model)
         self.params, self.signals = dict(params), list(signals)
         self.times = np.asarray(times, float)
         self.options = dict(options or {})
@@ -241,6 +254,9 @@ class ModelRival:
         opts["t_end"] = max(float(opts.get("t_end") or 0.0), float(self.times[-1]))
         try:
             res = self.cm.simulate(params={**self.params, **conditions}, **opts)
-            return {s: np.interp(self.times, res.t, res[s]) for s in self.signals}
+            measures = [s for s in self.signals if s in self.mf.measures]
+            scalars = evaluate_measures(self.mf, res) if measures else {}
+            return {s: np.atleast_1d(scalars[s]) if s in scalars
+                    else np.interp(self.times, res.t, res[s]) for s in self.signals}
         except AcausalError:
             return None

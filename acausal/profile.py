@@ -132,9 +132,10 @@ class _Objective:
     """chi^2 on the profile's variables, counting evaluations; a non-finite
     residual gives chi^2 = inf (the step is then shortened)."""
 
-    def __init__(self, residuals, coords, index, fd_step, inner_max_nfev):
+    def __init__(self, residuals, coords, index, fd_step, inner_max_nfev, tol, crossing_tol):
         self.residuals, self.c, self.i = residuals, coords, index
-        self.fd_step, self.max_nfev = fd_step, inner_max_nfev
+        self.fd_step, self.max_nfev, self.tol = fd_step, inner_max_nfev, tol
+        self.crossing_tol = crossing_tol
         self.others = np.array([j for j in range(coords.x0.size) if j != index], int)
         self.n = 0
 
@@ -160,7 +161,7 @@ class _Objective:
         fd = ForwardDifferences(lambda uo: self.r(self.full(ui, uo)), self.fd_step, hi)
         try:
             sol = optimize.least_squares(fd, start, jac=fd.jac, bounds=(lo, hi),
-                                         xtol=1e-10, ftol=1e-10, gtol=1e-10,
+                                         xtol=self.tol, ftol=self.tol, gtol=self.tol,
                                          max_nfev=self.max_nfev or 30 * self.others.size)
         except ValueError:          # a non-finite residual inside the optimiser
             return start, np.inf
@@ -242,7 +243,7 @@ def _refine(obj, below, above, thresh, chi0):
     a, b = below[0], above[0]
     if not np.isfinite(above[2]):
         return b
-    return float(optimize.brentq(g, a, b, xtol=1e-5 * abs(b - a), maxiter=40))
+    return float(optimize.brentq(g, a, b, xtol=obj.crossing_tol * abs(b - a), maxiter=40))
 
 
 def profile_likelihood(residuals: Residuals, x_opt: Sequence[float], index: int, *,
@@ -251,7 +252,8 @@ def profile_likelihood(residuals: Residuals, x_opt: Sequence[float], index: int,
                        dispersion: float = 1.0, dof: int | None = None,
                        name: str | None = None, fd_step: float = 1e-6,
                        rel_tol: float = 0.1, max_points: int = 40,
-                       inner_max_nfev: int | None = None, jacobian=None) -> Profile:
+                       inner_max_nfev: int | None = None, inner_tol: float = 1e-10,
+                       crossing_tol: float = 1e-5, jacobian=None) -> Profile:
     """Profile likelihood interval of parameter ``index``.
 
     ``residuals(x)``: weighted residuals (chi^2 = sum r^2) at the parameter
@@ -262,10 +264,14 @@ def profile_likelihood(residuals: Residuals, x_opt: Sequence[float], index: int,
     ``dof``: the threshold (:func:`threshold`); ``fd_step``: absolute
     finite-difference step in the profile's variables (1e-3 for simulated
     objectives, see ``acausal.calibrate.FD_STEP``); ``jacobian``: d r / d u
-    at the optimum, if known (else forward differences)."""
+    at the optimum, if known (else forward differences). ``inner_max_nfev``,
+    ``inner_tol``: limits of each re-optimisation of the others;
+    ``crossing_tol``: the threshold crossing is located to this fraction of
+    the last step (looser values for costly simulated objectives)."""
     c = _Coords(x_opt, log, scale, bounds)
     thr = threshold(level, dispersion, dof)
-    obj = _Objective(residuals, c, int(index), fd_step, inner_max_nfev)
+    obj = _Objective(residuals, c, int(index), fd_step, inner_max_nfev, inner_tol,
+                     crossing_tol)
     chi0 = obj.chi2(np.zeros(c.x0.size))
     hw = float(wald_halfwidths(residuals, x_opt, log=log, scale=scale, thresh=thr,
                                fd_step=fd_step, jacobian=jacobian)[index])
