@@ -81,6 +81,21 @@ def test_model_file_conditions_are_read_and_checked(tmp_path):
         compile_file(str(g))
 
 
+def test_model_rival_predicts_traces_and_measures(tmp_path):
+    f = tmp_path / "slider.py"
+    f.write_text(_SLIDER.format(law="measures = {'s_end': lambda res: res['mass.s'][-1]}",
+                                conditions=_RANGES))
+    pair = compile_file(str(f))
+    assert conditions_of(pair[0]) == [Condition("s0", -0.1, 0.1, "m"),
+                                      Condition("v0", -1.0, 1.0, "m/s")]
+    times = np.linspace(0.0, 0.2, 5)
+    out = ModelRival(pair, {"spring.c": 100.0}, ["mass.s", "s_end"], times)({"s0": 0.05})
+    # undamped: x = s0 cos(10 t); the run's own t_end is 0.25 s
+    np.testing.assert_allclose(out["mass.s"], 0.05 * np.cos(10.0 * times), atol=1e-6)
+    assert out["s_end"] == pytest.approx([0.05 * np.cos(2.5)], abs=1e-6)
+    assert ModelRival(pair, {"mass.m": -1.0}, ["mass.s"], times)({}) is None
+
+
 # -- the blind test ----------------------------------------------------------------------
 
 _SLIDER = textwrap.dedent('''
