@@ -134,3 +134,23 @@ def test_linear_check_accepts_linear_and_rejects_asymmetric():
     opt = optimize.least_squares(res, [1.0, 1.0], xtol=1e-14, ftol=1e-14, gtol=1e-14).x
     ok, ratios = linear_check(res, opt, 1, thresh=Q95)
     assert not ok
+
+
+@pytest.mark.slow
+def test_breaker_K_over_all_voltages_has_an_open_profile():
+    """The report data's K interval (docs/calibration.md): the Wald interval
+    [2.0e8, 4.3e9] on log K is not trustworthy; the profile (bh re-fitted at
+    each K) is closed below, near 2.9e8, and open up to the bound 1e10.
+    About 1100 simulations (1.5 min of CPU)."""
+    import os
+    from acausal import calibrate as cal
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    model = os.path.join(root, "models", "breaker_24kv.py")
+    ds = cal.model_dataset(model, os.path.join(root, "data", "report_24kv"))
+    out = cal.least_squares(model, ds, ["contact.K", "hook.bh"], profile="auto")
+    assert list(out.profile_ci95) == ["contact.K"]      # bh's Wald interval passes the check
+    p = out.profile_ci95["contact.K"]
+    assert not p.trustworthy and p.open_upper and not p.open_lower
+    assert p.upper == pytest.approx(1e10)
+    assert 2.5e8 < p.lower < 3.3e8 and p.lower > out.ci95["contact.K"][0] * 1.2
+    assert p.threshold == pytest.approx(out.cost / out.dof * stats.t.ppf(0.975, out.dof) ** 2)

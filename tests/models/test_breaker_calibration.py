@@ -61,10 +61,12 @@ def test_calibrate_command_fits_110V_and_predicts_the_other_voltages():
     assert sorted(out["validation"]) == ["V090", "V100", "V120", "V130", "V140"]
     for exp, sig in out["validation"].items():
         assert abs(sig["thrt"]) < 1.5e-4, (exp, sig)
+    # (the profile of K over all voltages takes minutes: tests/core/test_profile.py, slow tier)
     r = CliRunner().invoke(main, ["calibrate", MODEL, DATA, "--fit", "contact.K,hook.bh",
-                                  "--experiments", "all", "--json"])
+                                  "--experiments", "all", "--profile", "none", "--json"])
     out = json.loads(r.output)
     assert len(out["residuals"]) == 6 and out["validation"] == {}
+    assert out["profile_ci95"] == {}
 
 
 def test_least_squares_over_all_voltages_is_consistent_with_the_instrument():
