@@ -21,6 +21,7 @@ from .data import load_dataset
 from .differences import ForwardDifferences  # noqa: F401  (re-exported: acausal.diagnose uses it)
 from .errors import AcausalError, ModelError
 from .modelfile import compile_file, evaluate_measures
+from .profile import profiles
 
 
 # Finite-difference step of the least squares, absolute in the optimiser's
@@ -335,30 +336,14 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, prof
     out = Calibration("least_squares", values, ci, corr, raw, float(2 * sol.cost), dof,
                       n_sim[0])
     if profile != "none" and names:
-        fit = dict(x=xs, jac=sol.jac, lo=lo, hi=hi, log=logp, scale=scale, dof=dof,
-                   dispersion=max(2 * sol.cost / dof, 1.0) if dof > 0 else 1.0)
-        out.profile_ci95 = _profiles(lambda x: fun(to_z(x)), names, fit, profile == "all")
+        # in the fit's own variables (log for a positive range, value/scale
+        # otherwise), so that the profiles' Wald intervals are the ones above
+        out.profile_ci95 = profiles(
+            lambda x: fun(to_z(x)), xs, names, every=profile == "all", bounds=(lo, hi),
+            log=logp, scale=scale, dispersion=max(2 * sol.cost / dof, 1.0) if dof > 0 else 1.0,
+            dof=dof or None, jacobian=sol.jac, fd_step=FD_STEP, inner_max_nfev=20,
+            inner_tol=1e-6, crossing_tol=1e-2)
         out.n_sim = n_sim[0]
-    return out
-
-
-def _profiles(residuals, names, fit, every):
-    """name -> Profile for the fitted parameters (all of them when ``every``,
-    else those whose linearised interval fails the linear check). The profile
-    works in the fit's own variables (log for a positive range, value/scale
-    otherwise), so its Wald interval is the one of :func:`least_squares`."""
-    from .profile import linear_check, profile_likelihood, threshold
-    thr = threshold(0.95, fit["dispersion"], fit["dof"] or None)
-    common = dict(log=fit["log"], scale=fit["scale"], bounds=(fit["lo"], fit["hi"]))
-    out = {}
-    for k, name in enumerate(names):
-        if not every and linear_check(residuals, fit["x"], k, thresh=thr, jacobian=fit["jac"],
-                                      fd_step=FD_STEP, **common)[0]:
-            continue
-        out[name] = profile_likelihood(residuals, fit["x"], k, dispersion=fit["dispersion"],
-                                       dof=fit["dof"] or None, name=name, fd_step=FD_STEP,
-                                       jacobian=fit["jac"], inner_max_nfev=20, inner_tol=1e-6,
-                                       crossing_tol=1e-2, **common)
     return out
 
 

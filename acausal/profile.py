@@ -347,3 +347,40 @@ def linear_check(residuals: Residuals, x_opt: Sequence[float], index: int, *,
         ratios.append(float((r @ r - r0 @ r0) / thresh))
     ok = all(1 - band <= q <= 1 / (1 - band) for q in ratios)
     return bool(ok), tuple(ratios)
+
+
+def jacobian_in_profile_variables(jac_x, x_opt, *, log=False, scale=None) -> np.ndarray:
+    """d r / d u from d r / d x (columns per parameter in its own units):
+    times x* for a log-scaled parameter (u = log(x / x*)), times ``scale``
+    (default |x*|, 1 where x* = 0) otherwise (u = (x - x*) / scale)."""
+    c = _Coords(x_opt, log, scale, None)
+    return np.asarray(jac_x, float) * np.where(c.log, c.x0, c.scale)
+
+
+def profiles(residuals: Residuals, x_opt: Sequence[float], names: Sequence[str], *,
+             every: bool = False, bounds: tuple | None = None,
+             log: bool | Sequence[bool] = False, scale: Sequence[float] | None = None,
+             dispersion: float = 1.0, dof: int | None = None, jacobian=None,
+             fd_step: float = 1e-6, **options) -> dict:
+    """name -> :class:`Profile` for the parameters ``names`` (in the order of
+    ``x_opt``): every one when ``every``, else those whose linearised
+    interval fails :func:`linear_check` (two evaluations each). ``jacobian``:
+    d r / d u at the optimum (see :func:`jacobian_in_profile_variables`),
+    else forward differences; ``options``: further keyword arguments of
+    :func:`profile_likelihood` (``inner_max_nfev``, ``inner_tol``,
+    ``crossing_tol``, ``level``, ``max_points``, ``rel_tol``)."""
+    common = dict(log=log, scale=scale, bounds=bounds, fd_step=fd_step)
+    if jacobian is None:
+        c = _Coords(x_opt, log, scale, None)
+        fd = ForwardDifferences(lambda u: residuals(c.to_x(u)), fd_step,
+                                np.full(c.x0.size, np.inf))
+        jacobian = fd.jac(np.zeros(c.x0.size))
+    thr = threshold(options.get("level", 0.95), dispersion, dof)
+    out = {}
+    for k, name in enumerate(names):
+        if not every and linear_check(residuals, x_opt, k, thresh=thr, jacobian=jacobian,
+                                      **common)[0]:
+            continue
+        out[name] = profile_likelihood(residuals, x_opt, k, dispersion=dispersion, dof=dof,
+                                       name=name, jacobian=jacobian, **common, **options)
+    return out

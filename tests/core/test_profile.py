@@ -154,3 +154,24 @@ def test_breaker_K_over_all_voltages_has_an_open_profile():
     assert p.upper == pytest.approx(1e10)
     assert 2.5e8 < p.lower < 3.3e8 and p.lower > out.ci95["contact.K"][0] * 1.2
     assert p.threshold == pytest.approx(out.cost / out.dof * stats.t.ppf(0.975, out.dof) ** 2)
+
+
+def test_profiles_auto_profiles_only_what_the_linear_check_rejects():
+    from scipy import optimize
+    from acausal.profile import jacobian_in_profile_variables, profiles
+    t, y = _decay(0.15)
+
+    def res(x):
+        return (x[0] * np.exp(-x[1] * t) - y) / 0.15
+    opt = optimize.least_squares(res, [1.0, 1.0], xtol=1e-14, ftol=1e-14, gtol=1e-14).x
+    jx = np.column_stack([np.exp(-opt[1] * t), -opt[0] * t * np.exp(-opt[1] * t)]) / 0.15
+    # on k itself the profile is skewed (see above); on log k it is nearly quadratic
+    for log, flagged in (([False, False], {"k"}), ([False, True], set())):
+        ju = jacobian_in_profile_variables(jx, opt, log=log)
+        auto = profiles(res, opt, ["A", "k"], log=log, jacobian=ju)
+        every = profiles(res, opt, ["A", "k"], every=True, log=log)
+        assert set(auto) == flagged
+        assert {n for n, p in every.items() if not p.trustworthy} == flagged
+        for name, p in auto.items():      # what auto profiled, it profiled the same way
+            assert (p.lower, p.upper) == pytest.approx((every[name].lower, every[name].upper),
+                                                       rel=1e-6)
