@@ -79,7 +79,9 @@ class NextExperiment:
     ``pairwise``: "a | b" -> separation of every pair; ``predictions``:
     rival -> predicted samples of ``signal``; ``baseline``: the smallest
     separation at the reference conditions (``reference`` of
-    :func:`design_experiment`; None if not given)."""
+    :func:`design_experiment`; None if not given); ``decisive``: the
+    separation reaches ``min_separation`` of :func:`design_experiment`, else
+    ``message`` says that no experiment in the declared ranges splits them."""
 
     conditions: dict
     signal: str
@@ -90,6 +92,8 @@ class NextExperiment:
     predictions: dict
     n_evaluations: int
     baseline: float | None = None
+    decisive: bool = True
+    message: str = ""
 
     def to_dict(self) -> dict:
         """JSON-ready (the diagnosis's ``next_experiment`` key)."""
@@ -100,7 +104,8 @@ class NextExperiment:
                     predictions={k: np.asarray(v, float).tolist()
                                  for k, v in self.predictions.items()},
                     n_evaluations=self.n_evaluations,
-                    baseline_floors=None if self.baseline is None else float(self.baseline))
+                    baseline_floors=None if self.baseline is None else float(self.baseline),
+                    decisive=self.decisive, message=self.message)
 
 
 def conditions_of(modelfile) -> list:
@@ -170,8 +175,8 @@ class _Evaluator:
 def design_experiment(rivals: Mapping[str, Rival], conditions: Sequence[Condition],
                       signals: Sequence[Signal], *, fixed: Mapping[str, float] | None = None,
                       reference: Mapping[str, float] | None = None, n_initial: int | None = None,
-                      n_refine: int = 3, max_refine_evals: int = 60,
-                      seed: int = 0) -> NextExperiment:
+                      n_refine: int = 3, max_refine_evals: int = 60, seed: int = 0,
+                      min_separation: float = 3.0) -> NextExperiment:
     """The experiment within the conditions' ranges whose predicted outcomes
     differ most between ``rivals`` (name -> callable conditions -> {signal:
     samples}, or None when it cannot predict), in noise floors of the best of
@@ -179,7 +184,9 @@ def design_experiment(rivals: Mapping[str, Rival], conditions: Sequence[Conditio
     unchanged. ``reference``: the conditions of the data so far (its
     separation is reported as ``baseline``). Latin hypercube of
     ``n_initial`` points (default 8 per condition, at least 12), then a
-    bounded Powell search from the ``n_refine`` best."""
+    bounded Powell search from the ``n_refine`` best. ``min_separation``
+    [floors]: below it the result is not ``decisive`` (3 floors: the wrong
+    rival's chi^2 rises by 9, p = 0.003 for one degree of freedom)."""
     conds = list(conditions)
     if not conds:
         raise ValueError("no experiment conditions to search (declare `conditions` "
@@ -204,18 +211,24 @@ def design_experiment(rivals: Mapping[str, Rival], conditions: Sequence[Conditio
         ref = score({n: r({**ev.fixed, **reference}) for n, r in ev.rivals.items()},
                     ev.signals)
         base = math.sqrt(max(ref.d2, 0.0)) if np.isfinite(ref.d2) else None
-    return _result(ev, best_key, best, base)
+    return _result(ev, best_key, best, base, min_separation)
 
 
-def _result(ev: _Evaluator, key, best: _Score, base) -> NextExperiment:
+def _result(ev: _Evaluator, key, best: _Score, base, min_separation) -> NextExperiment:
     pair = min(best.pairwise, key=best.pairwise.get)
     n_samples = max(np.asarray(next(iter(best.predictions.values()))).size, 1)
     vals = ev.values(np.array(key))
     cond = {c.name: vals[c.name] for c in ev.conds}
-    return NextExperiment(cond, best.signal, math.sqrt(best.d2),
-                          math.sqrt(best.d2 / n_samples), tuple(pair.split(" | ")),
+    sep = math.sqrt(best.d2)
+    decisive = sep >= min_separation
+    message = "" if decisive else (
+        f"no experiment within the declared ranges of {', '.join(c.name for c in ev.conds)} "
+        f"separates {pair} by more than {sep:.3g} noise floors (needs {min_separation:g}): "
+        "declare other conditions (a start state, a load, a reversal of the motion)")
+    return NextExperiment(cond, best.signal, sep, math.sqrt(best.d2 / n_samples),
+                          tuple(pair.split(" | ")),
                           {k: math.sqrt(v) for k, v in best.pairwise.items()},
-                          best.predictions, ev.n, base)
+                          best.predictions, ev.n, base, decisive, message)
 
 
 def signals_of(dataset, names: Sequence[str]) -> list:

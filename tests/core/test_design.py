@@ -70,6 +70,15 @@ def test_a_rival_that_cannot_predict_makes_the_experiment_unusable():
     assert score({"x": {"y": T}, "z": None}, [Signal("y", 1.0)]).signal is None
 
 
+def test_rivals_no_condition_can_split_are_reported_as_not_decisive():
+    # y = a T + b and y = a T + b + 1e-3 (a fixed offset of 0.1 floor)
+    nxt = design_experiment({"one": _line, "two": lambda c: {"y": _line(c)["y"] + 1e-3}},
+                            [Condition("a", -0.5, 2.0), Condition("b", 0.0, 1.0)],
+                            [Signal("y", 0.01)])
+    assert nxt.separation == pytest.approx(0.1 * np.sqrt(T.size))
+    assert not nxt.decisive and "no experiment within the declared ranges" in nxt.message
+
+
 def test_model_file_conditions_are_read_and_checked(tmp_path):
     f = tmp_path / "bad.py"
     f.write_text(_SLIDER.format(law="", conditions='{"v0": (1.0, -1.0)}'))
@@ -196,7 +205,7 @@ def test_blind_next_experiment_splits_coulomb_friction_from_a_constant_load(tmp_
                                             Signal("mass.v", 1e-2, "m/s")],
                             reference=old[0][0], n_refine=1, max_refine_evals=30)
     assert nxt.baseline < 3.0                   # the old experiment: within the noise
-    assert nxt.separation > 100.0               # the new one: many floors apart
+    assert nxt.separation > 100.0 and nxt.decisive  # the new one: many floors apart
     json.dumps(nxt.to_dict())
 
     new = (nxt.conditions, _measure(nxt.conditions["s0"], nxt.conditions["v0"], rng))
