@@ -339,12 +339,27 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, prof
         # in the fit's own variables (log for a positive range, value/scale
         # otherwise), so that the profiles' Wald intervals are the ones above
         out.profile_ci95 = profiles(
-            lambda x: fun(to_z(x)), xs, names, every=profile == "all", bounds=(lo, hi),
+            _no_evidence_on_failure(path, dataset, names, signals, n_res, n_sim), xs, names,
+            every=profile == "all", bounds=(lo, hi),
             log=logp, scale=scale, dispersion=max(2 * sol.cost / dof, 1.0) if dof > 0 else 1.0,
             dof=dof or None, jacobian=sol.jac, fd_step=FD_STEP, inner_max_nfev=20,
             inner_tol=1e-6, crossing_tol=1e-2)
         out.n_sim = n_sim[0]
     return out
+
+
+def _no_evidence_on_failure(path, dataset, names, signals, n_res, n_sim):
+    """Residuals at parameter values x for the profile likelihood: a run that
+    fails gives NaN, not the fit's penalty, since a failure is no evidence
+    against x (the profile stops there and is reported open)."""
+    def residuals(x):
+        n_sim[0] += len(dataset.experiments)
+        try:
+            return residual_vector(path, dataset, dict(zip(names, np.asarray(x).tolist())),
+                                   signals)[0]
+        except AcausalError:
+            return np.full(n_res, np.nan)
+    return residuals
 
 
 def check_names(cm, names):

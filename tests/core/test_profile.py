@@ -175,3 +175,17 @@ def test_profiles_auto_profiles_only_what_the_linear_check_rejects():
         for name, p in auto.items():      # what auto profiled, it profiled the same way
             assert (p.lower, p.upper) == pytest.approx((every[name].lower, every[name].upper),
                                                        rel=1e-6)
+
+
+def test_a_failing_objective_ends_the_profile_open_not_closed():
+    X, y, sigma = _quadratic_data()
+    beta = np.linalg.lstsq(X, y, rcond=None)[0]
+    sd = sigma * np.sqrt(np.diag(np.linalg.inv(X.T @ X)))
+    wall = beta[1] + 0.5 * sd[1]          # beyond this the "simulation" fails
+
+    def res(b):
+        return np.full(y.size, np.nan) if b[1] > wall else (X @ b - y) / sigma
+    p = profile_likelihood(res, beta, 1)
+    assert p.open_upper and p.upper is None and "failed" in p.message
+    assert not p.open_lower and not p.trustworthy
+    assert p.values.max() <= wall
