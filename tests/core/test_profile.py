@@ -189,3 +189,70 @@ def test_a_failing_objective_ends_the_profile_open_not_closed():
     assert p.open_upper and p.upper is None and "failed" in p.message
     assert not p.open_lower and not p.trustworthy
     assert p.values.max() <= wall
+
+
+_COASTING = '''
+from acausal import Model, Experiment
+from acausal.mechanics.translational import Mass, Damper, Fixed
+
+model = Model()
+v0 = model.parameter("v0", 1.0, "m/s", "launch speed")
+model.mass = Mass(m=1.0, s=0.0, v=v0)
+model.damper = Damper(d=1.0)
+model.ground = Fixed()
+model.connect(model.ground.flange, model.damper.flange_a)
+model.connect(model.damper.flange_b, model.mass.flange)
+experiment = Experiment(t_end=2.0, rtol=1e-10, atol=1e-12, output_step=0.5)
+measures = {"s_end": lambda res: res["mass.s"][-1]}
+free_parameters = {"damper.d": (0.01, 100.0)}
+'''
+
+
+def test_calibrate_cli_profile_interval_matches_closed_form(tmp_path):
+    """A mass launched at v0 against a damper d: s(2 s) = v0 (1 - exp(-2 d)) / d.
+    Three launches, d fitted on its logarithm; the profile interval printed by
+    `acausal calibrate --profile all --json` against a grid on the closed form."""
+    import json
+    from click.testing import CliRunner
+    from acausal.cli import main
+    (tmp_path / "coast.py").write_text(_COASTING)
+    data = tmp_path / "data"
+    data.mkdir()
+    v0s, sigma = np.array([1.0, 2.0, 3.0]), 0.05
+
+    def s_end(d, v):
+        return v * (1.0 - np.exp(-2.0 * d)) / d
+    meas = s_end(0.8, v0s) + sigma * np.array([0.9, -1.3, 0.4])
+    (data / "experiments.csv").write_text("name,v0 [m/s],s_end [m]\n" + "".join(
+        f"E{k},{v},{m:.17g}\n" for k, (v, m) in enumerate(zip(v0s, meas))))
+    (data / "instrument.csv").write_text(f"signal,resolution [m],noise_std [m]\ns_end,,{sigma}\n")
+    args = ["calibrate", str(tmp_path / "coast.py"), str(data), "--fit", "damper.d",
+            "--profile", "all"]
+    r = CliRunner().invoke(main, args + ["--json"])
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.output)
+    p = out["profile_ci95"]["damper.d"]
+    ds = np.exp(np.linspace(np.log(0.2), np.log(3.0), 200001))
+    chi = (((s_end(ds[:, None], v0s) - meas) / sigma) ** 2).sum(axis=1)
+    S, dof = chi.min(), 2
+    thr = max(S / dof, 1.0) * stats.t.ppf(0.975, dof) ** 2
+    inside = ds[chi - S <= thr]
+    assert p["threshold"] == pytest.approx(thr, rel=1e-4)
+    assert p["lower"] == pytest.approx(inside.min(), rel=2e-3)
+    assert p["upper"] == pytest.approx(inside.max(), rel=2e-3)
+    assert p["wald"] == pytest.approx(out["ci95"]["damper.d"], rel=1e-6)
+
+
+def test_cli_profile_line_names_open_ends():
+    from acausal.cli import _profile_line
+    t = np.linspace(0.0, 1.0, 12)
+    y = 2.0 * t
+    prod = float(t @ y / (t @ t))
+    p = profile_likelihood(lambda x: (x[0] * x[1] * t - y) / 0.1, [1.0, prod], 0,
+                           bounds=([0.1, 0.01], [10.0, 100.0]), log=True)
+    assert _profile_line(p).startswith(
+        "profile-likelihood 95% CI [open at bound 0.1, open at bound 10] "
+        "(the linearised interval is not trustworthy;")
+    X, y, sigma = _quadratic_data()
+    q = profile_likelihood(lambda b: (X @ b - y) / sigma, np.linalg.lstsq(X, y, rcond=None)[0], 0)
+    assert f"[{q.lower:.6g}, {q.upper:.6g}] (agrees with the linearised" in _profile_line(q)
