@@ -312,7 +312,7 @@ def _assemble(obj, sides, hw, thr, level, chi0, name, rel_tol) -> Profile:
 def linear_check(residuals: Residuals, x_opt: Sequence[float], index: int, *,
                  log: bool | Sequence[bool] = False, scale: Sequence[float] | None = None,
                  bounds: tuple | None = None, thresh: float = 3.84, jacobian=None,
-                 fd_step: float = 1e-6, band: float = 0.25) -> tuple:
+                 fd_step: float = 1e-6, rel_tol: float = 0.1) -> tuple:
     """A cheap screen for a Wald interval (two evaluations): (ok, ratios).
 
     At both ends of the Wald interval of parameter ``index``, moves the
@@ -320,8 +320,11 @@ def linear_check(residuals: Residuals, x_opt: Sequence[float], index: int, *,
     the others to the change of x_index, from the Jacobian) and compares the
     actual delta chi^2 there with ``thresh``, which it equals for a model
     linear in its parameters. ``ok`` is False when either ratio falls outside
-    [1 - band, 1 / (1 - band)], when an end lies beyond a bound, or when the
-    Jacobian cannot determine the parameter: then trace the profile."""
+    [1/(1 + rel_tol)^2, 1/(1 - rel_tol)^2] (for a profile that is quadratic
+    near each end, a side longer or shorter than the Wald half-width by more
+    than ``rel_tol``: the test of :func:`profile_likelihood`), when an end
+    lies beyond a bound, or when the Jacobian cannot determine the
+    parameter: then trace the profile."""
     c = _Coords(x_opt, log, scale, bounds)
     k = c.x0.size
     if jacobian is None:
@@ -345,7 +348,7 @@ def linear_check(residuals: Residuals, x_opt: Sequence[float], index: int, *,
             return False, (np.nan, np.nan)
         r = np.asarray(residuals(c.to_x(u)), float)
         ratios.append(float((r @ r - r0 @ r0) / thresh))
-    ok = all(1 - band <= q <= 1 / (1 - band) for q in ratios)
+    ok = all((1 + rel_tol) ** -2 <= q <= (1 - rel_tol) ** -2 for q in ratios)
     return bool(ok), tuple(ratios)
 
 
@@ -370,6 +373,7 @@ def profiles(residuals: Residuals, x_opt: Sequence[float], names: Sequence[str],
     :func:`profile_likelihood` (``inner_max_nfev``, ``inner_tol``,
     ``crossing_tol``, ``level``, ``max_points``, ``rel_tol``)."""
     common = dict(log=log, scale=scale, bounds=bounds, fd_step=fd_step)
+    rel_tol = options.get("rel_tol", 0.1)
     if jacobian is None:
         c = _Coords(x_opt, log, scale, None)
         fd = ForwardDifferences(lambda u: residuals(c.to_x(u)), fd_step,
@@ -379,7 +383,7 @@ def profiles(residuals: Residuals, x_opt: Sequence[float], names: Sequence[str],
     out = {}
     for k, name in enumerate(names):
         if not every and linear_check(residuals, x_opt, k, thresh=thr, jacobian=jacobian,
-                                      **common)[0]:
+                                      rel_tol=rel_tol, **common)[0]:
             continue
         out[name] = profile_likelihood(residuals, x_opt, k, dispersion=dispersion, dof=dof,
                                        name=name, jacobian=jacobian, **common, **options)

@@ -156,6 +156,23 @@ def test_breaker_K_over_all_voltages_has_an_open_profile():
     assert p.threshold == pytest.approx(out.cost / out.dof * stats.t.ppf(0.975, out.dof) ** 2)
 
 
+@pytest.mark.slow
+def test_breaker_K_at_110V_profile_is_closed_and_shifted():
+    """Two readings for two parameters (dof 0: threshold 3.84): the profile of
+    K is closed, [4.07e8, 1.02e9] against the Wald [3.91e8, 9.74e8]."""
+    import os
+    from acausal import calibrate as cal
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    model = os.path.join(root, "models", "breaker_24kv.py")
+    ds, _ = cal.split(cal.model_dataset(model, os.path.join(root, "data", "report_24kv")))
+    out = cal.least_squares(model, ds, ["contact.K", "hook.bh"], profile="auto")
+    p = out.profile_ci95["contact.K"]
+    assert p.threshold == pytest.approx(Q95)
+    assert not (p.open_lower or p.open_upper)
+    assert p.lower == pytest.approx(4.07e8, rel=0.02) and p.upper == pytest.approx(1.025e9, rel=0.02)
+    assert p.lower > out.ci95["contact.K"][0] and p.upper > out.ci95["contact.K"][1]
+
+
 def test_profiles_auto_profiles_only_what_the_linear_check_rejects():
     from scipy import optimize
     from acausal.profile import jacobian_in_profile_variables, profiles
