@@ -81,7 +81,8 @@ class NextExperiment:
     separation at the reference conditions (``reference`` of
     :func:`design_experiment`; None if not given); ``decisive``: the
     separation reaches ``min_separation`` of :func:`design_experiment`, else
-    ``message`` says that no experiment in the declared ranges splits them."""
+    ``message`` says that no experiment in the declared ranges splits them;
+    ``times``: the sample times of the predictions, when given."""
 
     conditions: dict
     signal: str
@@ -94,6 +95,7 @@ class NextExperiment:
     baseline: float | None = None
     decisive: bool = True
     message: str = ""
+    times: np.ndarray | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready (the diagnosis's ``next_experiment`` key)."""
@@ -105,7 +107,8 @@ class NextExperiment:
                                  for k, v in self.predictions.items()},
                     n_evaluations=self.n_evaluations,
                     baseline_floors=None if self.baseline is None else float(self.baseline),
-                    decisive=self.decisive, message=self.message)
+                    decisive=self.decisive, message=self.message,
+                    times=None if self.times is None else np.asarray(self.times).tolist())
 
 
 def conditions_of(modelfile) -> list:
@@ -176,7 +179,7 @@ def design_experiment(rivals: Mapping[str, Rival], conditions: Sequence[Conditio
                       signals: Sequence[Signal], *, fixed: Mapping[str, float] | None = None,
                       reference: Mapping[str, float] | None = None, n_initial: int | None = None,
                       n_refine: int = 3, max_refine_evals: int = 60, seed: int = 0,
-                      min_separation: float = 3.0) -> NextExperiment:
+                      min_separation: float = 3.0, times=None) -> NextExperiment:
     """The experiment within the conditions' ranges whose predicted outcomes
     differ most between ``rivals`` (name -> callable conditions -> {signal:
     samples}, or None when it cannot predict), in noise floors of the best of
@@ -186,7 +189,8 @@ def design_experiment(rivals: Mapping[str, Rival], conditions: Sequence[Conditio
     ``n_initial`` points (default 8 per condition, at least 12), then a
     bounded Powell search from the ``n_refine`` best. ``min_separation``
     [floors]: below it the result is not ``decisive`` (3 floors: the wrong
-    rival's chi^2 rises by 9, p = 0.003 for one degree of freedom)."""
+    rival's chi^2 rises by 9, p = 0.003 for one degree of freedom).
+    ``times``: the rivals' sample times, kept in the result for its plot."""
     conds = list(conditions)
     if not conds:
         raise ValueError("no experiment conditions to search (declare `conditions` "
@@ -211,10 +215,10 @@ def design_experiment(rivals: Mapping[str, Rival], conditions: Sequence[Conditio
         ref = score({n: r({**ev.fixed, **reference}) for n, r in ev.rivals.items()},
                     ev.signals)
         base = math.sqrt(max(ref.d2, 0.0)) if np.isfinite(ref.d2) else None
-    return _result(ev, best_key, best, base, min_separation)
+    return _result(ev, best_key, best, base, min_separation, times)
 
 
-def _result(ev: _Evaluator, key, best: _Score, base, min_separation) -> NextExperiment:
+def _result(ev: _Evaluator, key, best: _Score, base, min_separation, times) -> NextExperiment:
     pair = min(best.pairwise, key=best.pairwise.get)
     n_samples = max(np.asarray(next(iter(best.predictions.values()))).size, 1)
     vals = ev.values(np.array(key))
@@ -228,7 +232,32 @@ def _result(ev: _Evaluator, key, best: _Score, base, min_separation) -> NextExpe
     return NextExperiment(cond, best.signal, sep, math.sqrt(best.d2 / n_samples),
                           tuple(pair.split(" | ")),
                           {k: math.sqrt(v) for k, v in best.pairwise.items()},
-                          best.predictions, ev.n, base, decisive, message)
+                          best.predictions, ev.n, base, decisive, message,
+                          None if times is None else np.asarray(times, float))
+
+
+def plot_next_experiment(nxt: NextExperiment, path=None, title=None):
+    """Each rival's predicted signal at the computed experiment (against the
+    sample times when known, else the sample index), with the separation in
+    the title. Returns the matplotlib figure; writes it to ``path`` if given."""
+    from matplotlib.figure import Figure
+    fig = Figure(figsize=(7, 3.2))
+    ax = fig.subplots()
+    for name, y in nxt.predictions.items():
+        y = np.asarray(y, float)
+        x = nxt.times if nxt.times is not None and len(nxt.times) == y.size else np.arange(y.size)
+        ax.plot(x, y, lw=1.2, marker="o" if y.size < 3 else None, label=name)
+    ax.set_xlabel("time [s]" if nxt.times is not None else "sample")
+    ax.set_ylabel(nxt.signal)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    cond = ", ".join(f"{k} = {v:.4g}" for k, v in nxt.conditions.items())
+    ax.set_title(title or f"next experiment: {cond}; {nxt.separation:.3g} floors apart",
+                 fontsize=9)
+    fig.tight_layout()
+    if path:
+        fig.savefig(path, dpi=120)
+    return fig
 
 
 def signals_of(dataset, names: Sequence[str]) -> list:

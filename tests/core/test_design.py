@@ -42,6 +42,17 @@ def test_two_rivals_separation_is_largest_at_the_analytic_optimum():
     json.dumps(nxt.to_dict())       # serialisable as the diagnosis's next_experiment
 
 
+def test_next_experiment_plot_is_written(tmp_path):
+    from acausal.design import plot_next_experiment
+    nxt = design_experiment({"line": _line, "parabola": _parabola},
+                            [Condition("a", -0.5, 2.0), Condition("b", 0.0, 1.0)],
+                            [Signal("y", 0.01)], n_initial=12, n_refine=1, times=T)
+    assert nxt.to_dict()["times"] == pytest.approx(T.tolist())
+    fig = plot_next_experiment(nxt, tmp_path / "next.png")
+    assert (tmp_path / "next.png").stat().st_size > 5000
+    assert [ln.get_label() for ln in fig.axes[0].get_lines()] == ["line", "parabola"]
+
+
 def test_three_rivals_maximise_the_smallest_pairwise_separation():
     # rivals y = c*T, y = c*T^2, y = c*T^3 + k: the third differs from the others
     # by k everywhere, the first two only by c (T - T^2); min over pairs needs both
