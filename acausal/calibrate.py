@@ -18,8 +18,10 @@ import numpy as np
 from scipy import optimize, stats
 
 from .data import load_dataset
+from .differences import ForwardDifferences  # noqa: F401  (re-exported: acausal.diagnose uses it)
 from .errors import AcausalError, ModelError
 from .modelfile import compile_file, evaluate_measures
+from .profile import profiles
 
 
 # Finite-difference step of the least squares, absolute in the optimiser's
@@ -33,34 +35,6 @@ from .modelfile import compile_file, evaluate_measures
 # stopped at K = 8.86e8, S = 27.260, short of the minimum K = 9.35e8,
 # S = 27.215, and the 110 V intervals came out 20 times too narrow.
 FD_STEP = 1e-3
-
-
-class ForwardDifferences:
-    """``fun`` with a ``jac`` for ``scipy.optimize.least_squares``: forward
-    differences with the absolute step ``step`` (backward where a forward step
-    would cross the upper bound ``hi``). The residual at the point the
-    optimiser just evaluated is reused, so a Jacobian costs one evaluation per
-    variable, as scipy's own."""
-
-    def __init__(self, fun, step, hi):
-        self.fun, self.step, self.hi = fun, float(step), np.asarray(hi, float)
-        self._z = self._r = None
-
-    def __call__(self, z):
-        r = np.asarray(self.fun(z), float)
-        self._z, self._r = np.array(z, float), r
-        return r
-
-    def jac(self, z):
-        z = np.asarray(z, float)
-        r0 = self._r if self._z is not None and np.array_equal(z, self._z) else self(z)
-        J = np.empty((r0.size, z.size))
-        for i in range(z.size):
-            h = self.step if z[i] + self.step <= self.hi[i] else -self.step
-            zz = z.copy()
-            zz[i] += h
-            J[:, i] = (np.asarray(self.fun(zz), float) - r0) / h
-        return J
 
 
 class CalibrationError(AcausalError):
@@ -157,10 +131,12 @@ class Calibration:
     dof: int = None
     n_sim: int = 0
     validation: dict = field(default_factory=dict)  # held-back experiment -> residuals
+    profile_ci95: dict = field(default_factory=dict)  # name -> acausal.profile.Profile
 
     def to_dict(self):
         return dict(method=self.method, values=self.values,
                     ci95={k: list(v) for k, v in self.ci95.items()},
+                    profile_ci95={k: p.to_dict() for k, p in self.profile_ci95.items()},
                     correlation=None if self.correlation is None else self.correlation.tolist(),
                     residuals=self.residuals, cost=self.cost, dof=self.dof, n_sim=self.n_sim,
                     validation=self.validation)
@@ -284,7 +260,7 @@ def _sigma(dataset, signal, values):
     return s
 
 
-def least_squares(path, dataset, names, bounds=None, x0=None, signals=None):
+def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, profile="none"):
     """Output-error least squares over parameters ``names``.
 
     Bounds come from ``bounds``, else the model file's ``free_parameters``,
@@ -292,7 +268,12 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None):
     positive is fitted on its logarithm, so its 95 % interval is asymmetric
     and never crosses zero. Intervals use the Jacobian at the optimum, scaled
     by the reduced chi-square when it exceeds 1 (never narrower than the
-    instrument model says), with Student t quantiles."""
+    instrument model says), with Student t quantiles.
+
+    ``profile``: "auto" adds profile-likelihood intervals
+    (:mod:`acausal.profile`, ``Calibration.profile_ci95``) for the parameters
+    whose linearised interval fails :func:`acausal.profile.linear_check`;
+    "all" for every fitted parameter; "none" (default) for none."""
     path = resolve(path)
     mf, cm = path
     entries = [cm.params[cm.param_index(n)] for n in names]
@@ -355,8 +336,33 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None):
     except np.linalg.LinAlgError:
         ci = {n: (float("nan"), float("nan")) for n in names}
     raw = residual_vector(path, dataset, values, signals)[2]
-    return Calibration("least_squares", values, ci, corr, raw, float(2 * sol.cost), dof,
-                       n_sim[0])
+    out = Calibration("least_squares", values, ci, corr, raw, float(2 * sol.cost), dof,
+                      n_sim[0])
+    if profile != "none" and names:
+        # in the fit's own variables (log for a positive range, value/scale
+        # otherwise), so that the profiles' Wald intervals are the ones above
+        out.profile_ci95 = profiles(
+            _no_evidence_on_failure(path, dataset, names, signals, n_res, n_sim), xs, names,
+            every=profile == "all", bounds=(lo, hi),
+            log=logp, scale=scale, dispersion=max(2 * sol.cost / dof, 1.0) if dof > 0 else 1.0,
+            dof=dof or None, jacobian=sol.jac, fd_step=FD_STEP, inner_max_nfev=20,
+            inner_tol=1e-6, crossing_tol=1e-2)
+        out.n_sim = n_sim[0]
+    return out
+
+
+def _no_evidence_on_failure(path, dataset, names, signals, n_res, n_sim):
+    """Residuals at parameter values x for the profile likelihood: a run that
+    fails gives NaN, not the fit's penalty, since a failure is no evidence
+    against x (the profile stops there and is reported open)."""
+    def residuals(x):
+        n_sim[0] += len(dataset.experiments)
+        try:
+            return residual_vector(path, dataset, dict(zip(names, np.asarray(x).tolist())),
+                                   signals)[0]
+        except AcausalError:
+            return np.full(n_res, np.nan)
+    return residuals
 
 
 def check_names(cm, names):

@@ -146,8 +146,12 @@ def variables(file):
               help="fit these experiments, or 'all' (default: the rows the data marks "
                    "use=calibrate, every row without a use column); the others are "
                    "predicted and compared")
+@click.option("--profile", type=click.Choice(["auto", "all", "none"]), default="auto",
+              show_default=True,
+              help="profile-likelihood 95% intervals (lsq): for the parameters whose "
+                   "linearised interval is not trustworthy (auto), every one, or none")
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object")
-def calibrate(file, data, fit, method, experiments, as_json):
+def calibrate(file, data, fit, method, experiments, profile, as_json):
     """Fit parameters of a model file to a measured dataset."""
     from . import calibrate as cal
     from .modelfile import compile_file
@@ -172,7 +176,7 @@ def calibrate(file, data, fit, method, experiments, as_json):
         else:
             names = [it.split(":", 1)[0] for it in items]
             cal.check_names(cm, names)
-            out = cal.least_squares(file, ds, names)
+            out = cal.least_squares(file, ds, names, profile=profile)
         out.validation = cal.validate(file, held, out.values)
     except (AcausalError, click.BadParameter) as exc:
         _fail(exc)
@@ -185,6 +189,8 @@ def calibrate(file, data, fit, method, experiments, as_json):
         ci = out.ci95.get(name)
         ci_s = f"  95% CI [{ci[0]:.6g}, {ci[1]:.6g}]" if ci else ""
         click.echo(f"  {name} = {v:.6g}{ci_s}")
+    for name, prof in out.profile_ci95.items():
+        click.echo(f"  {name}: {_profile_line(prof)}")
     if out.correlation is not None and len(out.values) > 1:
         click.echo("  correlation:")
         for name, row in zip(out.values, out.correlation):
@@ -197,6 +203,16 @@ def calibrate(file, data, fit, method, experiments, as_json):
         for exp, sig in out.validation.items():
             click.echo(f"    {exp}: " + ", ".join(
                 f"{k} {v}" if k == "error" else f"{k} {v:+.4g}" for k, v in sig.items()))
+
+
+def _profile_line(prof):
+    """One line for a profile-likelihood interval (acausal.profile.Profile)."""
+    ends = [("open" + (f" at bound {v:.6g}" if v is not None else "")) if opn else f"{v:.6g}"
+            for v, opn in ((prof.lower, prof.open_lower), (prof.upper, prof.open_upper))]
+    verdict = ("agrees with the linearised interval" if prof.trustworthy else
+               "the linearised interval is not trustworthy")
+    return (f"profile-likelihood 95% CI [{ends[0]}, {ends[1]}] ({verdict}; "
+            f"{prof.n_evaluations} evaluations)")
 
 
 @main.command()

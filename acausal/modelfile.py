@@ -7,7 +7,10 @@ computed from a result, such as a response time, in SI units; a
 :class:`~acausal.Measure` also gives its unit and the unit it is printed
 in), ``free_parameters``, a
 dict of parameter -> (low, high) that calibration and diagnosis may fit,
-and ``plot(result, path)``. A model file can import
+``conditions``, a dict of parameter -> (low, high) or (low, high, unit): the
+experiment conditions an experimenter can set and their ranges (an impact
+velocity, a start position), which :mod:`acausal.design` searches for the
+next experiment, and ``plot(result, path)``. A model file can import
 another one (``from breaker_24kv import build``): its folder is on the path.
 """
 import os
@@ -30,6 +33,7 @@ class ModelFile:
     measures: dict = field(default_factory=dict)
     namespace: dict = field(default_factory=dict)
     free: dict = field(default_factory=dict)   # parameter -> (low, high) bounds
+    conditions: dict = field(default_factory=dict)  # parameter -> (low, high, unit)
 
 
 def _where(exc, path):
@@ -77,7 +81,24 @@ def load_model_file(path):
         raise ModelFileError(f"{path}: 'free_parameters' must be a dict of "
                              "name -> (low, high)")
     return ModelFile(path, model, exp, dict(measures), ns, {k: tuple(map(float, v))
-                                                            for k, v in free.items()})
+                                                            for k, v in free.items()},
+                     _conditions(path, ns.get("conditions")))
+
+
+def _conditions(path, given):
+    """``conditions`` of a model file as name -> (low, high, unit)."""
+    out = {}
+    for name, spec in (given or {}).items():
+        ok = isinstance(spec, (tuple, list)) and len(spec) in (2, 3)
+        try:
+            low, high = (float(spec[0]), float(spec[1])) if ok else (0.0, 0.0)
+        except (TypeError, ValueError):
+            ok = False
+        if not ok or not isinstance(name, str) or not low < high:
+            raise ModelFileError(f"{path}: conditions[{name!r}] must be (low, high) or "
+                                 f"(low, high, unit) with low < high (found {spec!r})")
+        out[name] = (low, high, str(spec[2]) if len(spec) == 3 else "")
+    return out
 
 
 _CACHE = {}
@@ -95,6 +116,11 @@ def compile_file(path):
     if mf.experiment.stop is not None:
         mf.model.event(mf.experiment.stop.event(mf.model))
     cm = compile_model(mf.model)
+    for name in mf.conditions:
+        try:
+            cm.param_index(name)
+        except AcausalError as exc:
+            raise ModelFileError(f"{apath}: conditions: {exc}") from None
     _CACHE[key] = (mf, cm)
     return mf, cm
 

@@ -34,7 +34,7 @@ def test_report_method_recovers_the_reports_calibration():
 
 def test_least_squares_cli_at_110V_prints_intervals():
     r = CliRunner().invoke(main, ["calibrate", MODEL, DATA, "--fit", "contact.K,hook.bh",
-                                  "--experiments", "V110", "--json"])
+                                  "--experiments", "V110", "--profile", "none", "--json"])
     assert r.exit_code == 0, r.output
     out = json.loads(r.output)
     K, bh = out["values"]["contact.K"], out["values"]["hook.bh"]
@@ -48,11 +48,14 @@ def test_least_squares_cli_at_110V_prints_intervals():
 def test_calibrate_command_fits_110V_and_predicts_the_other_voltages():
     """The acceptance command: the data marks 110 V 'calibrate' and the other
     voltages 'validate', as the report calibrates and checks (Table 2)."""
-    r = CliRunner().invoke(main, ["calibrate", MODEL, DATA, "--fit", "contact.K,hook.bh"])
+    # (--profile none: the default also profiles K, 136 more runs; that is
+    # tests/core/test_profile.py's slow test)
+    r = CliRunner().invoke(main, ["calibrate", MODEL, DATA, "--fit", "contact.K,hook.bh",
+                                  "--profile", "none"])
     assert r.exit_code == 0, r.output
     assert "(V110)" in r.output and "95% CI" in r.output
     r = CliRunner().invoke(main, ["calibrate", MODEL, DATA, "--fit", "contact.K,hook.bh",
-                                  "--json"])
+                                  "--profile", "none", "--json"])
     out = json.loads(r.output)
     assert abs(out["values"]["contact.K"] / 6.25e8 - 1) < 0.10
     assert abs(out["values"]["hook.bh"] - 0.219) < 0.005
@@ -61,10 +64,12 @@ def test_calibrate_command_fits_110V_and_predicts_the_other_voltages():
     assert sorted(out["validation"]) == ["V090", "V100", "V120", "V130", "V140"]
     for exp, sig in out["validation"].items():
         assert abs(sig["thrt"]) < 1.5e-4, (exp, sig)
+    # (the profile of K over all voltages takes minutes: tests/core/test_profile.py, slow tier)
     r = CliRunner().invoke(main, ["calibrate", MODEL, DATA, "--fit", "contact.K,hook.bh",
-                                  "--experiments", "all", "--json"])
+                                  "--experiments", "all", "--profile", "none", "--json"])
     out = json.loads(r.output)
     assert len(out["residuals"]) == 6 and out["validation"] == {}
+    assert out["profile_ci95"] == {}
 
 
 def test_least_squares_over_all_voltages_is_consistent_with_the_instrument():

@@ -1,0 +1,32 @@
+"""Forward differences with an absolute step for ``scipy.optimize.least_squares``
+(used by :mod:`acausal.calibrate`, :mod:`acausal.profile` and the diagnosis;
+why the step is absolute: see ``acausal.calibrate.FD_STEP``)."""
+import numpy as np
+
+
+class ForwardDifferences:
+    """``fun`` with a ``jac`` for ``scipy.optimize.least_squares``: forward
+    differences with the absolute step ``step`` (backward where a forward step
+    would cross the upper bound ``hi``). The residual at the point the
+    optimiser just evaluated is reused, so a Jacobian costs one evaluation per
+    variable, as scipy's own."""
+
+    def __init__(self, fun, step, hi):
+        self.fun, self.step, self.hi = fun, float(step), np.asarray(hi, float)
+        self._z = self._r = None
+
+    def __call__(self, z):
+        r = np.asarray(self.fun(z), float)
+        self._z, self._r = np.array(z, float), r
+        return r
+
+    def jac(self, z):
+        z = np.asarray(z, float)
+        r0 = self._r if self._z is not None and np.array_equal(z, self._z) else self(z)
+        J = np.empty((r0.size, z.size))
+        for i in range(z.size):
+            h = self.step if z[i] + self.step <= self.hi[i] else -self.step
+            zz = z.copy()
+            zz[i] += h
+            J[:, i] = (np.asarray(self.fun(zz), float) - r0) / h
+        return J
