@@ -3,6 +3,7 @@
 Exit codes: 0 success, 2 a model or input error (one readable message on
 stderr), 3 a solver failure (time and component named).
 """
+import contextlib
 import json
 import sys
 
@@ -193,9 +194,12 @@ def calibrate(file, data, fit, method, experiments, as_json):
 @click.argument("file", type=click.Path(dir_okay=False))
 @click.option("--param", "params", multiple=True, required=True, metavar="NAME=A:B:N",
               help="a swept parameter: start:stop:count, a list a,b,c, or one value")
-@click.option("--measure", "measures", multiple=True, required=True, help="measure(s) to record")
+@click.option("--measure", "measures", multiple=True, required=True, metavar="M1,M2,...",
+              help="measure(s) to record: a list a,b or the option repeated")
 @click.option("--out", type=click.Path(dir_okay=False), default="sweep.csv", show_default=True,
-              help="results CSV; running again with the same file resumes")
+              help="results CSV; finished points are checkpointed in OUT.partial/ as they "
+                   "finish, so running the same command again after an interruption "
+                   "(even a kill) resumes")
 @click.option("--plot", type=click.Path(dir_okay=False), help="plot the first measure")
 @click.option("--scheduler", help="Dask scheduler address (default: local processes)")
 @click.option("--workers", type=int, help="local worker processes (default: all cores)")
@@ -205,9 +209,11 @@ def sweep(file, params, measures, out, plot, scheduler, workers, no_progress):
     import functools
     import os
 
-    from .executor import open_executor
+    from .checkpoint import source_files
+    from .executor import open_executor, terminate_on_sigterm
     from .modelfile import compile_file, sweep_task
     from .sweep import grid, parse_param, plot_sweep, run_sweep
+    measures = _csv_list(",".join(measures))
     try:
         mf, cm = compile_file(file)
         specs = [parse_param(p) for p in params]
@@ -218,15 +224,27 @@ def sweep(file, params, measures, out, plot, scheduler, workers, no_progress):
                 raise click.BadParameter(f"--measure {m!r}: the model file defines "
                                          f"{sorted(mf.measures) or 'no measures'}")
         task = functools.partial(sweep_task, os.path.abspath(file))
-        with open_executor(scheduler, workers) as ex:
-            rows = run_sweep(task, grid(specs), out, executor=ex, measures=list(measures),
-                             progress=not no_progress)
+        with terminate_on_sigterm(), _resumable(out), open_executor(scheduler, workers) as ex:
+            rows = run_sweep(task, grid(specs), out, executor=ex, measures=measures,
+                             progress=not no_progress, inputs=source_files(file))
         if plot:
             plot_sweep(rows, specs[0][0], measures[0], plot)
     except (AcausalError, click.BadParameter, ValueError) as exc:
         _fail(exc)
     failed = sum(1 for r in rows if r.get("status") != "ok")
     click.echo(f"{len(rows)} points, {failed} failed; results in {out}")
+
+
+@contextlib.contextmanager
+def _resumable(where):
+    """An interruption (Ctrl-C, SIGTERM) ends with one line saying where the
+    finished work is, and exit code 130."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        click.echo(f"acausal: interrupted; finished work is saved in {where}: run the same "
+                   "command again to resume", err=True)
+        sys.exit(130)
 
 
 def _csv_list(text):
