@@ -257,7 +257,10 @@ def _csv_list(text):
 @click.option("--json", "json_path", type=click.Path(dir_okay=False),
               help="write the summary as one JSON object to this file")
 @click.option("--report", "report_dir", type=click.Path(file_okay=False), default="diagnosis",
-              show_default=True, help="folder for report.md, plots and the extended model")
+              show_default=True, help="folder for report.md, plots and the extended model; "
+                                      "finished fits are checkpointed in REPORT/checkpoint/ as "
+                                      "they finish, so running the same command again after an "
+                                      "interruption (even a kill) resumes")
 @click.option("--scheduler", help="Dask scheduler address (default: local processes)")
 @click.option("--workers", type=int, help="local worker processes (default: all cores)")
 @click.option("--hypotheses", metavar="ID,ID,...", help="only these hypotheses")
@@ -273,13 +276,15 @@ def diagnose(file, data, json_path, report_dir, scheduler, workers, hypotheses, 
     extend the model and measure the gain."""
     from .data import DataError
     from .diagnose.run import diagnose as run_diagnosis
+    from .executor import terminate_on_sigterm
     try:
         if not 0 < alpha < 1:
             raise click.BadParameter(f"--alpha {alpha}: must be between 0 and 1")
-        out = run_diagnosis(file, data, out_dir=report_dir, scheduler=scheduler,
-                            workers=workers, progress=not no_progress,
-                            hypotheses=_csv_list(hypotheses), locations=_csv_list(locations),
-                            alpha=alpha, library=library)
+        with terminate_on_sigterm(), _resumable(f"{report_dir}/checkpoint"):
+            out = run_diagnosis(file, data, out_dir=report_dir, scheduler=scheduler,
+                                workers=workers, progress=not no_progress,
+                                hypotheses=_csv_list(hypotheses),
+                                locations=_csv_list(locations), alpha=alpha, library=library)
     except (AcausalError, DataError, click.BadParameter, ValueError, ImportError) as exc:
         _fail(exc)
     if json_path:

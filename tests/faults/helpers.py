@@ -63,9 +63,9 @@ def kill_tree_check(proc, sig, wait=10.0):
     return alive, stderr
 
 
-def valid_lines(path):
+def valid_lines(path, types=()):
     """Records of a checkpoint file whose checksum is intact, and the count of the others."""
-    store = Checkpoint(path.parent, path.stem)
+    store = Checkpoint(path.parent, path.stem, types)
     return store.load(), store.ignored
 
 
