@@ -11,7 +11,7 @@ from .compile import CompiledModel, compile_model
 from .connectors import Flange, Port, RotFlange
 from .declare import Assertion, Discrete, Event, Parameter, Start, Variable, guess
 from .experiment import Experiment, Stop
-from .errors import (AcausalError, ChatteringError, InitializationError, ModelError,
+from .errors import (AcausalError, ChatteringError, InitializationError, LimitError, ModelError,
                      ParameterError, SolverError, StructuralError)
 from .symbols import der, time
 
@@ -19,5 +19,5 @@ __all__ = [
     "Component", "Model", "CompiledModel", "compile_model", "Flange", "RotFlange", "Port",
     "Parameter", "Variable", "Discrete", "Event", "Assertion", "Start", "guess", "der",
     "time", "Eq", "Experiment", "Stop", "AcausalError", "ModelError", "ParameterError", "StructuralError",
-    "InitializationError", "SolverError", "ChatteringError",
+    "InitializationError", "SolverError", "ChatteringError", "LimitError",
 ]

@@ -47,52 +47,132 @@ def main():
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object")
 @click.option("--rtol", type=float)
 @click.option("--atol", type=float)
-def simulate(file, t_end, sets, out, plot, as_json, rtol, atol):
+@click.option("--max-rows", type=int, default=None, metavar="N",
+              help="most output rows to store (default 1e6): a larger grid is refused")
+@click.option("--max-wall", type=float, metavar="SECONDS",
+              help="stop after this wall time, keeping what was computed")
+@click.option("--max-steps", type=int, metavar="N",
+              help="stop after this many solver steps, keeping what was computed")
+@click.option("--progress/--no-progress", default=None,
+              help="progress bar on stderr for runs longer than 2 s "
+                   "(default: when stderr is a terminal)")
+def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, max_rows, max_wall, max_steps,
+             progress):
     """Simulate a model file."""
-    from .modelfile import compile_file, evaluate_measures
+    from .modelfile import compile_file, measure_values
     try:
         params = _parse_sets(sets)
         mf, cm = compile_file(file)
-        opts = mf.experiment.run_options()
-        for k, v in dict(t_end=t_end, rtol=rtol, atol=atol).items():
-            if v is not None:
-                opts[k] = v
-        try:
-            res = cm.simulate(params=params, **opts)
-        except SolverError as exc:
-            if exc.result is not None and out:
-                exc.result.to_csv(out)
-                click.echo(f"acausal: partial results up to t = {exc.t:.6g} s written to {out}",
-                           err=True)
-            raise
-        measures = evaluate_measures(mf, res)
+        opts = _simulate_options(mf, dict(t_end=t_end, rtol=rtol, atol=atol, max_rows=max_rows,
+                                          max_wall=max_wall, max_total_steps=max_steps),
+                                 progress)
+        with _c_stdout_to_stderr() if as_json else contextlib.nullcontext():
+            res, error = _run_keeping_partial(cm, params, opts)
+        measures, missing = measure_values(mf, res) if error is None else ({}, {})
         if out:
             res.to_csv(out)
+            if error is not None:
+                click.echo(f"acausal: partial results up to t = {res.t[-1]:.6g} s written to "
+                           f"{out}", err=True)
         if plot:
-            _plot(mf, res, plot)
+            _plot(mf, res, plot, partial=error is not None)
     except (AcausalError, click.BadParameter) as exc:
+        if as_json:
+            click.echo(json.dumps({"error": _error_dict(exc)}, indent=1))
         _fail(exc)
     if as_json:
-        click.echo(json.dumps({
-            "final": res.final(),
-            "events": [{"t": t, "name": n} for t, n in res.events],
-            "measures": measures,
-            "stats": {k: res.stats.get(k) for k in ("nfev", "steps", "wall_s", "compile_s",
-                                                    "njev", "events")},
-        }, indent=1))
+        click.echo(json.dumps(_result_dict(res, measures, missing, error), indent=1))
     else:
-        click.echo(f"simulated {mf.path}: t = {res.t[0]:g} .. {res.t[-1]:g} s, "
-                   f"{len(res.events)} events, {res.stats['steps']} steps, "
-                   f"{res.stats['wall_s'] * 1e3:.1f} ms (compile {cm.compile_s:.2f} s)")
-        for k, v in measures.items():
+        _print_run(mf, cm, res, measures, missing)
+    if error is not None:
+        _fail(error)
+
+
+def _simulate_options(mf, given, progress):
+    """The model file's run options, overridden by the command line's."""
+    opts = mf.experiment.run_options()
+    opts.update({k: v for k, v in given.items() if v is not None})
+    opts["progress"] = sys.stderr.isatty() if progress is None else progress
+    return opts
+
+
+def _run_keeping_partial(cm, params, opts):
+    """(result, None), or (partial result, the SolverError) when the solver
+    failed or a limit stopped the run after computing something."""
+    try:
+        return cm.simulate(params=params, **opts), None
+    except SolverError as exc:
+        if exc.result is None or len(exc.result.t) == 0:
+            raise
+        return exc.result, exc
+
+
+@contextlib.contextmanager
+def _c_stdout_to_stderr():
+    """Send what C code prints to stdout (SUNDIALS writes its error lines
+    there) to stderr instead, so that stdout carries only the JSON."""
+    import ctypes
+    import os
+    sys.stdout.flush()
+    saved = os.dup(1)
+    os.dup2(2, 1)
+    try:
+        yield
+    finally:
+        ctypes.CDLL(None).fflush(None)
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+def _finite(x):
+    return x if x == x and abs(x) != float("inf") else None
+
+
+def _error_dict(exc):
+    out = {"type": type(exc).__name__, "message": str(exc)}
+    for k in ("t", "component"):
+        if getattr(exc, k, None) is not None:
+            out[k] = getattr(exc, k)
+    return out
+
+
+def _result_dict(res, measures, missing, error):
+    return {
+        "error": None if error is None else _error_dict(error),
+        "status": res.status,
+        "final": {k: _finite(v) for k, v in res.final().items()},
+        "events": [{"t": t, "name": n} for t, n in res.events],
+        "measures": {k: _finite(v) for k, v in measures.items()},
+        "missing": missing,
+        "stats": {k: res.stats.get(k) for k in ("nfev", "steps", "wall_s", "compile_s",
+                                                "njev", "events")},
+    }
+
+
+def _print_run(mf, cm, res, measures, missing):
+    click.echo(f"simulated {mf.path}: t = {res.t[0]:g} .. {res.t[-1]:g} s, "
+               f"{len(res.events)} events, {res.stats['steps']} steps, "
+               f"{res.stats['wall_s'] * 1e3:.1f} ms (compile {cm.compile_s:.2f} s)")
+    for k, v in measures.items():
+        if k in missing:
+            click.echo(f"  {k} = missing ({missing[k]})")
+        else:
             click.echo(f"  {k} = {v:.6g}")
 
 
-def _plot(mf, res, path):
+def _plot(mf, res, path, partial=False):
+    """The model file's plot (or its list of variables), else the states.
+    A partial result that the model file's plot function cannot draw gets
+    the default plot."""
     custom = mf.namespace.get("plot")
     if callable(custom):
-        custom(res, path)
-        return
+        try:
+            custom(res, path)
+            return
+        except Exception:  # noqa: BLE001 - only for a partial result, see below
+            if not partial:
+                raise
+        custom = None
     names = custom or [s.name for s in res.model.dae.y[:res.model.dae.n_states]
                        if "." in s.name and not s.name.startswith("der(")][:6]
     res.plot(names, path, title=mf.path.rsplit("/", 1)[-1])

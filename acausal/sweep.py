@@ -173,13 +173,21 @@ def _run_point(task: Callable[[dict], Mapping], point: dict, measures: Sequence[
 
     Runs on the worker, so only plain data (floats, strings) travels back.
     BaseExceptions such as KeyboardInterrupt propagate and stop the sweep.
+    A dict under ``"__missing__"`` in the task's result (measure -> why it has
+    no value) goes into the error column of the ``ok`` row, for the
+    measures asked for.
     """
     start = time.perf_counter()
     try:
-        values = _measure_values(task(dict(point)), measures)
+        result = task(dict(point))
+        values = _measure_values(result, measures)
     except Exception as exc:
         return {"status": "failed", "error": _one_line(exc), "values": {}, "wall_s": time.perf_counter() - start}
-    return {"status": "ok", "error": "", "values": values, "wall_s": time.perf_counter() - start}
+    missing = result.get("__missing__")
+    missing = missing if isinstance(missing, Mapping) else {}
+    note = "; ".join(f"{m} missing: {' '.join(str(missing[m]).split())}" for m in measures
+                     if m in missing)[:_MAX_ERROR_CHARS]
+    return {"status": "ok", "error": note, "values": values, "wall_s": time.perf_counter() - start}
 
 
 # ---------------------------------------------------------------------------
