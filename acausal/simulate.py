@@ -24,6 +24,7 @@ CHATTER_SPAN = 1e-9     # ... within this fraction of the time span is chatterin
 MAX_ITER = 20           # event iterations at one instant
 MAX_ROWS = 1_000_000    # stored output rows, by default (each 8 bytes per unknown, twice)
 WINDOW_S = 0.25         # wall time per integration window when watched [s]
+PROGRESS_DELAY_S = 2.0  # a progress bar shows once a run has lasted this long [s]
 
 
 class EventState:
@@ -414,7 +415,7 @@ class _Watch:
 
 def _progress_bar(span):
     from tqdm import tqdm
-    return tqdm(total=span, desc="simulate", unit="s", file=sys.stderr, delay=2.0,
+    return tqdm(total=span, desc="simulate", unit="s", file=sys.stderr, delay=PROGRESS_DELAY_S,
                 bar_format="{desc}: {percentage:3.0f}%|{bar}| t = {n:.4g}/{total:.4g} s "
                            "[{elapsed}<{remaining}{postfix}]")
 
