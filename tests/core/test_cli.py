@@ -21,7 +21,8 @@ def test_simulate_json_oscillator_matches_closed_form():
     r = run("simulate", os.path.join(EX, "oscillator.py"), "--json")
     assert r.exit_code == 0, r.output
     out = json.loads(r.output)
-    assert set(out) == {"final", "events", "measures", "stats"}
+    assert set(out) == {"final", "events", "measures", "missing", "stats", "status", "error"}
+    assert out["error"] is None and out["status"] == "ok" and out["missing"] == {}
     assert {"nfev", "steps", "wall_s", "compile_s"} <= set(out["stats"])
     exact = 0.1 * np.cos(10.0)
     assert abs(out["final"]["mass.s"] / exact - 1) < 1e-6
