@@ -224,8 +224,8 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
     watch = _Watch(run, wall0, max_rows, max_wall, max_total_steps, progress)
     try:
         while not stop and t < t_end:
-            ida = run.solver(watch.wrap(cb))
             tspan = _tspan(t, tout, t_end, watch.horizon(t))
+            ida = run.solver(watch.wrap(cb, tspan))
             # two points: IDA reports every internal step (output_step=0)
             _reset_event_log(getattr(run, "_roots", None))
             sol = watch.solve(ida, tspan, y, yp)
@@ -344,10 +344,14 @@ class _Watch:
     def horizon(self, t):
         return t + self.dt if self.windowed else None
 
-    def wrap(self, cb):
-        """``cb`` with its residual checking the limits every 64 calls."""
+    def wrap(self, cb, tspan):
+        """``cb`` with its residual checking the limits every 64 calls (when
+        limits are set, or when the call stores every step, as a two-point
+        ``tspan`` does; else ``cb`` itself)."""
         res, count, calls = cb[0], cb[5], [0]
         self.counter = count
+        if not self.windowed and len(tspan) != 2:
+            return cb
 
         def checked(t, y, yp, r):
             calls[0] += 1
