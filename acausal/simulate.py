@@ -295,9 +295,9 @@ def _check_output_size(cm, t0, t_end, output_step, output_times, max_rows):
                 f"the output grid (every {output_step or (t_end - t0) / 500:g} s from {t0:g} "
                 f"to {t_end:g} s)")
         raise LimitError(
-            f"{grid} has {n:.3g} rows (~{gb:.3g} GB), more than max_rows = {max_rows:g}: choose a larger "
-            "output step, output_step=0 (the solver's own steps), a shorter t_end, or raise "
-            "max_rows (--max-rows)", t=t0)
+            f"{grid} has {n:.3g} rows (~{gb:.3g} GB), more than max_rows = {max_rows:g}: "
+            "choose a larger output step, output_step=0 (the solver's own steps), a shorter "
+            "t_end, or raise max_rows (--max-rows)", t=t0)
 
 
 def _tspan(t, tout, t_end, horizon):
@@ -308,7 +308,7 @@ def _tspan(t, tout, t_end, horizon):
     if horizon is not None and horizon < t_end:
         cut = later[later <= horizon]
         if len(cut) == 0:
-            cut = later[:1] if len(later) and later[0] < t_end else np.array([horizon])
+            cut = later[:1] if len(later) else np.array([horizon])
         return np.concatenate([[t], cut])
     return np.concatenate([[t], later if len(later) and later[-1] >= t_end
                            else np.append(later, t_end)])
@@ -433,8 +433,8 @@ def _dominant(run, last=1000):
     """Which component's events dominate the recent ones, in words."""
     recent = run.event_log[-last:]
     if not recent:
-        return ("no events: the solver's own steps took the time (a stiff model: a very "
-                "stiff spring or contact, or a very light body?)")
+        return ("no events: the time went into the solver's own steps (a long span, or a "
+                "stiff model: a very stiff spring or contact, a very light body)")
     owner, n = Counter(o for _, o in recent).most_common(1)[0]
     names = Counter(nm for (tt, nm) in run.events[-last:]).most_common(2)
     return (f"{100 * n / len(recent):.0f}% of the last {len(recent)} events are in {owner} "
