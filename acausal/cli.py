@@ -119,7 +119,10 @@ def _c_stdout_to_stderr():
     try:
         yield
     finally:
-        ctypes.CDLL(None).fflush(None)
+        try:
+            ctypes.CDLL(None).fflush(None)   # C stdio buffers, before stdout is restored
+        except (OSError, TypeError, AttributeError):  # no C library handle (Windows)
+            pass
         os.dup2(saved, 1)
         os.close(saved)
 

@@ -205,9 +205,10 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
     the requested output grid, and during it); ``max_wall`` seconds of wall
     time; ``max_total_steps`` solver steps in the whole run (``max_steps``
     is IDA's limit between two outputs). ``progress``: a progress bar on
-    stderr, shown once a run has lasted 2 s. With a wall or step limit or a
-    progress bar, the time span is integrated in windows of about a quarter
-    of a second of wall time each (see :class:`_Watch`)."""
+    stderr, shown once a run has lasted 2 s (it does not change the
+    solution). With a wall or step limit the time span is integrated in
+    windows of about a quarter of a second of wall time each (see
+    :class:`_Watch`)."""
     wall0 = _time.perf_counter()
     p = cm.param_vector(params)
     d = cm.discrete_start()
@@ -323,7 +324,7 @@ class _Watch:
 
     Between two solver calls: the stored rows, the wall time and the steps
     are checked (:meth:`check`), the progress bar moves. With a wall or step
-    limit or a progress bar the span is cut into windows (:meth:`horizon`)
+    limit the span is cut into windows (:meth:`horizon`)
     sized to take about ``WINDOW_S`` of wall time each (every window
     restarts IDA, like an event). Inside a solver call the residual is
     wrapped (:meth:`wrap`): a call that runs far past a limit (or stores
@@ -333,7 +334,7 @@ class _Watch:
     def __init__(self, run, wall0, max_rows, max_wall, max_total_steps, progress):
         self.run, self.wall0 = run, wall0
         self.max_rows, self.max_wall, self.max_steps = max_rows, max_wall, max_total_steps
-        self.windowed = bool(progress) or max_wall is not None or max_total_steps is not None
+        self.windowed = max_wall is not None or max_total_steps is not None
         self.span = run.t_end - run.t0
         self.dt = self.span * 1e-4   # grows by up to 8x a window
         self.bar = _progress_bar(self.span) if progress else None
@@ -345,20 +346,26 @@ class _Watch:
         return t + self.dt if self.windowed else None
 
     def wrap(self, cb, tspan):
-        """``cb`` with its residual checking the limits every 64 calls (when
-        limits are set, or when the call stores every step, as a two-point
-        ``tspan`` does; else ``cb`` itself)."""
+        """``cb`` with its residual checking the limits and moving the
+        progress bar every 64 calls (when limits are set, a bar is shown or
+        the call stores every step, as a two-point ``tspan`` does; else
+        ``cb`` itself)."""
         res, count, calls = cb[0], cb[5], [0]
         self.counter = count
-        if not self.windowed and len(tspan) != 2:
+        if not self.windowed and self.bar is None and len(tspan) != 2:
             return cb
 
         def checked(t, y, yp, r):
             calls[0] += 1
             if calls[0] % 64 == 0:
                 self._hard(count[0])
+                self._show(t)
             res(t, y, yp, r)
         return (checked,) + tuple(cb[1:])
+
+    def _show(self, t):
+        if self.bar is not None and t - self.run.t0 > self.bar.n:
+            self.bar.update(t - self.run.t0 - self.bar.n)
 
     def _hard(self, steps_now):
         steps = self.run.steps + steps_now
@@ -388,7 +395,7 @@ class _Watch:
             took = max(now - self.t_call, 1e-6)
             self.dt *= min(8.0, max(0.25, WINDOW_S / took))
         if self.bar is not None:
-            self.bar.update(t - run.t0 - self.bar.n)
+            self._show(t)
             self.bar.set_postfix(steps=run.steps, events=len(run.events), refresh=False)
         if self.max_rows is not None and run.rows > self.max_rows:
             raise self._error("rows", t)

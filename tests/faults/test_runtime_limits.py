@@ -166,9 +166,13 @@ def test_progress_bar_on_stderr(tmp_path, capsys, monkeypatch):
 
     monkeypatch.setattr(sim, "PROGRESS_DELAY_S", 0.0)
     _, cm = compile_file(write(tmp_path, "spring.py", SPRING))
-    cm.simulate(t_end=1.0, output_step=1e-3, progress=True)
+    shown = cm.simulate(t_end=1.0, output_step=1e-3, progress=True)
     err = capsys.readouterr().err
     assert "simulate:" in err and "100%" in err and "t = 1/1 s" in err
+    plain = cm.simulate(t_end=1.0, output_step=1e-3)
+    assert capsys.readouterr().err == ""
+    assert shown.stats["steps"] == plain.stats["steps"]      # the bar does not touch the run
+    np.testing.assert_allclose(shown["body.s"], plain["body.s"], rtol=0, atol=1e-15)
 
 
 # -- missing measures ------------------------------------------------------------------
