@@ -11,7 +11,7 @@ from .compile import CompiledModel, compile_model
 from .connectors import Flange, Port, RotFlange
 from .declare import Assertion, Discrete, Event, Parameter, Start, Variable, guess
 from .experiment import Experiment, Measure, Stop
-from .errors import (AcausalError, ChatteringError, InitializationError, ModelError,
+from .errors import (AcausalError, ChatteringError, InitializationError, LimitError, ModelError,
                      ParameterError, SolverError, StructuralError)
 from .symbols import der, time
 
@@ -20,5 +20,5 @@ __all__ = [
     "Parameter", "Variable", "Discrete", "Event", "Assertion", "Start", "guess", "der",
     "time", "Eq", "Experiment", "Measure", "Stop", "AcausalError", "ModelError",
     "ParameterError", "StructuralError",
-    "InitializationError", "SolverError", "ChatteringError",
+    "InitializationError", "SolverError", "ChatteringError", "LimitError",
 ]

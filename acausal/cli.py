@@ -3,6 +3,7 @@
 Exit codes: 0 success, 2 a model or input error (one readable message on
 stderr), 3 a solver failure (time and component named).
 """
+import contextlib
 import json
 import sys
 
@@ -46,64 +47,143 @@ def main():
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object")
 @click.option("--rtol", type=float)
 @click.option("--atol", type=float)
-def simulate(file, t_end, sets, out, plot, as_json, rtol, atol):
+@click.option("--max-rows", type=int, default=None, metavar="N",
+              help="most output rows to store (default 1e6): a larger grid is refused")
+@click.option("--max-wall", type=float, metavar="SECONDS",
+              help="stop after this wall time, keeping what was computed")
+@click.option("--max-steps", type=int, metavar="N",
+              help="stop after this many solver steps, keeping what was computed")
+@click.option("--progress/--no-progress", default=None,
+              help="progress bar on stderr for runs longer than 2 s "
+                   "(default: when stderr is a terminal)")
+def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, max_rows, max_wall, max_steps,
+             progress):
     """Simulate a model file."""
-    from .modelfile import compile_file, evaluate_measures
+    from .modelfile import compile_file, measure_values
     try:
         params = _parse_sets(sets)
         mf, cm = compile_file(file)
-        # a CSV or a plot needs the model file's dense grid; measures do not
-        opts = mf.experiment.run_options(dense=bool(out or plot))
-        for k, v in dict(t_end=t_end, rtol=rtol, atol=atol).items():
-            if v is not None:
-                opts[k] = v
-        try:
-            res = cm.simulate(params=params, **opts)
-        except SolverError as exc:
-            if exc.result is not None and out:
-                exc.result.to_csv(out)
-                click.echo(f"acausal: partial results up to t = {exc.t:.6g} s written to {out}",
-                           err=True)
-            raise
-        measures = evaluate_measures(mf, res)
+        opts = _simulate_options(mf, dict(t_end=t_end, rtol=rtol, atol=atol, max_rows=max_rows,
+                                          max_wall=max_wall, max_total_steps=max_steps),
+                                 progress, dense=bool(out or plot))
+        with _c_stdout_to_stderr() if as_json else contextlib.nullcontext():
+            res, error = _run_keeping_partial(cm, params, opts)
+        measures, missing = measure_values(mf, res) if error is None else ({}, {})
         if out:
             res.to_csv(out)
+            if error is not None:
+                click.echo(f"acausal: partial results up to t = {res.t[-1]:.6g} s written to "
+                           f"{out}", err=True)
         if plot:
-            _plot(mf, res, plot)
+            _plot(mf, res, plot, partial=error is not None)
     except (AcausalError, click.BadParameter) as exc:
+        if as_json:
+            click.echo(json.dumps({"error": _error_dict(exc)}, indent=1))
         _fail(exc)
-    _print_simulation(mf, cm, res, measures, as_json)
-
-
-def _print_simulation(mf, cm, res, measures, as_json):
-    """The result of ``simulate`` on stdout: one JSON object (values in SI
-    units, named in ``units``), or a summary with each measure in its
-    display unit."""
-    from .modelfile import measure_unit, show_measure
-    final = res.final()
     if as_json:
-        click.echo(json.dumps({
-            "final": final,
-            "events": [{"t": t, "name": n} for t, n in res.events],
-            "measures": measures,
-            "units": {"time": "s", "final": {n: res.unit(n) for n in final},
-                      "measures": {k: measure_unit(mf, k) for k in measures}},
-            "stats": {k: res.stats.get(k) for k in ("nfev", "steps", "wall_s", "compile_s",
-                                                    "njev", "events")},
-        }, indent=1))
-        return
+        click.echo(json.dumps(_result_dict(mf, res, measures, missing, error), indent=1))
+    else:
+        _print_run(mf, cm, res, measures, missing)
+    if error is not None:
+        _fail(error)
+
+
+def _simulate_options(mf, given, progress, dense=False):
+    """The model file's run options (its dense grid when a CSV or a plot
+    needs one; measures do not), overridden by the command line's."""
+    opts = mf.experiment.run_options(dense=dense)
+    opts.update({k: v for k, v in given.items() if v is not None})
+    opts["progress"] = sys.stderr.isatty() if progress is None else progress
+    return opts
+
+
+def _run_keeping_partial(cm, params, opts):
+    """(result, None), or (partial result, the SolverError) when the solver
+    failed or a limit stopped the run after computing something."""
+    try:
+        return cm.simulate(params=params, **opts), None
+    except SolverError as exc:
+        if exc.result is None or len(exc.result.t) == 0:
+            raise
+        return exc.result, exc
+
+
+@contextlib.contextmanager
+def _c_stdout_to_stderr():
+    """Send what C code prints to stdout (SUNDIALS writes its error lines
+    there) to stderr instead, so that stdout carries only the JSON."""
+    import ctypes
+    import os
+    sys.stdout.flush()
+    saved = os.dup(1)
+    os.dup2(2, 1)
+    try:
+        yield
+    finally:
+        try:
+            ctypes.CDLL(None).fflush(None)   # C stdio buffers, before stdout is restored
+        except (OSError, TypeError, AttributeError):  # no C library handle (Windows)
+            pass
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+def _finite(x):
+    return x if x == x and abs(x) != float("inf") else None
+
+
+def _error_dict(exc):
+    out = {"type": type(exc).__name__, "message": str(exc)}
+    for k in ("t", "component"):
+        if getattr(exc, k, None) is not None:
+            out[k] = getattr(exc, k)
+    return out
+
+
+def _result_dict(mf, res, measures, missing, error):
+    """The ``--json`` object: values in SI units, named in ``units``."""
+    from .modelfile import measure_unit
+    final = res.final()
+    return {
+        "error": None if error is None else _error_dict(error),
+        "status": res.status,
+        "final": {k: _finite(v) for k, v in final.items()},
+        "events": [{"t": t, "name": n} for t, n in res.events],
+        "measures": {k: _finite(v) for k, v in measures.items()},
+        "missing": missing,
+        "units": {"time": "s", "final": {n: res.unit(n) for n in final},
+                  "measures": {k: measure_unit(mf, k) for k in measures}},
+        "stats": {k: res.stats.get(k) for k in ("nfev", "steps", "wall_s", "compile_s",
+                                                "njev", "events")},
+    }
+
+
+def _print_run(mf, cm, res, measures, missing):
+    """The summary on stdout, each measure in its display unit."""
+    from .modelfile import show_measure
     click.echo(f"simulated {mf.path}: t = {res.t[0]:g} .. {res.t[-1]:g} s, "
                f"{len(res.events)} events, {res.stats['steps']} steps, "
                f"{res.stats['wall_s'] * 1e3:.1f} ms (compile {cm.compile_s:.2f} s)")
     for k, v in measures.items():
-        click.echo(f"  {k} = {show_measure(mf, k, v)}")
+        if k in missing:
+            click.echo(f"  {k} = missing ({missing[k]})")
+        else:
+            click.echo(f"  {k} = {show_measure(mf, k, v)}")
 
 
-def _plot(mf, res, path):
+def _plot(mf, res, path, partial=False):
+    """The model file's plot (or its list of variables), else the states.
+    A partial result that the model file's plot function cannot draw gets
+    the default plot."""
     custom = mf.namespace.get("plot")
     if callable(custom):
-        custom(res, path)
-        return
+        try:
+            custom(res, path)
+            return
+        except Exception:  # noqa: BLE001 - only for a partial result, see below
+            if not partial:
+                raise
+        custom = None
     res.plot(custom or None, path, title=mf.path.rsplit("/", 1)[-1])
 
 
@@ -219,9 +299,12 @@ def _profile_line(prof):
 @click.argument("file", type=click.Path(dir_okay=False))
 @click.option("--param", "params", multiple=True, required=True, metavar="NAME=A:B:N",
               help="a swept parameter: start:stop:count, a list a,b,c, or one value")
-@click.option("--measure", "measures", multiple=True, required=True, help="measure(s) to record")
+@click.option("--measure", "measures", multiple=True, required=True, metavar="M1,M2,...",
+              help="measure(s) to record: a list a,b or the option repeated")
 @click.option("--out", type=click.Path(dir_okay=False), default="sweep.csv", show_default=True,
-              help="results CSV; running again with the same file resumes")
+              help="results CSV; finished points are checkpointed in OUT.partial/ as they "
+                   "finish, so running the same command again after an interruption "
+                   "(even a kill) resumes")
 @click.option("--plot", type=click.Path(dir_okay=False), help="plot the first measure")
 @click.option("--scheduler", help="Dask scheduler address (default: local processes)")
 @click.option("--workers", type=int, help="local worker processes (default: all cores)")
@@ -231,9 +314,11 @@ def sweep(file, params, measures, out, plot, scheduler, workers, no_progress):
     import functools
     import os
 
-    from .executor import open_executor
+    from .checkpoint import source_files
+    from .executor import open_executor, terminate_on_sigterm
     from .modelfile import compile_file, sweep_task
     from .sweep import grid, parse_param, plot_sweep, run_sweep
+    measures = _csv_list(",".join(measures))
     try:
         mf, cm = compile_file(file)
         specs = [parse_param(p) for p in params]
@@ -244,15 +329,27 @@ def sweep(file, params, measures, out, plot, scheduler, workers, no_progress):
                 raise click.BadParameter(f"--measure {m!r}: the model file defines "
                                          f"{sorted(mf.measures) or 'no measures'}")
         task = functools.partial(sweep_task, os.path.abspath(file))
-        with open_executor(scheduler, workers) as ex:
-            rows = run_sweep(task, grid(specs), out, executor=ex, measures=list(measures),
-                             progress=not no_progress)
+        with terminate_on_sigterm(), _resumable(out), open_executor(scheduler, workers) as ex:
+            rows = run_sweep(task, grid(specs), out, executor=ex, measures=measures,
+                             progress=not no_progress, inputs=source_files(file))
         if plot:
             plot_sweep(rows, specs[0][0], measures[0], plot)
     except (AcausalError, click.BadParameter, ValueError) as exc:
         _fail(exc)
     failed = sum(1 for r in rows if r.get("status") != "ok")
     click.echo(f"{len(rows)} points, {failed} failed; results in {out}")
+
+
+@contextlib.contextmanager
+def _resumable(where):
+    """An interruption (Ctrl-C, SIGTERM) ends with one line saying where the
+    finished work is, and exit code 130."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        click.echo(f"acausal: interrupted; finished work is saved in {where}: run the same "
+                   "command again to resume", err=True)
+        sys.exit(130)
 
 
 def _csv_list(text):
@@ -265,7 +362,10 @@ def _csv_list(text):
 @click.option("--json", "json_path", type=click.Path(dir_okay=False),
               help="write the summary as one JSON object to this file")
 @click.option("--report", "report_dir", type=click.Path(file_okay=False), default="diagnosis",
-              show_default=True, help="folder for report.md, plots and the extended model")
+              show_default=True, help="folder for report.md, plots and the extended model; "
+                                      "finished fits are checkpointed in REPORT/checkpoint/ as "
+                                      "they finish, so running the same command again after an "
+                                      "interruption (even a kill) resumes")
 @click.option("--scheduler", help="Dask scheduler address (default: local processes)")
 @click.option("--workers", type=int, help="local worker processes (default: all cores)")
 @click.option("--hypotheses", metavar="ID,ID,...", help="only these hypotheses")
@@ -281,13 +381,15 @@ def diagnose(file, data, json_path, report_dir, scheduler, workers, hypotheses, 
     extend the model and measure the gain."""
     from .data import DataError
     from .diagnose.run import diagnose as run_diagnosis
+    from .executor import terminate_on_sigterm
     try:
         if not 0 < alpha < 1:
             raise click.BadParameter(f"--alpha {alpha}: must be between 0 and 1")
-        out = run_diagnosis(file, data, out_dir=report_dir, scheduler=scheduler,
-                            workers=workers, progress=not no_progress,
-                            hypotheses=_csv_list(hypotheses), locations=_csv_list(locations),
-                            alpha=alpha, library=library)
+        with terminate_on_sigterm(), _resumable(f"{report_dir}/checkpoint"):
+            out = run_diagnosis(file, data, out_dir=report_dir, scheduler=scheduler,
+                                workers=workers, progress=not no_progress,
+                                hypotheses=_csv_list(hypotheses),
+                                locations=_csv_list(locations), alpha=alpha, library=library)
     except (AcausalError, DataError, click.BadParameter, ValueError, ImportError) as exc:
         _fail(exc)
     if json_path:

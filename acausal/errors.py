@@ -48,5 +48,11 @@ class ChatteringError(SolverError):
     """Too many events in a tiny time window."""
 
 
+class LimitError(SolverError):
+    """A limit the caller set (stored output rows, wall time, solver steps)
+    stopped the run; ``result`` holds what was computed up to ``t`` and
+    ``component`` names the component whose events dominated."""
+
+
 class ModelFileError(ModelError):
     """A model file could not be loaded; the message names file and line."""

@@ -30,14 +30,18 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import contextlib
+import ctypes
 import functools
 import os
 import re
+import signal
+import sys
 import threading
+import time
 from collections.abc import Callable, Hashable, Iterable, Iterator
 from typing import Any
 
-__all__ = ["Executor", "open_executor", "worker_cache", "clear_worker_cache"]
+__all__ = ["Executor", "open_executor", "worker_cache", "clear_worker_cache", "terminate_on_sigterm"]
 
 _ADDRESS = re.compile(r"^([a-z][a-z0-9+.-]*://\S+|[\w.-]+:\d+)$", re.IGNORECASE)
 
@@ -233,15 +237,93 @@ def _is_dask_object(obj: Any) -> bool:
     return type(obj).__module__.split(".")[0] == "distributed"
 
 
+# ---------------------------------------------------------------------------
+# Workers die with their parent
+# ---------------------------------------------------------------------------
+
+WATCH_S = 0.5  # how often a worker checks that its parent is alive [s]
+_PR_SET_PDEATHSIG = 1  # from <linux/prctl.h>
+
+
+def _die_with_parent(parent: int) -> None:
+    """Pool-worker initializer: end this process when its parent ends.
+
+    On Linux the kernel sends SIGKILL when the parent dies
+    (``prctl(PR_SET_PDEATHSIG)``, through ctypes); everywhere, a daemon
+    thread checks every ``WATCH_S`` seconds that the parent is still the
+    parent (an orphan is re-parented) and ends the worker if not. So a
+    sweep or diagnosis killed by SIGKILL leaves no worker computing on.
+    """
+    if sys.platform.startswith("linux"):
+        try:
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+        except (OSError, AttributeError):  # no prctl: the watchdog alone
+            pass
+    if os.getppid() != parent:  # the parent died before prctl took effect
+        os._exit(1)
+    threading.Thread(target=_watch_parent, args=(parent,), daemon=True,
+                     name="acausal-parent-watchdog").start()
+
+
+def _watch_parent(parent: int) -> None:
+    while os.getppid() == parent:
+        time.sleep(WATCH_S)
+    os._exit(1)
+
+
+def _terminate_workers(pool: cf.ProcessPoolExecutor) -> None:
+    """Stop the pool's workers now, running tasks included (after an
+    interruption: their results would be thrown away anyway)."""
+    if hasattr(pool, "terminate_workers"):  # Python >= 3.14
+        pool.terminate_workers()
+        return
+    # Before 3.14 the pool does not expose its processes: this module is the
+    # one place that reaches into concurrent.futures' private state.
+    procs = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for proc in procs:
+        if proc.is_alive():
+            proc.terminate()
+    for proc in procs:
+        proc.join(timeout=5.0)
+
+
 @contextlib.contextmanager
 def _process_pool(workers: int | None):
+    """A local pool whose workers die with this process (see
+    :func:`_die_with_parent`); on an exception (an interruption, SIGTERM
+    turned into one by the CLI) the workers are terminated, not waited for."""
     n = default_workers() if workers is None else workers
-    pool = cf.ProcessPoolExecutor(max_workers=n)
+    pool = cf.ProcessPoolExecutor(max_workers=n, initializer=_die_with_parent,
+                                  initargs=(os.getpid(),))
     try:
         yield Executor("processes", pool, n)
-    finally:
+    except BaseException:
+        _terminate_workers(pool)
+        raise
+    else:
         # Pending tasks are dropped; running ones finish (at most one per worker).
         pool.shutdown(wait=True, cancel_futures=True)
+
+
+@contextlib.contextmanager
+def terminate_on_sigterm():
+    """Turn SIGTERM into :class:`KeyboardInterrupt` in the main thread while
+    the block runs, so that a killed command unwinds: its process pool is
+    terminated and its finished work saved (restores the old handler)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def handler(signum, frame):
+        raise KeyboardInterrupt(f"terminated by signal {signum}")
+
+    old = signal.signal(signal.SIGTERM, handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, old)
 
 
 @contextlib.contextmanager

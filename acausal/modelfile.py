@@ -152,6 +152,22 @@ def show_measure(mf, name, value):
         return f"{value:.6g}"
     v, unit = fn.shown(value)
     return f"{v:.6g} {unit}" if unit != "1" else f"{v:.6g}"
+def measure_values(mf, result):
+    """(name -> float, name -> reason): every measure of the model file; one
+    that cannot be computed from this result (an event that never happened,
+    say) is NaN in the first dict and has its reason in the second, so the
+    others are kept."""
+    values, missing = {}, {}
+    for name, fn in mf.measures.items():
+        try:
+            values[name] = float(fn(result))
+        except Exception as exc:  # noqa: BLE001 - the model file's code: reported, not raised
+            values[name] = float("nan")
+            missing[name] = f"{type(exc).__name__}: {exc}"
+            continue
+        if values[name] != values[name]:
+            missing[name] = "no value (the measure gave NaN)"
+    return values, missing
 
 
 def run_file(path, params=None, **overrides):
@@ -166,5 +182,9 @@ def run_file(path, params=None, **overrides):
 def sweep_task(path, point):
     """One sweep point: the model file compiled once per worker process
     (the compile cache is per process), simulated with ``point`` as
-    parameter overrides; returns the measures. Module-level, so picklable."""
-    return run_file(path, params=point)[1]
+    parameter overrides; returns the measures (NaN for one that cannot be
+    computed, with its reason in ``"__missing__"``). Module-level, so picklable."""
+    mf, cm = compile_file(path)
+    opts = mf.experiment.run_options()
+    values, missing = measure_values(mf, cm.simulate(params=point, **opts))
+    return {**values, "__missing__": missing}

@@ -8,18 +8,23 @@ integration restarts. Output: requested times, plus both sides of every
 event. A burst of events in a tiny window stops the run with a
 :class:`ChatteringError` naming the component.
 """
+import sys
 import time as _time
+from collections import Counter
 
 import numpy as np
 from sksundae.ida import IDA
 
-from .errors import ChatteringError, SolverError
+from .errors import ChatteringError, LimitError, SolverError
 from .initialize import initial_point, reinitialize
 from .result import Result
 
 CHATTER_COUNT = 100     # this many events ...
 CHATTER_SPAN = 1e-9     # ... within this fraction of the time span is chattering
 MAX_ITER = 20           # event iterations at one instant
+MAX_ROWS = 1_000_000    # stored output rows, by default (each 8 bytes per unknown, twice)
+WINDOW_S = 0.25         # wall time per integration window when watched [s]
+PROGRESS_DELAY_S = 2.0  # a progress bar shows once a run has lasted this long [s]
 
 
 class EventState:
@@ -126,7 +131,7 @@ class _Run:
                          max_num_steps=max_steps)
         self.T, self.Y, self.YP, self.D = [], [], [], []
         self.events, self.event_log = [], []
-        self.nfev = self.njev = self.steps = 0
+        self.nfev = self.njev = self.steps = self.rows = 0
         ev = cm.events
         self.directions = [e.direction for e in ev] + [-1] * len(cm.assertions)
 
@@ -135,6 +140,7 @@ class _Run:
         self.Y.append(np.atleast_2d(np.asarray(y, float)))
         self.YP.append(np.atleast_2d(np.asarray(yp, float)))
         self.D.append(np.tile(np.asarray(d, float), (len(self.T[-1]), 1)))
+        self.rows += len(self.T[-1])
 
     def solver(self, cb):
         """The IDA object of this run, made once: its callbacks dispatch to the
@@ -176,7 +182,8 @@ class _Run:
 
 
 def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_step=None,
-             output_times=None, max_step=None, max_steps=100000, atol_algebraic=None):
+             output_times=None, max_step=None, max_steps=100000, atol_algebraic=None,
+             max_rows=MAX_ROWS, max_wall=None, max_total_steps=None, progress=False):
     """Simulate a :class:`CompiledModel` from ``t0`` to ``t_end`` (or until a
     terminal event). ``params`` overrides parameter values, and the start
     values of variables whose start is fixed, by dotted path (both are
@@ -192,7 +199,18 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
     the step size collapses. A large value (e.g. 1e-2) practically leaves
     them out of the error test (like IDA's ``suppressalg``, which
     scikit-sundae does not expose); their accuracy then follows from the
-    states'. Default ``None``: ``atol`` for all, as before."""
+    states'. Default ``None``: ``atol`` for all, as before.
+
+    Limits (each stops the run with a :class:`~acausal.errors.LimitError`
+    that keeps the partial result and names the component whose events
+    dominate): ``max_rows`` stored output rows (checked before the run for
+    the requested output grid, and during it); ``max_wall`` seconds of wall
+    time; ``max_total_steps`` solver steps in the whole run (``max_steps``
+    is IDA's limit between two outputs). ``progress``: a progress bar on
+    stderr, shown once a run has lasted 2 s (it does not change the
+    solution). With a wall or step limit the time span is integrated in
+    windows of about a quarter of a second of wall time each (see
+    :class:`_Watch`)."""
     wall0 = _time.perf_counter()
     params, starts = cm.split_overrides(params)
     p = cm.param_vector(params)
@@ -203,18 +221,18 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
     run.cb_d = list(d)
     y, yp = initial_point(cm, p, d, cb, t0, starts)
     y, yp, d, cb, stop = _event_iteration(run, cb, t0, y, yp, d, initial=True)
+    _check_output_size(cm, t0, t_end, output_step, output_times, max_rows)
     tout = _output_times(t0, t_end, output_step, output_times)
     run.record(t0, y, yp, d)
     t = t0
+    watch = _Watch(run, wall0, max_rows, max_wall, max_total_steps, progress)
     try:
         while not stop and t < t_end:
-            ida = run.solver(cb)
-            later = tout[tout > t]
-            tspan = np.concatenate([[t], later if len(later) and later[-1] >= t_end
-                                    else np.append(later, t_end)])
+            tspan = _tspan(t, tout, t_end, watch.horizon(t))
+            ida = run.solver(watch.wrap(cb, tspan))
             # two points: IDA reports every internal step (output_step=0)
             _reset_event_log(getattr(run, "_roots", None))
-            sol = ida.solve(tspan, y, yp)
+            sol = watch.solve(ida, tspan, y, yp)
             if len(tspan) == 2 and output_step != 0 and len(sol.t) > 2:
                 # IDA reported every internal step; keep what was asked for
                 keep = np.r_[0, len(sol.t) - 1]
@@ -231,11 +249,14 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
                 raise _failure(run, cm, sol, cb)
             run.record(sol_t[1:], sol_y[1:], sol_yp[1:], d)
             t, y, yp = float(sol.t[-1]), np.array(sol.y[-1]), np.array(sol.yp[-1])
+            watch.check(t)
             d, final_fired = _observers(run, cb, sol, d)
             if d != run.cb_d:
                 cb = cm.callbacks(run.p, d)
             run.cb_d = list(d)
             if sol.status != 2:
+                if tspan[-1] < t_end:   # the end of a window of the watch
+                    continue
                 break
             fired = final_fired
             d_before = list(d)
@@ -246,10 +267,188 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
         exc.result = exc.result or run.result("failed", str(exc))
         exc.result.stats["wall_s"] = _time.perf_counter() - wall0
         raise
+    finally:
+        watch.close()
     res = run.result()
     res.stats["wall_s"] = _time.perf_counter() - wall0
     res.stats["compile_s"] = cm.compile_s
     return res
+
+
+# ---------------------------------------------------------------------------
+# Limits and progress of a run (output rows, wall time, steps)
+# ---------------------------------------------------------------------------
+
+
+def _output_count(t0, t_end, output_step, output_times):
+    """Rows the requested output grid will store (before building it)."""
+    if output_times is not None:
+        return len(output_times)
+    if output_step == 0:
+        return 2
+    step = output_step or (t_end - t0) / 500.0
+    return (t_end - t0) / step + 1
+
+
+def _check_output_size(cm, t0, t_end, output_step, output_times, max_rows):
+    """Refuse, before allocating it, an output grid of more than ``max_rows`` rows."""
+    n = _output_count(t0, t_end, output_step, output_times)
+    if max_rows is not None and n > max_rows:
+        gb = n * 8 * (2 * len(cm.dae.y) + len(cm.discretes) + 1) / 1e9
+        grid = ("the output times" if output_times is not None else
+                f"the output grid (every {output_step or (t_end - t0) / 500:g} s from {t0:g} "
+                f"to {t_end:g} s)")
+        raise LimitError(
+            f"{grid} has {n:.3g} rows (~{gb:.3g} GB), more than max_rows = {max_rows:g}: "
+            "choose a larger output step, output_step=0 (the solver's own steps), a shorter "
+            "t_end, or raise max_rows (--max-rows)", t=t0)
+
+
+def _tspan(t, tout, t_end, horizon):
+    """Times of the next solver call: ``t``, then the output times after it,
+    up to ``t_end`` (which ends the span), or up to ``horizon`` when a watch
+    cuts the run into windows (at least one output time)."""
+    later = tout[tout > t]
+    if horizon is not None and horizon < t_end:
+        cut = later[later <= horizon]
+        if len(cut) == 0:
+            cut = later[:1] if len(later) else np.array([horizon])
+        return np.concatenate([[t], cut])
+    return np.concatenate([[t], later if len(later) and later[-1] >= t_end
+                           else np.append(later, t_end)])
+
+
+class _HardStop(Exception):
+    """Raised from inside the residual when a limit is far exceeded."""
+
+
+class _Watch:
+    """The limits and the progress bar of one run.
+
+    Between two solver calls: the stored rows, the wall time and the steps
+    are checked (:meth:`check`), the progress bar moves. With a wall or step
+    limit the span is cut into windows (:meth:`horizon`)
+    sized to take about ``WINDOW_S`` of wall time each (every window
+    restarts IDA, like an event). Inside a solver call the residual is
+    wrapped (:meth:`wrap`): a call that runs far past a limit (or stores
+    every step past ``max_rows``) is stopped; the rows of that call are lost,
+    the earlier ones kept."""
+
+    def __init__(self, run, wall0, max_rows, max_wall, max_total_steps, progress):
+        self.run, self.wall0 = run, wall0
+        self.max_rows, self.max_wall, self.max_steps = max_rows, max_wall, max_total_steps
+        self.windowed = max_wall is not None or max_total_steps is not None
+        self.span = run.t_end - run.t0
+        self.dt = self.span * 1e-4   # grows by up to 8x a window
+        self.bar = _progress_bar(self.span) if progress else None
+        self.t_call = None
+        self.counter = None
+        self.every_step = False
+
+    def horizon(self, t):
+        return t + self.dt if self.windowed else None
+
+    def wrap(self, cb, tspan):
+        """``cb`` with its residual checking the limits and moving the
+        progress bar every 64 calls (when limits are set, a bar is shown or
+        the call stores every step, as a two-point ``tspan`` does; else
+        ``cb`` itself)."""
+        res, count, calls = cb[0], cb[5], [0]
+        self.counter = count
+        if not self.windowed and self.bar is None and len(tspan) != 2:
+            return cb
+
+        def checked(t, y, yp, r):
+            calls[0] += 1
+            if calls[0] % 64 == 0:
+                self._hard(count[0])
+                self._show(t)
+            res(t, y, yp, r)
+        return (checked,) + tuple(cb[1:])
+
+    def _show(self, t):
+        if self.bar is not None and t - self.run.t0 > self.bar.n:
+            self.bar.update(t - self.run.t0 - self.bar.n)
+
+    def _hard(self, steps_now):
+        steps = self.run.steps + steps_now
+        wall = _time.perf_counter() - self.wall0
+        if self.max_wall is not None and wall > 1.25 * self.max_wall + 1.0:
+            raise _HardStop("wall")
+        if self.max_steps is not None and steps > 1.25 * self.max_steps + 1000:
+            raise _HardStop("steps")
+        if (self.every_step and self.max_rows is not None
+                and self.run.rows + steps_now > self.max_rows):
+            raise _HardStop("rows")  # every step is stored (a two-point span)
+
+    def solve(self, ida, tspan, y, yp):
+        self.t_call = _time.perf_counter()
+        self.every_step = len(tspan) == 2
+        try:
+            return ida.solve(tspan, y, yp)
+        except _HardStop as exc:
+            self.run.steps += self.counter[0]
+            self.counter[0] = 0
+            raise self._error(str(exc), float(tspan[0])) from None
+
+    def check(self, t):
+        """After a solver call that reached ``t``: limits, progress, next window."""
+        run, now = self.run, _time.perf_counter()
+        if self.t_call is not None and self.windowed:
+            took = max(now - self.t_call, 1e-6)
+            self.dt *= min(8.0, max(0.25, WINDOW_S / took))
+        if self.bar is not None:
+            self._show(t)
+            self.bar.set_postfix(steps=run.steps, events=len(run.events), refresh=False)
+        if self.max_rows is not None and run.rows > self.max_rows:
+            raise self._error("rows", t)
+        if self.max_wall is not None and now - self.wall0 > self.max_wall:
+            raise self._error("wall", t)
+        if self.max_steps is not None and run.steps > self.max_steps:
+            raise self._error("steps", t)
+
+    def _error(self, which, t):
+        run = self.run
+        what = {"rows": ("more than max_rows = {:g} stored output rows", self.max_rows),
+                "wall": ("the wall-time limit max_wall = {:g} s", self.max_wall),
+                "steps": ("the step limit max_total_steps = {:g}", self.max_steps)}[which]
+        what = what[0].format(what[1])
+        t_last = float(run.T[-1][-1]) if run.T else t
+        why = (_dominant(run) if which != "rows" else "an output step, a shorter t_end or a "
+               "larger max_rows (--max-rows) stores less")
+        msg = (f"stopped at t = {t_last:.6g} s of {run.t_end:g} s by {what} "
+               f"({run.steps} steps, {len(run.events)} events, "
+               f"{_time.perf_counter() - self.wall0:.3g} s): {why}")
+        return LimitError(msg, t=t_last, component=_dominant_owner(run),
+                          result=run.result("stopped", msg))
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()
+
+
+def _progress_bar(span):
+    from tqdm import tqdm
+    return tqdm(total=span, desc="simulate", unit="s", file=sys.stderr, delay=PROGRESS_DELAY_S,
+                bar_format="{desc}: {percentage:3.0f}%|{bar}| t = {n:.4g}/{total:.4g} s "
+                           "[{elapsed}<{remaining}{postfix}]")
+
+
+def _dominant_owner(run, last=1000):
+    owners = Counter(o for _, o in run.event_log[-last:])
+    return owners.most_common(1)[0][0] if owners else None
+
+
+def _dominant(run, last=1000):
+    """Which component's events dominate the recent ones, in words."""
+    recent = run.event_log[-last:]
+    if not recent:
+        return ("no events: the time went into the solver's own steps (a long span, or a "
+                "stiff model: a very stiff spring or contact, a very light body)")
+    owner, n = Counter(o for _, o in recent).most_common(1)[0]
+    names = Counter(nm for (tt, nm) in run.events[-last:]).most_common(2)
+    return (f"{100 * n / len(recent):.0f}% of the last {len(recent)} events are in {owner} "
+            f"({', '.join(nm for nm, _ in names)})")
 
 
 def _reset_event_log(roots):

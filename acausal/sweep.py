@@ -2,9 +2,12 @@
 
 A sweep maps each point of a grid (a dict ``{param_name: float}``) through a
 ``task(point) -> {measure_name: value}`` on an executor from
-:func:`acausal.executor.open_executor`. Every finished point is appended to a
-CSV file at once, so a sweep that stops midway loses no finished work, and
-running it again with the same CSV computes only the missing points::
+:func:`acausal.executor.open_executor`. Every finished point is appended at
+once to a checkpoint beside the CSV (``<csv>.partial/``, one checksummed line
+per point, see :mod:`acausal.checkpoint`) and the CSV is replaced atomically
+every few seconds, so a sweep killed at any moment loses no finished work and
+leaves no corrupt row, and running it again with the same CSV computes only
+the missing points::
 
     params = [parse_param("v_impact=3:5:21"), parse_param("contact.K=1e5,1e6")]
     with open_executor(workers=2) as ex:
@@ -21,10 +24,11 @@ are matched between runs by these values.
 
 from __future__ import annotations
 
-import contextlib
 import csv
 import itertools
+import json
 import math
+import os
 import pickle
 import re
 import sys
@@ -35,6 +39,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from .checkpoint import Checkpoint, input_key
 
 __all__ = ["parse_param", "grid", "run_sweep", "plot_sweep", "SweepRows", "SweepAborted"]
 
@@ -167,13 +173,21 @@ def _run_point(task: Callable[[dict], Mapping], point: dict, measures: Sequence[
 
     Runs on the worker, so only plain data (floats, strings) travels back.
     BaseExceptions such as KeyboardInterrupt propagate and stop the sweep.
+    A dict under ``"__missing__"`` in the task's result (measure -> why it has
+    no value) goes into the error column of the ``ok`` row, for the
+    measures asked for.
     """
     start = time.perf_counter()
     try:
-        values = _measure_values(task(dict(point)), measures)
+        result = task(dict(point))
+        values = _measure_values(result, measures)
     except Exception as exc:
         return {"status": "failed", "error": _one_line(exc), "values": {}, "wall_s": time.perf_counter() - start}
-    return {"status": "ok", "error": "", "values": values, "wall_s": time.perf_counter() - start}
+    missing = result.get("__missing__")
+    missing = missing if isinstance(missing, Mapping) else {}
+    note = "; ".join(f"{m} missing: {' '.join(str(missing[m]).split())}" for m in measures
+                     if m in missing)[:_MAX_ERROR_CHARS]
+    return {"status": "ok", "error": note, "values": values, "wall_s": time.perf_counter() - start}
 
 
 # ---------------------------------------------------------------------------
@@ -237,8 +251,8 @@ def _check_header(path: Path, header: list[str], columns: Sequence[str]) -> None
         )
 
 
-def _load_rows(path: Path, params: Sequence[str], measures: Sequence[str]) -> tuple[list[str] | None, dict]:
-    """Read a previous run's rows keyed by point; ``(None, {})`` if there is none."""
+def _load_cells(path: Path, params: Sequence[str], measures: Sequence[str]) -> tuple[list[str] | None, dict]:
+    """A previous run's CSV cells keyed by point; ``(None, {})`` if there is none."""
     if not path.exists() or path.stat().st_size == 0:
         return None, {}
     _repair_tail(path)
@@ -248,36 +262,83 @@ def _load_rows(path: Path, params: Sequence[str], measures: Sequence[str]) -> tu
         if header is None:
             return None, {}
         _check_header(path, header, [*params, *measures, *RESERVED])
-        rows, bad = {}, 0
+        cells_by_key, bad = {}, 0
         for line in reader:
             cells = dict(zip(header, line))
             try:
                 if len(line) != len(header) or cells["status"] not in ("ok", "failed"):
                     raise ValueError
-                rows[_key(cells, params)] = _parse_row(cells, params, measures)
+                _parse_row(cells, params, measures)
+                cells_by_key[_key(cells, params)] = cells
             except ValueError:
                 bad += 1
     if bad:
         warnings.warn(f"{path}: ignored {bad} malformed line(s); those points will be recomputed",
                       RuntimeWarning, stacklevel=3)
-    return header, rows
+    return header, cells_by_key
 
 
-@contextlib.contextmanager
-def _csv_appender(path: Path, header: Sequence[str], new: bool):
-    """Yield ``append(cells)`` that writes one row and flushes it."""
+def _write_csv(path: Path, header: Sequence[str], rows: Iterable[Mapping[str, str]]) -> None:
+    """Write the whole CSV to a temporary file, then rename it over ``path``:
+    a reader (or a kill) never sees a half-written file."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    with open(path, "w" if new else "a", newline="", encoding="utf-8") as f:
+    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
+    with open(tmp, "w", newline="", encoding="utf-8") as f:
         writer = csv.DictWriter(f, fieldnames=list(header), lineterminator="\n")
-        if new:
-            writer.writeheader()
-            f.flush()
+        writer.writeheader()
+        writer.writerows(rows)
+    os.replace(tmp, path)
 
-        def append(cells: dict[str, str]) -> None:
-            writer.writerow(cells)
-            f.flush()
 
-        yield append
+class _Journal:
+    """The sweep's finished points: a :class:`~acausal.checkpoint.Checkpoint`
+    (each point one checksummed line, written as it finishes) plus the CSV,
+    rewritten atomically at most every ``CSV_EVERY_S`` seconds and at the end."""
+
+    CSV_EVERY_S = 2.0
+
+    def __init__(self, out_csv: Path, store: Checkpoint | None, header: Sequence[str], cells: dict):
+        self.out_csv, self.store, self.header, self.cells = out_csv, store, list(header), cells
+        self.written = time.monotonic()
+
+    def add(self, key: tuple, cells: dict[str, str]) -> None:
+        if self.store is not None:
+            self.store.append(json.dumps(key), cells)
+        self.cells[key] = cells
+        if time.monotonic() - self.written > self.CSV_EVERY_S:
+            self.write_csv()
+
+    def write_csv(self) -> None:
+        _write_csv(self.out_csv, self.header, self.cells.values())
+        self.written = time.monotonic()
+
+
+def _open_journal(out_csv: Path, params, measures, checkpoint, inputs) -> _Journal:
+    """The CSV's rows merged with the checkpoint's (a run killed before its
+    last CSV write left points only there)."""
+    header, cells = _load_cells(out_csv, params, measures)
+    store = None
+    if checkpoint is not False:
+        folder = Path(checkpoint) if checkpoint else out_csv.with_name(out_csv.name + ".partial")
+        store = Checkpoint(folder, input_key(list(params), sorted(measures), *inputs))
+        for key, saved in store.load().items():
+            try:
+                cells.setdefault(tuple(json.loads(key)), _parse_cells(saved, params, measures))
+            except (ValueError, KeyError, TypeError):
+                store.ignored += 1
+        if store.ignored:
+            warnings.warn(f"{store.path}: ignored {store.ignored} damaged record(s); those points "
+                          "will be recomputed", RuntimeWarning, stacklevel=3)
+    return _Journal(out_csv, store, header or [*params, *measures, *RESERVED], cells)
+
+
+def _parse_cells(saved: Any, params: Sequence[str], measures: Sequence[str]) -> dict[str, str]:
+    """Checkpointed cells, checked like a CSV row."""
+    if not isinstance(saved, dict) or saved.get("status") not in ("ok", "failed"):
+        raise ValueError("not a sweep row")
+    cells = {c: str(saved[c]) for c in [*params, *measures, *RESERVED]}
+    _parse_row(cells, params, measures)
+    return cells
 
 
 # ---------------------------------------------------------------------------
@@ -363,6 +424,8 @@ def run_sweep(
     executor,
     measures: Sequence[str],
     progress: bool = True,
+    checkpoint: str | Path | None | bool = None,
+    inputs: Sequence[Any] = (),
 ) -> SweepRows:
     """Run ``task(point)`` for every point not already in ``out_csv``.
 
@@ -371,13 +434,22 @@ def run_sweep(
             picklable (a module-level function or ``functools.partial`` of one).
             Expensive set-up belongs in :func:`acausal.executor.worker_cache`.
         points: dicts ``{param: float}`` with the same keys, e.g. from :func:`grid`.
-        out_csv: results file. Each finished point is appended and flushed at
-            once. Points already in it (status ok *or* failed) are not rerun; to
+        out_csv: results file. Points already in it (or in the checkpoint) (status ok *or* failed) are not rerun; to
             retry failures, delete their lines. A file from a sweep with other
             parameter/measure columns is refused (ValueError).
         executor: an :class:`acausal.executor.Executor` (from ``open_executor``).
         measures: names to take from each task result (numbers or strings).
         progress: show a tqdm progress bar on stderr.
+        checkpoint: folder of the checkpoint (default ``<out_csv>.partial``;
+            ``False``: none). Each finished point is appended there at once as
+            a checksummed line (:mod:`acausal.checkpoint`), and ``out_csv`` is
+            rewritten atomically (temporary file, then rename) every few
+            seconds and at the end, so a sweep killed at any moment (even by
+            SIGKILL) loses no finished point and leaves no corrupt row. When
+            the sweep completes, the checkpoint is deleted.
+        inputs: what else the points' results depend on (e.g. the model
+            file as a :class:`~pathlib.Path`, options), hashed into the
+            checkpoint's name: a checkpoint of other inputs is not reused.
 
     Returns:
         :class:`SweepRows` (a list) with one row per point, in ``points`` order:
@@ -393,22 +465,24 @@ def run_sweep(
     params = _param_names(points)
     measures = _check_measures(measures, params)
     out_csv = Path(out_csv)
-    header, done = _load_rows(out_csv, params, measures)
-    todo = list({_key(p, params): p for p in points if _key(p, params) not in done}.values())
+    journal = _open_journal(out_csv, params, measures, checkpoint, inputs)
+    todo = list({_key(p, params): p for p in points if _key(p, params) not in journal.cells}.values())
     if todo and executor.needs_pickle:
         _check_picklable(task)
 
-    with _csv_appender(out_csv, header or [*params, *measures, *RESERVED], new=header is None) as append:
+    def on_row(point: dict, record: dict) -> None:
+        journal.add(_key(point, params), _format_cells(point, record, params, measures))
 
-        def on_row(point: dict, record: dict) -> None:
-            cells = _format_cells(point, record, params, measures)
-            append(cells)
-            done[_key(point, params)] = _parse_row(cells, params, measures)
-
-        futures = {executor.submit(_run_point, task, p, measures): p for p in todo}
-        n_unique = len({_key(p, params) for p in points})
-        bar = _progress_bar(n_unique, n_unique - len(todo), progress)
+    futures = {executor.submit(_run_point, task, p, measures): p for p in todo}
+    n_unique = len({_key(p, params) for p in points})
+    bar = _progress_bar(n_unique, n_unique - len(todo), progress)
+    try:
         _collect(executor, futures, on_row, bar)
+    finally:
+        journal.write_csv()
+    if journal.store is not None:
+        journal.store.discard()  # everything is in the CSV now
+    done = {key: _parse_row(cells, params, measures) for key, cells in journal.cells.items()}
     return SweepRows((done[_key(p, params)] for p in points), params, measures)
 
 

@@ -150,21 +150,43 @@ def _progress(total, desc, enabled):
     return tqdm(total=total, desc=desc, unit="fit")
 
 
-def _run_tasks(ex, calls, desc, progress):
-    """Submit (fn, args) calls; return results in submission order."""
-    futures = [ex.submit(fn, *args) for fn, args in calls]
-    index = {id(f): i for i, f in enumerate(futures)}
-    out = [None] * len(futures)
-    bar = _progress(len(futures), desc, progress)
+def _run_tasks(ex, calls, desc, progress, store=None, keys=None):
+    """Submit (fn, args) calls; return results in submission order.
+
+    With a ``store`` (:class:`acausal.checkpoint.Checkpoint`) and one key per
+    call, a result found in the store is taken from there instead of being
+    recomputed, and every new result is appended to it as soon as it
+    arrives: an interrupted diagnosis keeps its finished fits."""
+    saved = store.load() if store is not None else {}
+    out = [saved.get(k) for k in keys] if store is not None else [None] * len(calls)
+    todo = [i for i, r in enumerate(out) if r is None]
+    futures = [ex.submit(fn, *args) for fn, args in (calls[i] for i in todo)]
+    index = {id(f): i for i, f in zip(todo, futures)}
+    bar = _progress(len(calls), desc, progress)
+    if bar is not None:
+        bar.update(len(calls) - len(todo))
     try:
         for fut in ex.as_completed(futures):
-            out[index[id(fut)]] = fut.result()
+            i = index[id(fut)]
+            out[i] = fut.result()
+            if store is not None:
+                store.append(keys[i], out[i])
             if bar is not None:
                 bar.update(1)
     finally:
         if bar is not None:
             bar.close()
     return out
+
+
+def _checkpoint(out_dir, model_path, data_folder, options):
+    """The diagnosis's checkpoint, ``<out_dir>/checkpoint/<hash>.jsonl``,
+    the hash of the model file (and its neighbours), the data and the
+    options: one record per finished fit."""
+    from ..checkpoint import Checkpoint, input_key, source_files
+    from .fitting import Fit
+    key = input_key(source_files(model_path), Path(data_folder), options)
+    return Checkpoint(Path(out_dir) / "checkpoint", key, types=(Fit,))
 
 
 def _select(items, wanted, what):
@@ -232,12 +254,15 @@ def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
                            float(s.scale) or 1.0) for s in specs] for h, l, specs in cands}
     specs_by = {(h, l): specs for h, l, specs in cands}
     lib_name = lib.name
+    store = _checkpoint(out_dir, model_path, data_folder, dict(
+        library=lib_name, candidates=[[h, l] for h, l, _ in cands], free=free,
+        max_nfev=max_nfev, exact_cv=exact_cv))
 
     with open_executor(scheduler, workers) as ex:
         # the nominal fit first: the candidates start from its calibrated values
         nominal = _run_tasks(ex, [(fit_task, (model_path, data_folder, lib_name, None, None,
                                               [], free, max_nfev))],
-                             "calibrating", progress)[0]
+                             "calibrating", progress, store, ["nominal"])[0]
         if nominal["fit"] is None or not nominal["fit"].ok:
             raise DiagnosisError(f"the nominal model could not be fitted: "
                                  f"{nominal['error'] or nominal['fit'].message}")
@@ -247,7 +272,8 @@ def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
         absorb = (list(f0.names), f0.jacobian)
         calls = [(fit_task, (model_path, data_folder, lib_name, h, l, spec_rows[(h, l)],
                              warm, max_nfev, budget, absorb)) for h, l, _ in cands]
-        results = [nominal] + _run_tasks(ex, calls, "fitting candidates", progress)
+        results = [nominal] + _run_tasks(ex, calls, "fitting candidates", progress, store,
+                                         [f"fit {h} {l}" for h, l, _ in cands])
         t_fit = time.perf_counter() - t_start
         n = f0.n
         fitted = [r for r in results[1:] if r["fit"] is not None and r["fit"].ok
@@ -296,7 +322,8 @@ def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
                     calls.append((loo_task, (model_path, data_folder, lib_name, h, l,
                                              f.names, f.values, lo, hi, sc, e.name,
                                              max(5, max_nfev // 4), budget / 3)))
-            for r in _run_tasks(ex, calls, "leave-one-out", progress):
+            keys = [f"loo {c[1][3]} {c[1][4]} {c[1][10]}" for c in calls]
+            for r in _run_tasks(ex, calls, "leave-one-out", progress, store, keys):
                 loo_exact.setdefault((r["hyp"], r["location"]), {})[r["held"]] = r["residuals"]
         for r in rows:
             got = loo_exact.get((r["cause"], r["location"]))
@@ -379,6 +406,7 @@ def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
         ctx["timing"]["total_s"] = time.perf_counter() - t_start
     (out_dir / "diagnosis.json").write_text(json.dumps(summary, indent=1))
     (out_dir / "candidates.json").write_text(json.dumps(_clean(_details(ctx)), indent=1))
+    store.discard()  # complete: the fits are in the report
     return summary
 
 
@@ -425,7 +453,8 @@ def _details(ctx):
                                     lr_p=_num(r["lr_p"])))
                            for r in ctx["rows"]],
                failed=[dict(cause=r["hyp"], location=r["location"], error=r["error"] or
-                            (r["fit"].message if r["fit"] is not None else ""))
+                            (r["fit"].message if r["fit"] is not None else ""),
+                            wall_s=r["wall_s"])
                        for r in ctx["failed"]],
                decision=ctx["decision"], overdispersion=ctx["c_hat"],
                weak_evidence=ctx["weak"], timing=ctx["timing"])

@@ -21,7 +21,9 @@ def test_simulate_json_oscillator_matches_closed_form():
     r = run("simulate", os.path.join(EX, "oscillator.py"), "--json")
     assert r.exit_code == 0, r.output
     out = json.loads(r.output)
-    assert set(out) == {"final", "events", "measures", "units", "stats"}
+    assert set(out) == {"final", "events", "measures", "missing", "units", "stats", "status",
+                        "error"}
+    assert out["error"] is None and out["status"] == "ok" and out["missing"] == {}
     assert out["units"]["final"]["mass.s"] == "m" and out["units"]["time"] == "s"
     assert {"nfev", "steps", "wall_s", "compile_s"} <= set(out["stats"])
     exact = 0.1 * np.cos(10.0)

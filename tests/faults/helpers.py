@@ -1,0 +1,74 @@
+"""Running the ``acausal`` command in a subprocess and killing it (faults tests)."""
+import os
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import psutil
+
+from acausal.checkpoint import Checkpoint
+
+ROOT = Path(__file__).resolve().parents[2]
+HERE = Path(__file__).resolve().parent
+
+
+def copy_model(name, folder):
+    """Copy a model file of this folder into ``folder`` (its own folder: the
+    checkpoint hashes the model's neighbours)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    return Path(shutil.copy(HERE / name, folder / name))
+
+
+def env(log_dir, sleep=0.0):
+    e = dict(os.environ, PYTHONPATH=str(ROOT), ACAUSAL_TEST_LOG=str(log_dir),
+             ACAUSAL_TEST_SLEEP=str(sleep))
+    log_dir.mkdir(parents=True, exist_ok=True)
+    return e
+
+
+def cli(args, environment, **kw):
+    return subprocess.Popen([sys.executable, "-m", "acausal.cli", *map(str, args)],
+                            env=environment, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, **kw)
+
+
+def wait_for(condition, proc, timeout=120.0, poll=0.02):
+    """Poll ``condition()`` until true; fail if ``proc`` ends first or time runs out."""
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if condition():
+            return
+        if proc.poll() is not None:
+            out, err = proc.communicate()
+            raise AssertionError(f"the command ended (exit {proc.returncode}) before the "
+                                 f"kill:\n{out}\n{err}")
+        time.sleep(poll)
+    proc.kill()
+    raise AssertionError("timed out waiting for the command")
+
+
+def kill_tree_check(proc, sig, wait=10.0):
+    """Send ``sig`` to ``proc`` (the main process only); return its
+    descendants still alive ``wait`` seconds later (there should be none)
+    and its stderr."""
+    family = psutil.Process(proc.pid).children(recursive=True)
+    assert family, "the command started no worker process"
+    os.kill(proc.pid, sig)
+    _, stderr = proc.communicate(timeout=60)
+    _, alive = psutil.wait_procs(family, timeout=wait)
+    for p in alive:  # do not leave them behind, even when the test fails
+        p.kill()
+    return alive, stderr
+
+
+def valid_lines(path, types=()):
+    """Records of a checkpoint file whose checksum is intact, and the count of the others."""
+    store = Checkpoint(path.parent, path.stem, types)
+    return store.load(), store.ignored
+
+
+def logged(log_dir):
+    """The values a test model's measure saw (one marker file per call)."""
+    return sorted(float(p.read_text()) for p in Path(log_dir).iterdir())
