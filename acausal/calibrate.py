@@ -18,7 +18,7 @@ import numpy as np
 from scipy import optimize, stats
 
 from .data import load_dataset
-from .errors import AcausalError, ModelError
+from .errors import AcausalError, CalibrationError, ModelError
 from .modelfile import compile_file, evaluate_measures
 
 
@@ -61,10 +61,6 @@ class ForwardDifferences:
             zz[i] += h
             J[:, i] = (np.asarray(self.fun(zz), float) - r0) / h
         return J
-
-
-class CalibrationError(AcausalError):
-    """The calibration could not be carried out (no bracket, no data...)."""
 
 
 def resolve(model):

@@ -1,7 +1,9 @@
 """The ``acausal`` command: simulate, variables, calibrate, sweep, diagnose.
 
-Exit codes: 0 success, 2 a model or input error (one readable message on
-stderr), 3 a solver failure (time and component named).
+Exit codes: 0 success, 2 a model or input error (an AcausalError: one
+readable line on stderr), 3 a solver failure (time and component named).
+Any other exception is a bug: it is not caught, so Python shows its
+traceback and exits with 1.
 """
 import json
 import sys
@@ -223,7 +225,7 @@ def sweep(file, params, measures, out, plot, scheduler, workers, no_progress):
                              progress=not no_progress)
         if plot:
             plot_sweep(rows, specs[0][0], measures[0], plot)
-    except (AcausalError, click.BadParameter, ValueError) as exc:
+    except (AcausalError, click.BadParameter) as exc:
         _fail(exc)
     failed = sum(1 for r in rows if r.get("status") != "ok")
     click.echo(f"{len(rows)} points, {failed} failed; results in {out}")
@@ -253,7 +255,6 @@ def diagnose(file, data, json_path, report_dir, scheduler, workers, hypotheses, 
              alpha, no_progress, library):
     """Show what a model gets wrong against measured data, name the cause,
     extend the model and measure the gain."""
-    from .data import DataError
     from .diagnose.run import diagnose as run_diagnosis
     try:
         if not 0 < alpha < 1:
@@ -262,7 +263,7 @@ def diagnose(file, data, json_path, report_dir, scheduler, workers, hypotheses, 
                             workers=workers, progress=not no_progress,
                             hypotheses=_csv_list(hypotheses), locations=_csv_list(locations),
                             alpha=alpha, library=library)
-    except (AcausalError, DataError, click.BadParameter, ValueError, ImportError) as exc:
+    except (AcausalError, click.BadParameter) as exc:
         _fail(exc)
     if json_path:
         with open(json_path, "w") as f:

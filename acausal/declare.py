@@ -9,7 +9,7 @@ import numbers
 
 import sympy as sp
 
-from .errors import ParameterError
+from .errors import ModelError, ParameterError
 
 
 class Declaration:
@@ -144,7 +144,7 @@ class Event:
     def __init__(self, name, expr, direction=0, action=None, *, terminal=False,
                  recheck=False, observer=False):
         if direction not in (-1, 0, 1):
-            raise ValueError(f"event {name}: direction must be -1, 0 or +1")
+            raise ModelError(f"event {name}: direction must be -1, 0 or +1")
         self.name = name
         self.expr = sp.sympify(expr)
         self.direction = direction
