@@ -9,6 +9,7 @@ import json
 import sys
 
 import click
+import numpy as np
 
 from .errors import AcausalError, SolverError
 
@@ -183,12 +184,22 @@ def calibrate(file, data, fit, method, experiments, as_json):
             click.echo(f"    {name:20s} " + " ".join(f"{x:+.3f}" for x in row))
     click.echo("  residuals (simulated - measured):")
     for exp, sig in out.residuals.items():
-        click.echo(f"    {exp}: " + ", ".join(f"{k} {v:+.4g}" for k, v in sig.items()))
+        click.echo(f"    {exp}: " + ", ".join(_residual(k, v) for k, v in sig.items()))
     if out.validation:
         click.echo("  held back, predicted with these values (simulated - measured):")
         for exp, sig in out.validation.items():
-            click.echo(f"    {exp}: " + ", ".join(
-                f"{k} {v}" if k == "error" else f"{k} {v:+.4g}" for k, v in sig.items()))
+            click.echo(f"    {exp}: " + ", ".join(_residual(k, v) for k, v in sig.items()))
+
+
+def _residual(name, value):
+    """'thrt +1.2e-05' for a measure, 'hook.phi rms 3.4e-04 over 40 samples'
+    for a trace, the message for a failed prediction."""
+    if name == "error":
+        return f"{name} {value}"
+    v = np.asarray(value, dtype=float)
+    if v.ndim == 0:
+        return f"{name} {float(v):+.4g}"
+    return f"{name} rms {float(np.sqrt(np.mean(v ** 2))):.4g} over {v.size} samples"
 
 
 @main.command()

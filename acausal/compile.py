@@ -141,7 +141,14 @@ class CompiledModel:
         for name, value in (overrides or {}).items():
             i = self.param_index(name)
             e = self.params[i]
-            value = float(value)
+            try:
+                value = float(value)
+            except (TypeError, ValueError):
+                raise ParameterError(f"parameter {name} must be a number [{e.unit}], got "
+                                     f"{value!r}", variable=name) from None
+            if not np.isfinite(value):
+                raise ParameterError(f"parameter {name} = {value} [{e.unit}] is not a finite "
+                                     "number", variable=name)
             e.decl.check_bounds(value, name)
             p[i] = value
         return p

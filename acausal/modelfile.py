@@ -3,9 +3,12 @@
 A model file binds a :class:`~acausal.Model` to the module-level name
 ``model``; it may define ``experiment`` (an :class:`~acausal.Experiment`),
 ``measures``, a dict of name -> function(result) -> float (a scalar
-computed from a result, such as a response time), ``free_parameters``, a
-dict of parameter -> (low, high) that calibration and diagnosis may fit,
-and ``plot(result, path)``. A model file can import
+computed from a result, such as a response time), ``measure_units``, a dict
+of measure -> SI unit (``{"thrt": "s"}``; a measure function may instead
+carry a ``unit`` attribute), ``conditions``, the parameters an experiment
+sets (``["v_impact"]``: a dataset must give at least one of them),
+``free_parameters``, a dict of parameter -> (low, high) that calibration
+and diagnosis may fit, and ``plot(result, path)``. A model file can import
 another one (``from breaker_24kv import build``): its folder is on the path.
 """
 import os
@@ -28,6 +31,12 @@ class ModelFile:
     measures: dict = field(default_factory=dict)
     namespace: dict = field(default_factory=dict)
     free: dict = field(default_factory=dict)   # parameter -> (low, high) bounds
+    measure_units: dict = field(default_factory=dict)  # measure -> SI unit (None: unknown)
+    conditions: tuple = ()                     # parameters an experiment sets
+
+    def measure_unit(self, name):
+        """The SI unit of measure ``name``, or None if the file declares none."""
+        return self.measure_units.get(name)
 
 
 def _where(exc, path):
@@ -74,8 +83,32 @@ def load_model_file(path):
             isinstance(b, (tuple, list)) and len(b) == 2 for b in free.values()):
         raise ModelFileError(f"{path}: 'free_parameters' must be a dict of "
                              "name -> (low, high)")
+    units, conditions = _measure_units(ns, measures, path), _conditions(ns, path)
     return ModelFile(path, model, exp, dict(measures), ns, {k: tuple(map(float, v))
-                                                            for k, v in free.items()})
+                                                            for k, v in free.items()},
+                     units, conditions)
+
+
+def _measure_units(ns, measures, path):
+    """measure -> SI unit from ``measure_units`` or the functions' ``unit``."""
+    given = ns.get("measure_units") or {}
+    if not isinstance(given, dict) or not all(isinstance(u, str) for u in given.values()):
+        raise ModelFileError(f"{path}: 'measure_units' must be a dict of measure -> unit")
+    unknown = sorted(set(given) - set(measures))
+    if unknown:
+        raise ModelFileError(f"{path}: 'measure_units' names {unknown[0]!r}, which is "
+                             "not a measure")
+    units = {name: getattr(fn, "unit", None) for name, fn in measures.items()}
+    units.update(given)
+    return {k: u for k, u in units.items() if isinstance(u, str)}
+
+
+def _conditions(ns, path):
+    """The ``conditions`` a model file declares, as a tuple of names."""
+    given = ns.get("conditions") or ()
+    if isinstance(given, str) or not all(isinstance(c, str) for c in given):
+        raise ModelFileError(f"{path}: 'conditions' must be a list of parameter names")
+    return tuple(given)
 
 
 _CACHE = {}

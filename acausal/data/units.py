@@ -34,6 +34,14 @@ def read_unit(text: str, where: tuple):
     raise DataError(f"cannot read unit [{text}]: {reason}", *where)
 
 
+def si_unit(text: Optional[str]) -> Optional[str]:
+    """The SI base unit of the same dimension as ``text`` (``'ms'`` ->
+    ``'second'``); None stays None. Raises pint's errors if unparseable."""
+    if text is None:
+        return None
+    return str(ureg().Quantity(1.0, parse_unit(text)).to_base_units().units)
+
+
 def kind(unit) -> str:
     """A phrase naming the dimension of a pint unit, for messages."""
     reg = ureg()
