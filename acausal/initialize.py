@@ -25,7 +25,18 @@ def _jacobians(cb, t, y, yp, n):
 
 
 def initial_point(cm, p, d, cb, t0):
-    """Return (y0, yp0) consistent with the model and its fixed starts."""
+    """Return (y0, yp0) consistent with the model and its fixed starts.
+    When there is none because of a parameter changed from its default (a
+    1e30 N/m spring), the InitializationError names that parameter."""
+    try:
+        return _solve_initial(cm, p, d, cb, t0)
+    except InitializationError as exc:
+        _raise_if_parameter_breaks(cm, t0, p, d, exc)
+        raise
+
+
+def _solve_initial(cm, p, d, cb, t0):
+    """initial_point without the diagnosis of its failure."""
     dae = cm.dae
     n, ns = len(dae.y), dae.n_states
     fixed = cm.fixed_starts(p)           # list of (var index, value, name)
@@ -101,6 +112,29 @@ def initial_point(cm, p, d, cb, t0):
     z = np.concatenate([y, yp[:ns]])
     _check(cm, residual(z, []), jac(z, []), z, fixed, n)
     return y, _algebraic_rates(cm, cb, t0, y, yp)
+
+
+def _raise_if_parameter_breaks(cm, t0, p, d, exc):
+    """Raise an InitializationError naming the parameter whose value makes
+    the initial equations unsolvable, instead of ``exc``: each parameter
+    that differs from its default (``--set``, ``simulate(params=...)``) is
+    put back to its default alone, and the first one with which the
+    equations solve is named (a 1e30 N/m spring or a 1e-30 kg*m^2 inertia
+    makes them numerically singular, which shows as "inconsistent" starts)."""
+    for k, entry in enumerate(cm.params):
+        if p[k] == entry.default:
+            continue
+        q = np.array(p, dtype=float)
+        q[k] = entry.default
+        try:
+            _solve_initial(cm, q, d, cm.callbacks(q, d), t0)
+        except (InitializationError, ArithmeticError, ValueError, np.linalg.LinAlgError):
+            continue
+        raise InitializationError(
+            f"parameter {entry.name} = {p[k]:g} [{entry.unit}] makes the initial equations "
+            f"unsolvable (with its default {entry.default:g} they solve): check its value "
+            f"and unit; the initialisation said: {exc}",
+            variable=entry.name) from None
 
 
 def _snap_fixed_states(cm, y, fixed):
