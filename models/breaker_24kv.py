@@ -166,9 +166,19 @@ MEASURES = {
     "impact_velocity": lambda res: ct.impact_velocity(res, "contact"),
 }
 
+# the SI unit of each measure: calibration refuses a data column of another
+# dimension (a 'thrt [kg]' header)
+MEASURE_UNITS = {"thrt": "s", "contact_period": "s", "peak_force": "N",
+                 "impact_velocity": "m/s"}
+# the parameters an experiment sets: a dataset must give at least one of them
+# (else every experiment would silently run at the default v_impact)
+CONDITIONS = ("v_impact",)
+
 free_parameters = dict(FREE_PARAMETERS)
 experiment = release_experiment(model)
 measures = dict(MEASURES)
+measure_units = dict(MEASURE_UNITS)
+conditions = list(CONDITIONS)
 
 
 def plot(res, path):

@@ -24,6 +24,7 @@ Same sign convention, run and measures as the base file, plus ``n_impacts``
 (impacts of the armature on the hook before release).
 Run: ``acausal simulate models/breaker_24kv_light_hook.py --plot FILE``.
 """
+from breaker_24kv import CONDITIONS, MEASURE_UNITS
 from breaker_24kv import (BH_CAL, FREE_PARAMETERS, K_CAL, MEASURES, build,
                          release_experiment, t_first_contact)
 
@@ -42,6 +43,8 @@ measures = {
     **MEASURES,
     "n_impacts": lambda res: ct.n_impacts(res, "contact"),
 }
+measure_units = {**MEASURE_UNITS, "n_impacts": "1"}
+conditions = list(CONDITIONS)
 
 
 def plot(res, path):

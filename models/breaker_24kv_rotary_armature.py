@@ -26,6 +26,7 @@ Run: ``acausal simulate models/breaker_24kv_rotary_armature.py --plot FILE``.
 import math
 
 import sympy as sp
+from breaker_24kv import CONDITIONS, MEASURE_UNITS
 from breaker_24kv import (BH_CAL, FREE_PARAMETERS, GAP0, K_CAL, MEASURES, MainShaft,
                          THETA1_0, TriggerHook, release_experiment, t_first_contact)
 
@@ -104,6 +105,8 @@ measures = {
     **MEASURES,
     "n_impacts": lambda res: ct.n_impacts(res, "contact"),
 }
+measure_units = {**MEASURE_UNITS, "n_impacts": "1"}
+conditions = list(CONDITIONS)
 
 
 def plot(res, path):

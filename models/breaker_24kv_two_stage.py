@@ -30,6 +30,7 @@ Run: ``acausal simulate models/breaker_24kv_two_stage.py --plot FILE``.
 """
 import math
 
+from breaker_24kv import CONDITIONS, MEASURE_UNITS
 from breaker_24kv import (Armature, BH_CAL, FREE_PARAMETERS, K_CAL, MEASURES, MainShaft,
                          THETA1_0, TriggerHook, release_experiment, t_first_contact)
 
@@ -116,6 +117,8 @@ measures = {
     "n_impacts": lambda res: ct.n_impacts(res, "contact"),
     "n_latch_impacts": lambda res: ct.n_impacts(res, "latch_contact"),
 }
+measure_units = {**MEASURE_UNITS, "latch_peak_force": "N", "n_impacts": "1", "n_latch_impacts": "1"}
+conditions = list(CONDITIONS)
 
 
 def plot(res, path):
