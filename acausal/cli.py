@@ -11,7 +11,7 @@ import sys
 import click
 import numpy as np
 
-from .errors import AcausalError, SolverError
+from .errors import AcausalError, SolverError, UsageError
 
 
 def _fail(exc):
@@ -21,15 +21,18 @@ def _fail(exc):
 
 
 def _parse_sets(sets):
+    """``--set PATH=VALUE`` items as {path: float}; a UsageError naming the
+    item if it is malformed (the model checks names, finiteness and bounds)."""
     out = {}
     for item in sets:
         if "=" not in item:
-            raise click.BadParameter(f"--set {item!r}: expected PATH=VALUE")
+            raise UsageError(f"--set {item!r}: expected PATH=VALUE")
         k, v = item.split("=", 1)
         try:
             out[k.strip()] = float(v)
         except ValueError:
-            raise click.BadParameter(f"--set {item!r}: {v!r} is not a number") from None
+            raise UsageError(f"--set {item!r}: {v!r} is not a number", variable=k.strip()
+                             ) from None
     return out
 
 

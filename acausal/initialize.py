@@ -9,6 +9,8 @@ or the model raise :class:`InitializationError` naming them — they are never
 silently changed. After an event only the algebraic unknowns and ``y'`` are
 recomputed, the states are kept.
 """
+import math
+
 import numpy as np
 import scipy.linalg
 import sympy as sp
@@ -121,8 +123,11 @@ def _raise_if_parameter_breaks(cm, t0, p, d, exc):
     put back to its default alone, and the first one with which the
     equations solve is named (a 1e30 N/m spring or a 1e-30 kg*m^2 inertia
     makes them numerically singular, which shows as "inconsistent" starts)."""
+    if not str(exc).startswith(("inconsistent fixed start values",
+                                "no consistent initial point")):
+        return  # a named cause (an assertion such as a linkage that cannot close)
     for k, entry in enumerate(cm.params):
-        if p[k] == entry.default:
+        if not _far_from(p[k], entry.default):
             continue
         q = np.array(p, dtype=float)
         q[k] = entry.default
@@ -135,6 +140,20 @@ def _raise_if_parameter_breaks(cm, t0, p, d, exc):
             f"unsolvable (with its default {entry.default:g} they solve): check its value "
             f"and unit; the initialisation said: {exc}",
             variable=entry.name) from None
+
+
+# A value this many decades from the parameter's default is suspect when
+# the initialisation fails (a 1e30 N/m spring for 2.4e5, a 1e-30 kg*m^2
+# inertia for 4.4e-4); values nearer their defaults are design changes.
+SUSPECT_DECADES = 6.0
+
+
+def _far_from(value, default):
+    """True if ``value`` lies SUSPECT_DECADES or more (in magnitude) from a
+    nonzero default."""
+    if default == 0 or value == 0:
+        return False
+    return abs(math.log10(abs(value / default))) >= SUSPECT_DECADES
 
 
 def _snap_fixed_states(cm, y, fixed):

@@ -11,7 +11,9 @@ sets (``["v_impact"]``: a dataset must give at least one of them),
 and diagnosis may fit, and ``plot(result, path)``. A model file can import
 another one (``from breaker_24kv import build``): its folder is on the path.
 """
+import math
 import os
+import re
 import runpy
 import sys
 import traceback
@@ -39,65 +41,137 @@ class ModelFile:
         return self.measure_units.get(name)
 
 
-def _where(exc, path):
-    """'file:line' of the deepest frame of ``exc`` inside ``path``."""
+def _line(exc, path):
+    """Line of the deepest frame of ``exc`` inside ``path`` (None if none)."""
     line = None
     for fr in traceback.extract_tb(exc.__traceback__):
         if os.path.abspath(fr.filename) == path:
             line = fr.lineno
-    return f"{path}:{line}" if line else path
+    return line
+
+
+def _error(path, line, message):
+    """A ModelFileError 'path:line: message' carrying ``file`` and ``line``."""
+    where = f"{path}:{line}" if line else path
+    return ModelFileError(f"{where}: {message}", file=path, line=line)
+
+
+def _run(path):
+    """The namespace of the model file ``path`` after running it; any
+    exception it raises becomes a ModelFileError naming its line."""
+    try:
+        return runpy.run_path(path, run_name="__acausal_model__")
+    except SyntaxError as exc:  # also a bad encoding or a NUL byte
+        line = exc.lineno if os.path.abspath(exc.filename or path) == path else None
+        raise _error(path, line, f"syntax error: {exc.msg}") from None
+    except AcausalError as exc:
+        raise _error(path, _line(exc, path), str(exc)) from None
+    except Exception as exc:  # a bug in the script: say where
+        raise _error(path, _line(exc, path), f"{type(exc).__name__}: {exc}") from None
 
 
 def load_model_file(path):
     """Run a model file and collect ``model``, ``experiment`` and ``measures``."""
     path = os.path.abspath(path)
     if not os.path.isfile(path):
-        raise ModelFileError(f"{path}: no such model file")
+        raise ModelFileError(f"{path}: no such model file", file=path)
     folder = os.path.dirname(path)
     added = folder not in sys.path
     if added:
         sys.path.insert(0, folder)
     try:
-        ns = runpy.run_path(path, run_name="__acausal_model__")
-    except SyntaxError as exc:
-        raise ModelFileError(f"{exc.filename}:{exc.lineno}: syntax error: {exc.msg}") from None
-    except AcausalError as exc:
-        raise ModelFileError(f"{_where(exc, path)}: {exc}") from None
-    except Exception as exc:  # a bug in the script: say where
-        raise ModelFileError(f"{_where(exc, path)}: {type(exc).__name__}: {exc}") from None
+        ns = _run(path)
     finally:
         if added:
             sys.path.remove(folder)
+    return _collect(ns, path)
+
+
+def _binding_line(path, name):
+    """Line of the first top-level assignment to ``name`` in the file."""
+    try:
+        with open(path, encoding="utf-8", errors="replace") as f:
+            for k, text in enumerate(f, start=1):
+                if re.match(rf"{name}\s*(:[^=]*)?=(?!=)", text):
+                    return k
+    except OSError:
+        pass
+    return None
+
+
+def _bad(path, name, message):
+    """A ModelFileError at the line that binds ``name``."""
+    return _error(path, _binding_line(path, name), message)
+
+
+def _collect(ns, path):
+    """The ModelFile of a model file's namespace, every name checked."""
     model = ns.get("model")
     if not isinstance(model, Model):
-        raise ModelFileError(f"{path}: a model file must bind a Model to the name 'model'"
-                             + (f" (found {type(model).__name__})" if model is not None else ""))
+        raise _bad(path, "model", "a model file must bind a Model to the name 'model'"
+                   + (f" (found {type(model).__name__})" if model is not None else ""))
     exp = ns.get("experiment") or Experiment()
     if not isinstance(exp, Experiment):
-        raise ModelFileError(f"{path}: 'experiment' must be an acausal.Experiment")
+        raise _bad(path, "experiment", "'experiment' must be an acausal.Experiment")
+    _check_experiment(exp, path)
     measures = ns.get("measures") or {}
     if not isinstance(measures, dict) or not all(callable(f) for f in measures.values()):
-        raise ModelFileError(f"{path}: 'measures' must be a dict of name -> function(result)")
-    free = ns.get("free_parameters") or {}
-    if not isinstance(free, dict) or not all(
-            isinstance(b, (tuple, list)) and len(b) == 2 for b in free.values()):
-        raise ModelFileError(f"{path}: 'free_parameters' must be a dict of "
-                             "name -> (low, high)")
+        raise _bad(path, "measures", "'measures' must be a dict of name -> function(result)")
     units, conditions = _measure_units(ns, measures, path), _conditions(ns, path)
-    return ModelFile(path, model, exp, dict(measures), ns, {k: tuple(map(float, v))
-                                                            for k, v in free.items()},
-                     units, conditions)
+    return ModelFile(path, model, exp, dict(measures), ns, _free(ns, path), units, conditions)
+
+
+def _number(v):
+    """``v`` as a float, or None if it is not a real number."""
+    if isinstance(v, bool):
+        return None
+    try:
+        return float(v)
+    except (TypeError, ValueError):
+        return None
+
+
+def _check_experiment(exp, path):
+    """The Experiment's times and tolerances are numbers in range."""
+    for name in ("t0", "t_end", "rtol", "atol", "output_step", "max_step", "atol_algebraic"):
+        value = getattr(exp, name)
+        if value is None and name not in ("t0", "t_end", "rtol", "atol"):
+            continue
+        v = _number(value)
+        if v is None or not math.isfinite(v) or (name != "t0" and v <= 0):
+            what = "a finite number" if name == "t0" else "a finite number > 0"
+            raise _bad(path, "experiment", f"experiment {name} = {value!r} must be {what}")
+    if not float(exp.t_end) > float(exp.t0):
+        raise _bad(path, "experiment", f"experiment t_end = {exp.t_end!r} must be after "
+                   f"t0 = {exp.t0!r}")
+
+
+def _free(ns, path):
+    """``free_parameters`` as name -> (low, high) floats, low < high."""
+    free = ns.get("free_parameters") or {}
+    out = {}
+    if isinstance(free, dict):
+        for name, b in free.items():
+            lo, hi = (map(_number, b) if isinstance(b, (tuple, list)) and len(b) == 2
+                      else (None, None))
+            if lo is None or hi is None or not lo < hi:
+                break
+            out[name] = (lo, hi)
+        else:
+            return out
+    raise _bad(path, "free_parameters", "'free_parameters' must be a dict of name -> "
+               "(low, high) with numbers low < high")
 
 
 def _measure_units(ns, measures, path):
     """measure -> SI unit from ``measure_units`` or the functions' ``unit``."""
     given = ns.get("measure_units") or {}
     if not isinstance(given, dict) or not all(isinstance(u, str) for u in given.values()):
-        raise ModelFileError(f"{path}: 'measure_units' must be a dict of measure -> unit")
+        raise _bad(path, "measure_units", "'measure_units' must be a dict of measure -> unit")
     unknown = sorted(set(given) - set(measures))
     if unknown:
-        raise ModelFileError(f"{path}: 'measure_units' names {unknown[0]!r}, which is "
-                             "not a measure")
+        raise _bad(path, "measure_units", f"'measure_units' names {unknown[0]!r}, which is "
+                   "not a measure")
     units = {name: getattr(fn, "unit", None) for name, fn in measures.items()}
     units.update(given)
     return {k: u for k, u in units.items() if isinstance(u, str)}
@@ -106,8 +180,8 @@ def _measure_units(ns, measures, path):
 def _conditions(ns, path):
     """The ``conditions`` a model file declares, as a tuple of names."""
     given = ns.get("conditions") or ()
-    if isinstance(given, str) or not all(isinstance(c, str) for c in given):
-        raise ModelFileError(f"{path}: 'conditions' must be a list of parameter names")
+    if not isinstance(given, (list, tuple)) or not all(isinstance(c, str) for c in given):
+        raise _bad(path, "conditions", "'conditions' must be a list of parameter names")
     return tuple(given)
 
 
