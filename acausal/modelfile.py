@@ -63,11 +63,28 @@ def _run(path):
         return runpy.run_path(path, run_name="__acausal_model__")
     except SyntaxError as exc:  # also a bad encoding or a NUL byte
         line = exc.lineno if os.path.abspath(exc.filename or path) == path else None
-        raise _error(path, line, f"syntax error: {exc.msg}") from None
+        raise _error(path, line or _bad_byte_line(path), f"syntax error: {exc.msg}") from None
     except AcausalError as exc:
         raise _error(path, _line(exc, path), str(exc)) from None
     except Exception as exc:  # a bug in the script: say where
-        raise _error(path, _line(exc, path), f"{type(exc).__name__}: {exc}") from None
+        line = _line(exc, path) or _bad_byte_line(path)
+        raise _error(path, line, f"{type(exc).__name__}: {exc}") from None
+
+
+def _bad_byte_line(path):
+    """Line of the first NUL byte or byte that is not UTF-8 in the file
+    (what Python refuses before it can name a line), or None."""
+    try:
+        with open(path, "rb") as f:
+            data = f.read()
+    except OSError:
+        return None
+    bad = data.find(b"\0")
+    try:
+        data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        bad = exc.start if bad < 0 else min(bad, exc.start)
+    return data.count(b"\n", 0, bad) + 1 if bad >= 0 else None
 
 
 def load_model_file(path):
