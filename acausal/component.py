@@ -83,7 +83,7 @@ class Component:
                 valid = ", ".join(n for n, x in decls.items() if not isinstance(x, Discrete))
                 raise ParameterError(
                     f"{type(self).__name__} {self.path or '(top)'} has no parameter or "
-                    f"variable {key!r}; it has: {valid}")
+                    f"variable {key!r}; it has: {valid}", component=self.path, variable=key)
             if isinstance(d, Parameter):
                 self._values[key] = d.check(value, self.path or type(self).__name__)
             elif isinstance(d, Variable):
@@ -91,7 +91,8 @@ class Component:
                 _check_start(start.value, f"{self.path or type(self).__name__}.{key}", d.unit)
                 self._starts[key] = start
             else:
-                raise ParameterError(f"{key!r} of {self.path} is discrete; it cannot be set")
+                raise ParameterError(f"{key!r} of {self.path} is discrete; it cannot be set",
+                                     component=self.path, variable=key)
         return self
 
     def value(self, name):

@@ -66,8 +66,9 @@ class AcausalError(Exception):
         return ": ".join(parts)
 
     def __str__(self):
-        text = re.sub(r"\s*\n\s*", "; ", getattr(self, "message", None)
-                      or (str(self.args[0]) if self.args else ""))
+        text = getattr(self, "message", None) or (str(self.args[0]) if self.args else "")
+        text = re.sub(r"([.:;,]?)\s*\n\s*(?:- )?",
+                      lambda m: ": " if m.group(1) == ":" else "; ", text.strip())
         where = self.location()
         return f"{where}: {text}" if where else text
 
