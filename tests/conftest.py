@@ -1,8 +1,31 @@
-"""Session-wide test hooks: summaries that tests ask to show in the
-terminal summary (printed with or without ``-s``, also under ``-q``)."""
+"""Suite-wide pytest hooks.
+
+The versions this run used are printed at the end of every run (also under
+``-q``), so that a red run on a fresh machine shows what moved since the
+last green one: CI installs the newest versions pip resolves.
+
+Tests may add lines to the same terminal summary through the
+``terminal_report`` fixture (e.g. the fuzz tier's counts), printed with or
+without ``-s``.
+"""
+import platform
+from importlib import metadata
+
 import pytest
 
+VERSIONED = ("numpy", "scipy", "sympy", "scikit-sundae", "matplotlib", "pint", "click",
+             "tqdm", "dask", "distributed", "hypothesis", "casadi", "pytest")
 SUMMARY = pytest.StashKey[list]()
+
+
+def _versions():
+    out = [f"python {platform.python_version()}"]
+    for name in VERSIONED:
+        try:
+            out.append(f"{name} {metadata.version(name)}")
+        except metadata.PackageNotFoundError:
+            continue
+    return out
 
 
 @pytest.fixture
@@ -11,9 +34,11 @@ def terminal_report(request):
     return request.config.stash.setdefault(SUMMARY, [])
 
 
-def pytest_terminal_summary(terminalreporter, exitstatus, config):
+def pytest_terminal_summary(terminalreporter, config):
     lines = config.stash.get(SUMMARY, [])
     if lines:
-        terminalreporter.section("acausal summaries")
+        terminalreporter.write_sep("-", "acausal summaries")
         for line in lines:
             terminalreporter.write_line(line)
+    terminalreporter.write_sep("-", "versions")
+    terminalreporter.write_line(", ".join(_versions()))

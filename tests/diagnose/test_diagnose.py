@@ -235,6 +235,7 @@ def _report_diagnosis(tmp_path, *restrict):
     return out
 
 
+@pytest.mark.slow   # 2-3 min on 2 cores: the six-voltage calibration dominates
 def test_report_data_diagnosis_restricted(tmp_path):
     out = _report_diagnosis(tmp_path, "--hypotheses", "flexible_link,constant_load",
                             "--locations", "hook.body,hook.body:cam")
