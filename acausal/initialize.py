@@ -119,10 +119,12 @@ def _solve_initial(cm, p, d, cb, t0):
 def _raise_if_parameter_breaks(cm, t0, p, d, exc):
     """Raise an InitializationError naming the parameter whose value makes
     the initial equations unsolvable, instead of ``exc``: each parameter
-    that differs from its default (``--set``, ``simulate(params=...)``) is
-    put back to its default alone, and the first one with which the
-    equations solve is named (a 1e30 N/m spring or a 1e-30 kg*m^2 inertia
-    makes them numerically singular, which shows as "inconsistent" starts)."""
+    set (``--set``, ``simulate(params=...)``) SUSPECT_DECADES or more away
+    from its default is put back to its default alone, and the first one
+    with which the equations solve is named (a 1e30 N/m spring or a 1e-30
+    kg*m^2 inertia makes them numerically singular, which shows as
+    "inconsistent fixed start values"). Only the generic failures are
+    diagnosed; a named cause (a linkage that cannot close) is kept."""
     if not str(exc).startswith(("inconsistent fixed start values",
                                 "no consistent initial point")):
         return  # a named cause (an assertion such as a linkage that cannot close)

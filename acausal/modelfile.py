@@ -148,19 +148,31 @@ def _number(v):
         return None
 
 
+def _positive(value):
+    """True for a finite number > 0."""
+    v = _number(value)
+    return v is not None and math.isfinite(v) and v > 0
+
+
 def _check_experiment(exp, path):
-    """The Experiment's times and tolerances are numbers in range."""
-    for name in ("t0", "t_end", "rtol", "atol", "output_step", "max_step", "atol_algebraic"):
-        value = getattr(exp, name)
-        if value is None and name not in ("t0", "t_end", "rtol", "atol"):
-            continue
-        v = _number(value)
-        if v is None or not math.isfinite(v) or (name != "t0" and v <= 0):
-            what = "a finite number" if name == "t0" else "a finite number > 0"
-            raise _bad(path, "experiment", f"experiment {name} = {value!r} must be {what}")
-    if not float(exp.t_end) > float(exp.t0):
-        raise _bad(path, "experiment", f"experiment t_end = {exp.t_end!r} must be after "
-                   f"t0 = {exp.t0!r}")
+    """The Experiment's times and tolerances are numbers in range (``atol``
+    may also be a dict of tolerances by variable)."""
+    bad = None
+    t0, t_end = _number(getattr(exp, "t0", 0.0)), _number(getattr(exp, "t_end", None))
+    if t0 is None or not math.isfinite(t0):
+        bad = f"t0 = {exp.t0!r} must be a finite number"
+    elif t_end is None or not math.isfinite(t_end) or not t_end > t0:
+        bad = f"t_end = {exp.t_end!r} must be a finite number after t0 = {exp.t0!r}"
+    atol = getattr(exp, "atol", None)
+    tolerances = list(atol.values()) if isinstance(atol, dict) else [atol]
+    for name in ("rtol", "atol", "output_step", "max_step", "atol_algebraic"):
+        value = getattr(exp, name, None)
+        values = tolerances if name == "atol" else [value]
+        if bad is None and (value is not None or name in ("rtol", "atol")) and \
+                not all(_positive(v) for v in values):
+            bad = f"{name} = {value!r} must be a finite number > 0"
+    if bad is not None:
+        raise _bad(path, "experiment", f"experiment {bad}")
 
 
 def _free(ns, path):
