@@ -7,9 +7,9 @@ The model of these tests is a mass launched at ``v0`` against a spring to
 ground, ``s(t) = v0 / w * sin(w t)`` with ``w = sqrt(c / m)``; the data are
 written from that closed form, not by the code under test.
 """
+import json
 import math
 import os
-import textwrap
 
 import numpy as np
 import pytest
@@ -174,7 +174,6 @@ def test_calibrate_with_a_trace_reports_the_fit(tmp_path, model_file):
     assert "mass.s rms" in r.output and "over 21 samples" in r.output
     j = run("calibrate", model_file, folder, "--fit", "spring.c", "--json")
     assert j.exit_code == 0, (j.output, j.exception)
-    import json
     out = json.loads(j.stdout)
     assert len(out["residuals"]["V1"]["mass.s"]) == 21
     assert abs(out["values"]["spring.c"] / C_TRUE - 1) < 1e-5
@@ -189,7 +188,7 @@ def test_non_finite_set_is_refused_naming_the_parameter(model_file, spec):
 
 @pytest.mark.parametrize("value", [math.inf, -math.inf, math.nan])
 def test_non_finite_parameters_refused_by_the_api(value):
-    m = Model_with_mass()
+    m = spring_mass_model()
     cm = compile_model(m)
     for name in ("mass.m", "spring.c"):
         with pytest.raises(ParameterError, match=name) as info:
@@ -203,7 +202,7 @@ def test_non_finite_parameters_refused_by_the_api(value):
         Mass(m=1.0, s=value)
 
 
-def Model_with_mass():
+def spring_mass_model():
     from acausal import Model
     m = Model()
     m.mass = Mass(m=1.0, s=0.1, v=0.0)

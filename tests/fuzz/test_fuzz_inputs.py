@@ -8,7 +8,6 @@ exception, or a hang, fails the test. The counts are printed in the
 terminal summary (``acausal summaries``).
 """
 import math
-import os
 import traceback
 from collections import Counter
 from pathlib import Path
