@@ -255,3 +255,29 @@ def test_cli_shows_a_bug_as_a_traceback_with_exit_1(tmp_path, model_file, monkey
     missing = run("diagnose", model_file, folder, "--library", "no_such_library_xyz",
                   "--no-progress", "--report", tmp_path / "report")
     assert "no_such_library_xyz" in one_line_error(missing)
+
+
+@pytest.mark.parametrize("edit, words", [
+    (("thrt [ms]", "thrt [kg]"), ["column 'thrt'", "a mass", "a time"]),
+    (("v_impact [m/s],", ""), ["v_impact", "sets none of the model's conditions"]),
+])
+def test_breaker_refuses_the_wrong_data_of_the_issue(tmp_path, edit, words):
+    """The issue's two cases on the report's own data: a 'thrt [kg]' header
+    (accepted, gave hook.bh = 1 +- 2000) and a missing v_impact column (every
+    experiment ran at the default)."""
+    from acausal.calibrate import model_dataset
+    src = os.path.join(ROOT, "data", "report_24kv")
+    for name in ("experiments.csv", "instrument.csv"):
+        text = open(os.path.join(src, name), encoding="utf-8").read()
+        if name == "experiments.csv":
+            text = text.replace(*edit)
+            if edit[0].startswith("v_impact"):   # drop the column's cells too
+                text = "\n".join(",".join(x.split(",")[:1] + x.split(",")[2:])
+                                 if x.startswith("V") else x for x in text.splitlines())
+        (tmp_path / name).write_text(text, encoding="utf-8")
+    with pytest.raises(DataError) as info:
+        model_dataset(os.path.join(ROOT, "models", "breaker_24kv.py"), tmp_path)
+    msg = str(info.value)
+    assert msg.startswith(f"{tmp_path / 'experiments.csv'}:{info.value.line}: ")
+    for w in words:
+        assert w in msg, msg
