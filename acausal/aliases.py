@@ -35,7 +35,7 @@ def bind_parameters(flat):
                 if s.name not in names:
                     raise ModelError(
                         f"parameter {info.symbol.name} is bound to {info.value}, but "
-                        f"{s.name!r} is not a parameter of the model")
+                        f"{s.name!r} is not a parameter of the model", variable=info.symbol.name)
             bound[info.symbol] = info.value
     resolved = {}
 
@@ -168,7 +168,7 @@ def eliminate_aliases(flat):
             raise StructuralError(
                 f"the model is over-determined: {eq.describe()} {what} other equations "
                 f"(the same relation is imposed twice; e.g. two fixed supports connected "
-                f"to each other, or a connection made twice)", excess=[eq])
+                f"to each other, or a connection made twice)", excess=[eq], component=eq.origin)
 
     aliases, subs = {}, {}
     for x in unknowns:
@@ -185,7 +185,7 @@ def eliminate_aliases(flat):
         if e == 0:
             raise StructuralError(
                 f"the model is over-determined: {eq.describe()} holds identically "
-                f"once aliases are removed", excess=[eq])
+                f"once aliases are removed", excess=[eq], component=eq.origin)
         out.append(type(eq)(e, eq.origin, eq.label))
     remaining = [x for x in unknowns if x not in aliases]
     return Reduced(out, remaining, aliases, psubs, subs)

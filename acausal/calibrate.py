@@ -19,7 +19,7 @@ from scipy import optimize, stats
 
 from .data import load_dataset
 from .differences import ForwardDifferences  # noqa: F401  (re-exported: acausal.diagnose uses it)
-from .errors import AcausalError, ModelError
+from .errors import AcausalError, CalibrationError, ModelError, ModelFileError
 from .modelfile import compile_file, evaluate_measures
 from .profile import profiles
 
@@ -37,8 +37,6 @@ from .profile import profiles
 FD_STEP = 1e-3
 
 
-class CalibrationError(AcausalError):
-    """The calibration could not be carried out (no bracket, no data...)."""
 
 
 def resolve(model):
@@ -53,12 +51,25 @@ def resolve(model):
 
 def model_dataset(path, folder):
     """Load ``folder`` checking its columns against the model file's
-    parameters, measures and variables (with their units)."""
+    parameters, measures and variables (with their units), and that it sets
+    at least one of the model file's ``conditions``."""
     mf, cm = resolve(path)
     params = {p.name: p.unit for p in cm.params}
-    measures = {name: None for name in mf.measures}
+    measures = {name: _si(mf, name) for name in mf.measures}
     variables = {n: cm.flat.variables[n].unit for n in cm.var_names}
-    return load_dataset(folder, parameters=params, measures=measures, variables=variables)
+    return load_dataset(folder, parameters=params, measures=measures, variables=variables,
+                        conditions=[c for c in mf.conditions if c in params])
+
+
+def _si(mf, measure):
+    """The SI unit of a measure declared in a model file (None if undeclared)."""
+    from .data.units import si_unit
+    unit = mf.measure_unit(measure)
+    try:
+        return si_unit(unit)
+    except Exception:  # pint raises UndefinedUnitError, TokenError, AssertionError...
+        raise ModelFileError(f"{mf.path}: measure {measure!r} has unit {unit!r}, which "
+                             "is not a unit expression") from None
 
 
 def subset(dataset, names):
@@ -138,8 +149,14 @@ class Calibration:
                     ci95={k: list(v) for k, v in self.ci95.items()},
                     profile_ci95={k: p.to_dict() for k, p in self.profile_ci95.items()},
                     correlation=None if self.correlation is None else self.correlation.tolist(),
-                    residuals=self.residuals, cost=self.cost, dof=self.dof, n_sim=self.n_sim,
-                    validation=self.validation)
+                    residuals=_plain(self.residuals), cost=self.cost, dof=self.dof,
+                    n_sim=self.n_sim, validation=_plain(self.validation))
+
+
+def _plain(residuals):
+    """experiment -> {signal: float, or list of floats for a trace}, for JSON."""
+    return {exp: {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in sig.items()}
+            for exp, sig in residuals.items()}
 
 
 def report_method(path, dataset, pairs, experiment=None, brackets=None, base=None,

@@ -1,15 +1,18 @@
 """The ``acausal`` command: simulate, variables, calibrate, sweep, diagnose.
 
-Exit codes: 0 success, 2 a model or input error (one readable message on
-stderr), 3 a solver failure (time and component named).
+Exit codes: 0 success, 2 a model or input error (an AcausalError: one
+readable line on stderr), 3 a solver failure (time and component named).
+Any other exception is a bug: it is not caught, so Python shows its
+traceback and exits with 1.
 """
 import contextlib
 import json
 import sys
 
 import click
+import numpy as np
 
-from .errors import AcausalError, SolverError
+from .errors import AcausalError, SolverError, UsageError
 
 
 def _fail(exc):
@@ -19,15 +22,18 @@ def _fail(exc):
 
 
 def _parse_sets(sets):
+    """``--set PATH=VALUE`` items as {path: float}; a UsageError naming the
+    item if it is malformed (the model checks names, finiteness and bounds)."""
     out = {}
     for item in sets:
         if "=" not in item:
-            raise click.BadParameter(f"--set {item!r}: expected PATH=VALUE")
+            raise UsageError(f"--set {item!r}: expected PATH=VALUE")
         k, v = item.split("=", 1)
         try:
             out[k.strip()] = float(v)
         except ValueError:
-            raise click.BadParameter(f"--set {item!r}: {v!r} is not a number") from None
+            raise UsageError(f"--set {item!r}: {v!r} is not a number", variable=k.strip()
+                             ) from None
     return out
 
 
@@ -277,12 +283,22 @@ def calibrate(file, data, fit, method, experiments, profile, as_json):
             click.echo(f"    {name:20s} " + " ".join(f"{x:+.3f}" for x in row))
     click.echo("  residuals (simulated - measured):")
     for exp, sig in out.residuals.items():
-        click.echo(f"    {exp}: " + ", ".join(f"{k} {v:+.4g}" for k, v in sig.items()))
+        click.echo(f"    {exp}: " + ", ".join(_residual(k, v) for k, v in sig.items()))
     if out.validation:
         click.echo("  held back, predicted with these values (simulated - measured):")
         for exp, sig in out.validation.items():
-            click.echo(f"    {exp}: " + ", ".join(
-                f"{k} {v}" if k == "error" else f"{k} {v:+.4g}" for k, v in sig.items()))
+            click.echo(f"    {exp}: " + ", ".join(_residual(k, v) for k, v in sig.items()))
+
+
+def _residual(name, value):
+    """'thrt +1.2e-05' for a measure, 'hook.phi rms 3.4e-04 over 40 samples'
+    for a trace, the message for a failed prediction."""
+    if name == "error":
+        return f"{name} {value}"
+    v = np.asarray(value, dtype=float)
+    if v.ndim == 0:
+        return f"{name} {float(v):+.4g}"
+    return f"{name} rms {float(np.sqrt(np.mean(v ** 2))):.4g} over {v.size} samples"
 
 
 def _profile_line(prof):
@@ -334,7 +350,7 @@ def sweep(file, params, measures, out, plot, scheduler, workers, no_progress):
                              progress=not no_progress, inputs=source_files(file))
         if plot:
             plot_sweep(rows, specs[0][0], measures[0], plot)
-    except (AcausalError, click.BadParameter, ValueError) as exc:
+    except (AcausalError, click.BadParameter) as exc:
         _fail(exc)
     failed = sum(1 for r in rows if r.get("status") != "ok")
     click.echo(f"{len(rows)} points, {failed} failed; results in {out}")
@@ -379,7 +395,6 @@ def diagnose(file, data, json_path, report_dir, scheduler, workers, hypotheses, 
              alpha, no_progress, library):
     """Show what a model gets wrong against measured data, name the cause,
     extend the model and measure the gain."""
-    from .data import DataError
     from .diagnose.run import diagnose as run_diagnosis
     from .executor import terminate_on_sigterm
     try:
@@ -390,7 +405,7 @@ def diagnose(file, data, json_path, report_dir, scheduler, workers, hypotheses, 
                                 workers=workers, progress=not no_progress,
                                 hypotheses=_csv_list(hypotheses),
                                 locations=_csv_list(locations), alpha=alpha, library=library)
-    except (AcausalError, DataError, click.BadParameter, ValueError, ImportError) as exc:
+    except (AcausalError, click.BadParameter) as exc:
         _fail(exc)
     if json_path:
         with open(json_path, "w") as f:

@@ -56,8 +56,9 @@ class Names:
             e = sp.sympify(e).xreplace(self.map)
             bad = [s for s in e.free_symbols if s not in self.allowed]
             if bad:
-                raise ValueError(f"internal: {what} refers to {bad[0]} which is not "
-                                 "a state, algebraic unknown, parameter or discrete value")
+                raise ValueError(  # internal: CompiledModel.resolve checked user expressions
+                    f"internal: {what} refers to {bad[0]} which is not "
+                    "a state, algebraic unknown, parameter or discrete value")
             out.append(e)
         return out
 

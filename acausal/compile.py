@@ -58,10 +58,7 @@ class CompiledModel:
         dummies = dummy_derivatives(g, values, lambda s: base_and_order(s)[0] in fixed)
         self.dae = build_dae(g, dummies, set(self.param_syms), values)
         if not self.dae.y:
-            raise ModelError("the model leaves nothing to integrate: every variable is "
-                             "given explicitly (prescribed motion, constants), so there is no "
-                             "state or implicit unknown for the solver; add a dynamic element "
-                             "(a mass, an inertia, a damper between moving parts)")
+            raise ModelError(_nothing_to_integrate(flat))
         self._subs = dict(red.param_subs)
         self._start_fns = {}
         self._alias = red.subs
@@ -141,7 +138,14 @@ class CompiledModel:
         for name, value in (overrides or {}).items():
             i = self.param_index(name)
             e = self.params[i]
-            value = float(value)
+            try:
+                value = float(value)
+            except (TypeError, ValueError):
+                raise ParameterError(f"parameter {name} must be a number [{e.unit}], got "
+                                     f"{value!r}", variable=name) from None
+            if not np.isfinite(value):
+                raise ParameterError(f"parameter {name} = {value} [{e.unit}] is not a finite "
+                                     "number", variable=name)
             e.decl.check_bounds(value, name)
             p[i] = value
         return p
@@ -327,6 +331,23 @@ def _alias_starts(flat, red):
             out[r] = Start((sp.sympify(st.value) - off) / sign, st.fixed)
             via[r] = (name, float(sign), off)
     return out, via
+
+
+def _nothing_to_integrate(flat):
+    """Why a model leaves the solver no unknown: its bodies' motion is
+    prescribed (a mass tied to a wall), or it has no dynamic element."""
+    moving = sorted({base_and_order(s)[0].name for eq in flat.equations
+                     for s in sp.sympify(eq.expr).free_symbols if base_and_order(s)[1] > 0})
+    if moving:
+        shown = ", ".join(moving[:4]) + (" ..." if len(moving) > 4 else "")
+        return ("the model leaves nothing to integrate: the motion of every body is "
+                f"prescribed ({shown} follow from the constraints alone, e.g. a mass "
+                "connected directly to a fixed support or to a prescribed motion cannot "
+                "move); join such a body to its support through a spring or a damper, or "
+                "remove the body")
+    return ("the model leaves nothing to integrate: it has no dynamic element (every "
+            "variable is given explicitly by constants or prescribed motion); add a mass, "
+            "an inertia or a damper between moving parts")
 
 
 def _is_zero(v):

@@ -7,6 +7,9 @@ inherited the Modelica way: every class in the hierarchy that defines
 relative motion) owns the connector equations and a leaf only adds its law.
 Components never compile or solve anything.
 """
+import math
+import numbers
+
 import sympy as sp
 
 from .connectors import Connector, Port
@@ -21,6 +24,21 @@ def _collect(cls, kind):
             if isinstance(val, kind):
                 out[name] = val
     return out
+
+
+def _check_start(value, label, unit):
+    """A ParameterError unless a start value is a finite number or an
+    expression of parameters."""
+    if isinstance(value, sp.Basic) and not value.is_number:
+        return
+    ok = not isinstance(value, bool) and isinstance(value, (numbers.Real, sp.Basic))
+    try:
+        ok = ok and math.isfinite(float(value))
+    except (TypeError, ValueError):  # a sympy number that is not real
+        ok = False
+    if not ok:
+        raise ParameterError(f"start value {label} = {value!r} [{unit}] is not a finite "
+                             "number", variable=label)
 
 
 class Component:
@@ -65,13 +83,16 @@ class Component:
                 valid = ", ".join(n for n, x in decls.items() if not isinstance(x, Discrete))
                 raise ParameterError(
                     f"{type(self).__name__} {self.path or '(top)'} has no parameter or "
-                    f"variable {key!r}; it has: {valid}")
+                    f"variable {key!r}; it has: {valid}", component=self.path, variable=key)
             if isinstance(d, Parameter):
                 self._values[key] = d.check(value, self.path or type(self).__name__)
             elif isinstance(d, Variable):
-                self._starts[key] = value if isinstance(value, Start) else Start(value, True)
+                start = value if isinstance(value, Start) else Start(value, True)
+                _check_start(start.value, f"{self.path or type(self).__name__}.{key}", d.unit)
+                self._starts[key] = start
             else:
-                raise ParameterError(f"{key!r} of {self.path} is discrete; it cannot be set")
+                raise ParameterError(f"{key!r} of {self.path} is discrete; it cannot be set",
+                                     component=self.path, variable=key)
         return self
 
     def value(self, name):

@@ -9,7 +9,7 @@ import numbers
 
 import sympy as sp
 
-from .errors import ParameterError
+from .errors import ModelError, ParameterError
 
 
 class Declaration:
@@ -70,10 +70,16 @@ class Parameter(Declaration):
             return value  # bound to an expression of other parameters
         if isinstance(value, bool) or not isinstance(value, (numbers.Real, sp.Basic)):
             raise ParameterError(
-                f"parameter {label} must be a number [{self.unit}], got {value!r}")
-        v = float(value)
+                f"parameter {label} must be a number [{self.unit}], got {value!r}",
+                variable=label)
+        try:
+            v = float(value)
+        except (TypeError, ValueError):  # a sympy number that is not real (zoo, I)
+            raise ParameterError(f"parameter {label} = {value} is not a real number",
+                                 variable=label) from None
         if not math.isfinite(v):
-            raise ParameterError(f"parameter {label} = {v} is not finite")
+            raise ParameterError(f"parameter {label} = {v} is not a finite number",
+                                 variable=label)
         self.check_bounds(v, label)
         return value
 
@@ -81,11 +87,13 @@ class Parameter(Declaration):
         if self.min is not None and (v < self.min or (self.min_open and v == self.min)):
             rel = ">" if self.min_open else ">="
             raise ParameterError(
-                f"parameter {label} = {v:g} [{self.unit}] must be {rel} {self.min:g} ({self.desc})")
+                f"parameter {label} = {v:g} [{self.unit}] must be {rel} {self.min:g} ({self.desc})",
+                variable=label)
         if self.max is not None and (v > self.max or (self.max_open and v == self.max)):
             rel = "<" if self.max_open else "<="
             raise ParameterError(
-                f"parameter {label} = {v:g} [{self.unit}] must be {rel} {self.max:g} ({self.desc})")
+                f"parameter {label} = {v:g} [{self.unit}] must be {rel} {self.max:g} ({self.desc})",
+                variable=label)
 
 
 class Start:
@@ -144,7 +152,7 @@ class Event:
     def __init__(self, name, expr, direction=0, action=None, *, terminal=False,
                  recheck=False, observer=False):
         if direction not in (-1, 0, 1):
-            raise ValueError(f"event {name}: direction must be -1, 0 or +1")
+            raise ModelError(f"event {name}: direction must be -1, 0 or +1")
         self.name = name
         self.expr = sp.sympify(expr)
         self.direction = direction

@@ -41,7 +41,7 @@ import numpy as np
 from scipy import optimize
 from scipy.stats import qmc
 
-from .errors import AcausalError
+from .errors import AcausalError, UsageError
 from .modelfile import compile_file, evaluate_measures
 
 Rival = Callable[[Mapping[str, float]], "Mapping[str, np.ndarray] | None"]
@@ -113,7 +113,13 @@ class NextExperiment:
 
 def conditions_of(modelfile) -> list:
     """The :class:`Condition` list a model file declares (its ``conditions``)."""
-    return [Condition(n, lo, hi, unit) for n, (lo, hi, unit) in modelfile.conditions.items()]
+    out = []
+    for n, (lo, hi, unit) in modelfile.conditions.items():
+        if lo is None:
+            raise UsageError(f"{modelfile.path}: condition {n!r} has no range; declare "
+                             f"conditions = {{{n!r}: (low, high, unit)}} to search it")
+        out.append(Condition(n, lo, hi, unit))
+    return out
 
 
 @dataclass(frozen=True)
@@ -133,7 +139,7 @@ def score(predictions: Mapping[str, Mapping[str, np.ndarray] | None],
     differences over floor^2), and the signal where it is largest."""
     names = list(predictions)
     if len(names) < 2:
-        raise ValueError("experiment design needs at least two rival models")
+        raise UsageError("experiment design needs at least two rival models")
     if any(p is None for p in predictions.values()):
         return _Score(-math.inf, None, {}, {})
     best = _Score(-math.inf, None, {}, {})
@@ -193,8 +199,8 @@ def design_experiment(rivals: Mapping[str, Rival], conditions: Sequence[Conditio
     ``times``: the rivals' sample times, kept in the result for its plot."""
     conds = list(conditions)
     if not conds:
-        raise ValueError("no experiment conditions to search (declare `conditions` "
-                         "in the model file)")
+        raise UsageError("no experiment conditions to search (declare `conditions` "
+                         "with their ranges in the model file)")
     ev = _Evaluator(rivals, conds, signals, fixed)
     n0 = n_initial or max(12, 8 * len(conds))
     pts = qmc.LatinHypercube(d=len(conds), seed=seed).random(n0)

@@ -1,10 +1,76 @@
-"""Typed errors. Every error names what is wrong and where (component path,
-variable, equation, file and line) so that the command line can print one
-readable message instead of a traceback."""
+"""Typed errors. Every error a user can cause is an :class:`AcausalError`
+subclass that names what is wrong and where (component path, variable,
+file, line and column, time), so that the command line prints one readable
+line instead of a traceback. Anything else that escapes is a bug.
+
+Hierarchy::
+
+    AcausalError                      payload: component, variable, file, line, column, t
+      ModelError                      the model is not well formed
+        ParameterError                a parameter value is not allowed
+        ConnectionError_              connectors that cannot be joined
+        StructuralError               structurally singular (excess, missing)
+        InitializationError           no consistent initial point
+        ModelFileError                a model file could not be loaded
+      DataError                       a measured-data file is wrong (file:line, column)
+      CalibrationError                a calibration cannot be carried out
+      DiagnosisError                  a diagnosis cannot be carried out
+      SolverError                     the integrator failed (t, component, result)
+        ChatteringError               too many events in a tiny window
+"""
+import re
+
+_PAYLOAD = ("component", "variable", "file", "line", "column", "t")
+
+
+def _restore(cls, args, state):
+    """Unpickle an error without calling its ``__init__`` (whose signature
+    differs between subclasses)."""
+    err = cls.__new__(cls)
+    Exception.__init__(err, *args)
+    err.__dict__.update(state)
+    return err
 
 
 class AcausalError(Exception):
-    """Base class of all errors raised by the library."""
+    """Base class of every error a user can cause.
+
+    ``message`` says what is wrong; the optional keyword arguments say where:
+    ``component`` (dotted path), ``variable``, ``file``, ``line``, ``column``
+    and ``t`` (simulated time [s]). ``str()`` gives one line: the location
+    (``file:line:``, ``column 'c':``, ``at t = ...``) not already in the
+    message, then the message with its line breaks joined.
+    """
+
+    def __init__(self, message="", *, component=None, variable=None, file=None,
+                 line=None, column=None, t=None):
+        super().__init__(message)
+        self.message = str(message)
+        self.component, self.variable = component, variable
+        self.file, self.line, self.column, self.t = file, line, column, t
+
+    def __reduce__(self):  # keep the payload when pickled (dask workers, ...)
+        return _restore, (type(self), self.args, dict(self.__dict__))
+
+    def location(self):
+        """The location prefix of :meth:`__str__` (``''`` when none is known
+        or the message already starts with it)."""
+        parts = []
+        file = getattr(self, "file", None)
+        if file is not None and not self.message.startswith(str(file)):
+            line = getattr(self, "line", None)
+            parts.append(f"{file}:{line}" if line is not None else str(file))
+        column = getattr(self, "column", None)
+        if column is not None and f"column '{column}'" not in self.message:
+            parts.append(f"column '{column}'")
+        return ": ".join(parts)
+
+    def __str__(self):
+        text = getattr(self, "message", None) or (str(self.args[0]) if self.args else "")
+        text = re.sub(r"([.:;,]?)\s*\n\s*(?:- )?",
+                      lambda m: ": " if m.group(1) == ":" else "; ", text.strip())
+        where = self.location()
+        return f"{where}: {text}" if where else text
 
 
 class ModelError(AcausalError):
@@ -12,7 +78,8 @@ class ModelError(AcausalError):
 
 
 class ParameterError(ModelError):
-    """A parameter value is out of its bounds or of the wrong kind."""
+    """A parameter value is out of its bounds or of the wrong kind;
+    ``variable`` names the parameter."""
 
 
 class ConnectionError_(ModelError):
@@ -23,8 +90,8 @@ class StructuralError(ModelError):
     """The flattened system is structurally singular: equations in excess or
     missing. ``excess`` and ``missing`` list what is involved."""
 
-    def __init__(self, message, excess=(), missing=()):
-        super().__init__(message)
+    def __init__(self, message, excess=(), missing=(), **where):
+        super().__init__(message, **where)
         self.excess = list(excess)
         self.missing = list(missing)
 
@@ -37,10 +104,8 @@ class SolverError(AcausalError):
     """The integrator failed. ``t`` is the time of failure, ``component`` the
     component most likely responsible, ``result`` what was computed so far."""
 
-    def __init__(self, message, t=None, component=None, result=None):
-        super().__init__(message)
-        self.t = t
-        self.component = component
+    def __init__(self, message, t=None, component=None, result=None, **where):
+        super().__init__(message, t=t, component=component, **where)
         self.result = result
 
 
@@ -56,3 +121,38 @@ class LimitError(SolverError):
 
 class ModelFileError(ModelError):
     """A model file could not be loaded; the message names file and line."""
+
+
+class DataError(AcausalError):
+    """A problem in a data file, located by ``file``, ``line`` and ``column``
+    (a column name).
+
+    The message reads ``file:LINE: column 'NAME': reason``; parts that are
+    unknown (``None``) are left out. ``reason`` is the bare reason.
+    """
+
+    def __init__(self, reason, file=None, line=None, column=None):
+        super().__init__(reason, file=file, line=line, column=column)
+        self.reason = reason
+
+
+class CalibrationError(AcausalError):
+    """The calibration could not be carried out (no bracket, no data...)."""
+
+
+class DiagnosisError(AcausalError):
+    """The diagnosis could not be carried out (bad data, no fit, ...)."""
+
+
+class UsageError(AcausalError):
+    """An option or argument that cannot be used as given (a malformed
+    ``--param`` spec, ``workers=0``, a missing optional package, ...)."""
+
+
+class UnknownNameError(AcausalError, KeyError):
+    """A name that is not there (a variable of a result, an experiment of a
+    dataset). Also a ``KeyError``, so that mappings keep their meaning."""
+
+
+class MeasureError(AcausalError):
+    """A measure cannot be computed from a result (no impact, no event)."""

@@ -40,6 +40,7 @@ import threading
 import time
 from collections.abc import Callable, Hashable, Iterable, Iterator
 from typing import Any
+from .errors import UsageError
 
 __all__ = ["Executor", "open_executor", "worker_cache", "clear_worker_cache", "terminate_on_sigterm"]
 
@@ -225,7 +226,7 @@ def _import_distributed():
     try:
         import distributed
     except ImportError as exc:
-        raise ImportError(
+        raise UsageError(
             "A Dask scheduler was requested but dask.distributed is not installed; "
             "install it with: pip install 'acausal[dask]'"
         ) from exc
@@ -360,16 +361,16 @@ def open_executor(scheduler: Any = None, workers: int | None = None):
     """
     if workers is not None:
         if scheduler not in (None, "processes"):
-            raise ValueError(f"workers= applies only to the local process pool, not to {scheduler!r}")
+            raise UsageError(f"workers= applies only to the local process pool, not to {scheduler!r}")
         if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-            raise ValueError(f"workers must be an integer >= 1, got {workers!r}")
+            raise UsageError(f"workers must be an integer >= 1, got {workers!r}")
     if scheduler is None or scheduler == "processes":
         return _process_pool(workers)
     if scheduler == "serial":
         return contextlib.nullcontext(Executor("serial", None, 1))
     if isinstance(scheduler, str):
         if not _ADDRESS.match(scheduler):
-            raise ValueError(
+            raise UsageError(
                 f"unknown scheduler {scheduler!r}: expected None, 'processes', 'serial' "
                 "or a Dask scheduler address such as 'tcp://127.0.0.1:8786'"
             )

@@ -166,7 +166,8 @@ def _equations(flat, comp, known):
             if s != time and base.name not in known:
                 raise ModelError(
                     f"equation {i + 1} of {_label(comp)} ({type(comp).__name__}) uses "
-                    f"{s.name!r}, which is not a variable or parameter of the model")
+                    f"{s.name!r}, which is not a variable or parameter of the model",
+                    component=path, variable=s.name)
         flat.equations.append(Equation(expr, path, f"equation {i + 1} ({type(comp).__name__})"))
     for ev in comp.gather("events"):
         ev.owner = path
@@ -205,11 +206,13 @@ def _connections(flat, model, comps):
             for p in group:
                 if id(p) not in ports:
                     raise ModelError(
-                        f"connect() in {_label(comp)}: {p.path} is not part of this model")
+                        f"connect() in {_label(comp)}: {p.path} is not part of this model",
+                        component=p.path)
                 if type(p.ctype).domain != type(first.ctype).domain:
                     raise ConnectionError_(
                         f"connect() in {_label(comp)}: cannot connect {first.path} "
-                        f"({type(first.ctype).__name__}) to {p.path} ({type(p.ctype).__name__})")
+                        f"({type(first.ctype).__name__}) to {p.path} ({type(p.ctype).__name__})",
+                        component=p.path)
                 ra, rb = find(first), find(p)
                 if ra is not rb:
                     parent[rb] = ra

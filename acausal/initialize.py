@@ -9,6 +9,8 @@ or the model raise :class:`InitializationError` naming them — they are never
 silently changed. After an event only the algebraic unknowns and ``y'`` are
 recomputed, the states are kept.
 """
+import math
+
 import numpy as np
 import scipy.linalg
 import sympy as sp
@@ -26,7 +28,18 @@ def _jacobians(cb, t, y, yp, n):
 
 def initial_point(cm, p, d, cb, t0, starts=None):
     """Return (y0, yp0) consistent with the model and its fixed starts
-    (``starts``: name -> value overriding declared fixed start values)."""
+    (``starts``: name -> value overriding declared fixed start values).
+    When there is none because of a parameter changed from its default (a
+    1e30 N/m spring), the InitializationError names that parameter."""
+    try:
+        return _solve_initial(cm, p, d, cb, t0, starts)
+    except InitializationError as exc:
+        _raise_if_parameter_breaks(cm, t0, p, d, exc)
+        raise
+
+
+def _solve_initial(cm, p, d, cb, t0, starts=None):
+    """initial_point without the diagnosis of its failure."""
     dae = cm.dae
     n, ns = len(dae.y), dae.n_states
     fixed = cm.fixed_starts(p, starts)   # list of (var index, value, name)
@@ -102,6 +115,48 @@ def initial_point(cm, p, d, cb, t0, starts=None):
     z = np.concatenate([y, yp[:ns]])
     _check(cm, residual(z, []), jac(z, []), z, fixed, n)
     return y, _algebraic_rates(cm, cb, t0, y, yp)
+
+
+def _raise_if_parameter_breaks(cm, t0, p, d, exc):
+    """Raise an InitializationError naming the parameter whose value makes
+    the initial equations unsolvable, instead of ``exc``: each parameter
+    set (``--set``, ``simulate(params=...)``) SUSPECT_DECADES or more away
+    from its default is put back to its default alone, and the first one
+    with which the equations solve is named (a 1e30 N/m spring or a 1e-30
+    kg*m^2 inertia makes them numerically singular, which shows as
+    "inconsistent fixed start values"). Only the generic failures are
+    diagnosed; a named cause (a linkage that cannot close) is kept."""
+    if not str(exc).startswith(("inconsistent fixed start values",
+                                "no consistent initial point")):
+        return  # a named cause (an assertion such as a linkage that cannot close)
+    for k, entry in enumerate(cm.params):
+        if not _far_from(p[k], entry.default):
+            continue
+        q = np.array(p, dtype=float)
+        q[k] = entry.default
+        try:
+            _solve_initial(cm, q, d, cm.callbacks(q, d), t0)
+        except (InitializationError, ArithmeticError, ValueError, np.linalg.LinAlgError):
+            continue
+        raise InitializationError(
+            f"parameter {entry.name} = {p[k]:g} [{entry.unit}] makes the initial equations "
+            f"unsolvable (with its default {entry.default:g} they solve): check its value "
+            f"and unit; the initialisation said: {exc}",
+            variable=entry.name) from None
+
+
+# A value this many decades from the parameter's default is suspect when
+# the initialisation fails (a 1e30 N/m spring for 2.4e5, a 1e-30 kg*m^2
+# inertia for 4.4e-4); values nearer their defaults are design changes.
+SUSPECT_DECADES = 6.0
+
+
+def _far_from(value, default):
+    """True if ``value`` lies SUSPECT_DECADES or more (in magnitude) from a
+    nonzero default."""
+    if default == 0 or value == 0:
+        return False
+    return abs(math.log10(abs(value / default))) >= SUSPECT_DECADES
 
 
 def _snap_fixed_states(cm, y, fixed):

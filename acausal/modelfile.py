@@ -5,15 +5,18 @@ A model file binds a :class:`~acausal.Model` to the module-level name
 ``measures``, a dict of name -> function(result) -> float (a scalar
 computed from a result, such as a response time, in SI units; a
 :class:`~acausal.Measure` also gives its unit and the unit it is printed
-in), ``free_parameters``, a
+in; ``measure_units``, a dict of measure -> SI unit, may give the units of
+plain functions), ``conditions``, the parameters an experiment sets: a dict
+of parameter -> (low, high) or (low, high, unit), their ranges, which
+:mod:`acausal.design` searches for the next experiment, or a plain list of
+names (a dataset must give at least one of them), ``free_parameters``, a
 dict of parameter -> (low, high) that calibration and diagnosis may fit,
-``conditions``, a dict of parameter -> (low, high) or (low, high, unit): the
-experiment conditions an experimenter can set and their ranges (an impact
-velocity, a start position), which :mod:`acausal.design` searches for the
-next experiment, and ``plot(result, path)``. A model file can import
+and ``plot(result, path)``. A model file can import
 another one (``from breaker_24kv import build``): its folder is on the path.
 """
+import math
 import os
+import re
 import runpy
 import sys
 import traceback
@@ -33,70 +36,196 @@ class ModelFile:
     measures: dict = field(default_factory=dict)
     namespace: dict = field(default_factory=dict)
     free: dict = field(default_factory=dict)   # parameter -> (low, high) bounds
+    measure_units: dict = field(default_factory=dict)  # measure -> SI unit (None: unknown)
     conditions: dict = field(default_factory=dict)  # parameter -> (low, high, unit)
 
+    def measure_unit(self, name):
+        """The SI unit of measure ``name``, or None if the file declares none."""
+        return self.measure_units.get(name)
 
-def _where(exc, path):
-    """'file:line' of the deepest frame of ``exc`` inside ``path``."""
+
+def _line(exc, path):
+    """Line of the deepest frame of ``exc`` inside ``path`` (None if none)."""
     line = None
     for fr in traceback.extract_tb(exc.__traceback__):
         if os.path.abspath(fr.filename) == path:
             line = fr.lineno
-    return f"{path}:{line}" if line else path
+    return line
+
+
+def _error(path, line, message):
+    """A ModelFileError 'path:line: message' carrying ``file`` and ``line``."""
+    where = f"{path}:{line}" if line else path
+    return ModelFileError(f"{where}: {message}", file=path, line=line)
+
+
+def _run(path):
+    """The namespace of the model file ``path`` after running it; any
+    exception it raises becomes a ModelFileError naming its line."""
+    try:
+        return runpy.run_path(path, run_name="__acausal_model__")
+    except SyntaxError as exc:  # also a bad encoding or a NUL byte
+        line = exc.lineno if os.path.abspath(exc.filename or path) == path else None
+        raise _error(path, line or _bad_byte_line(path), f"syntax error: {exc.msg}") from None
+    except AcausalError as exc:
+        raise _error(path, _line(exc, path), str(exc)) from None
+    except Exception as exc:  # a bug in the script: say where
+        line = _line(exc, path) or _bad_byte_line(path)
+        raise _error(path, line, f"{type(exc).__name__}: {exc}") from None
+
+
+def _bad_byte_line(path):
+    """Line of the first NUL byte or byte that is not UTF-8 in the file
+    (what Python refuses before it can name a line), or None."""
+    try:
+        with open(path, "rb") as f:
+            data = f.read()
+    except OSError:
+        return None
+    bad = data.find(b"\0")
+    try:
+        data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        bad = exc.start if bad < 0 else min(bad, exc.start)
+    return data.count(b"\n", 0, bad) + 1 if bad >= 0 else None
 
 
 def load_model_file(path):
     """Run a model file and collect ``model``, ``experiment`` and ``measures``."""
     path = os.path.abspath(path)
     if not os.path.isfile(path):
-        raise ModelFileError(f"{path}: no such model file")
+        raise ModelFileError(f"{path}: no such model file", file=path)
     folder = os.path.dirname(path)
     added = folder not in sys.path
     if added:
         sys.path.insert(0, folder)
     try:
-        ns = runpy.run_path(path, run_name="__acausal_model__")
-    except SyntaxError as exc:
-        raise ModelFileError(f"{exc.filename}:{exc.lineno}: syntax error: {exc.msg}") from None
-    except AcausalError as exc:
-        raise ModelFileError(f"{_where(exc, path)}: {exc}") from None
-    except Exception as exc:  # a bug in the script: say where
-        raise ModelFileError(f"{_where(exc, path)}: {type(exc).__name__}: {exc}") from None
+        ns = _run(path)
     finally:
         if added:
             sys.path.remove(folder)
+    return _collect(ns, path)
+
+
+def _binding_line(path, name):
+    """Line of the first top-level assignment to ``name`` in the file."""
+    try:
+        with open(path, encoding="utf-8", errors="replace") as f:
+            for k, text in enumerate(f, start=1):
+                if re.match(rf"{name}\s*(:[^=]*)?=(?!=)", text):
+                    return k
+    except OSError:
+        pass
+    return None
+
+
+def _bad(path, name, message):
+    """A ModelFileError at the line that binds ``name``."""
+    return _error(path, _binding_line(path, name), message)
+
+
+def _collect(ns, path):
+    """The ModelFile of a model file's namespace, every name checked."""
     model = ns.get("model")
     if not isinstance(model, Model):
-        raise ModelFileError(f"{path}: a model file must bind a Model to the name 'model'"
-                             + (f" (found {type(model).__name__})" if model is not None else ""))
+        raise _bad(path, "model", "a model file must bind a Model to the name 'model'"
+                   + (f" (found {type(model).__name__})" if model is not None else ""))
     exp = ns.get("experiment") or Experiment()
     if not isinstance(exp, Experiment):
-        raise ModelFileError(f"{path}: 'experiment' must be an acausal.Experiment")
+        raise _bad(path, "experiment", "'experiment' must be an acausal.Experiment")
+    _check_experiment(exp, path)
     measures = ns.get("measures") or {}
     if not isinstance(measures, dict) or not all(callable(f) for f in measures.values()):
-        raise ModelFileError(f"{path}: 'measures' must be a dict of name -> function(result)")
+        raise _bad(path, "measures", "'measures' must be a dict of name -> function(result)")
+    units, conditions = _measure_units(ns, measures, path), _conditions(ns, path)
+    return ModelFile(path, model, exp, dict(measures), ns, _free(ns, path), units, conditions)
+
+
+def _number(v):
+    """``v`` as a float, or None if it is not a real number."""
+    if isinstance(v, bool):
+        return None
+    try:
+        return float(v)
+    except (TypeError, ValueError):
+        return None
+
+
+def _positive(value):
+    """True for a finite number > 0."""
+    v = _number(value)
+    return v is not None and math.isfinite(v) and v > 0
+
+
+def _check_experiment(exp, path):
+    """The Experiment's times and tolerances are numbers in range (``atol``
+    may also be a dict of tolerances by variable)."""
+    bad = None
+    t0, t_end = _number(getattr(exp, "t0", 0.0)), _number(getattr(exp, "t_end", None))
+    if t0 is None or not math.isfinite(t0):
+        bad = f"t0 = {exp.t0!r} must be a finite number"
+    elif t_end is None or not math.isfinite(t_end) or not t_end > t0:
+        bad = f"t_end = {exp.t_end!r} must be a finite number after t0 = {exp.t0!r}"
+    atol = getattr(exp, "atol", None)
+    tolerances = list(atol.values()) if isinstance(atol, dict) else [atol]
+    for name in ("rtol", "atol", "output_step", "dense_step", "max_step", "atol_algebraic"):
+        value = getattr(exp, name, None)
+        values = tolerances if name == "atol" else [value]
+        if name == "output_step" and _number(value) == 0:
+            continue          # 0: the solver's own steps and events
+        if bad is None and (value is not None or name in ("rtol", "atol")) and \
+                not all(_positive(v) for v in values):
+            bad = f"{name} = {value!r} must be a finite number > 0" + \
+                (" (or 0: the solver's steps)" if name == "output_step" else "")
+    if bad is not None:
+        raise _bad(path, "experiment", f"experiment {bad}")
+
+
+def _free(ns, path):
+    """``free_parameters`` as name -> (low, high) floats, low < high."""
     free = ns.get("free_parameters") or {}
-    if not isinstance(free, dict) or not all(
-            isinstance(b, (tuple, list)) and len(b) == 2 for b in free.values()):
-        raise ModelFileError(f"{path}: 'free_parameters' must be a dict of "
-                             "name -> (low, high)")
-    return ModelFile(path, model, exp, dict(measures), ns, {k: tuple(map(float, v))
-                                                            for k, v in free.items()},
-                     _conditions(path, ns.get("conditions")))
-
-
-def _conditions(path, given):
-    """``conditions`` of a model file as name -> (low, high, unit)."""
     out = {}
-    for name, spec in (given or {}).items():
-        ok = isinstance(spec, (tuple, list)) and len(spec) in (2, 3)
-        try:
-            low, high = (float(spec[0]), float(spec[1])) if ok else (0.0, 0.0)
-        except (TypeError, ValueError):
-            ok = False
-        if not ok or not isinstance(name, str) or not low < high:
-            raise ModelFileError(f"{path}: conditions[{name!r}] must be (low, high) or "
-                                 f"(low, high, unit) with low < high (found {spec!r})")
+    if isinstance(free, dict):
+        for name, b in free.items():
+            lo, hi = (map(_number, b) if isinstance(b, (tuple, list)) and len(b) == 2
+                      else (None, None))
+            if lo is None or hi is None or not lo < hi:
+                break
+            out[name] = (lo, hi)
+        else:
+            return out
+    raise _bad(path, "free_parameters", "'free_parameters' must be a dict of name -> "
+               "(low, high) with numbers low < high")
+
+
+def _measure_units(ns, measures, path):
+    """measure -> SI unit from ``measure_units`` or the functions' ``unit``."""
+    given = ns.get("measure_units") or {}
+    if not isinstance(given, dict) or not all(isinstance(u, str) for u in given.values()):
+        raise _bad(path, "measure_units", "'measure_units' must be a dict of measure -> unit")
+    unknown = sorted(set(given) - set(measures))
+    if unknown:
+        raise _bad(path, "measure_units", f"'measure_units' names {unknown[0]!r}, which is "
+                   "not a measure")
+    units = {name: getattr(fn, "unit", None) for name, fn in measures.items()}
+    units.update(given)
+    return {k: u for k, u in units.items() if isinstance(u, str)}
+
+
+def _conditions(ns, path):
+    """The ``conditions`` a model file declares, as name -> (low, high,
+    unit); a plain list of names has no ranges (None, None, "")."""
+    given = ns.get("conditions") or {}
+    if isinstance(given, (list, tuple)) and all(isinstance(c, str) for c in given):
+        return {name: (None, None, "") for name in given}
+    out = {}
+    for name, spec in (given.items() if isinstance(given, dict) else [(None, None)]):
+        ok = isinstance(name, str) and isinstance(spec, (tuple, list)) and len(spec) in (2, 3)
+        low, high = (_number(spec[0]), _number(spec[1])) if ok else (None, None)
+        if low is None or high is None or not low < high:
+            raise _bad(path, "conditions", f"conditions[{name!r}] must be (low, high) or "
+                       f"(low, high, unit) with low < high (found {spec!r}); 'conditions' "
+                       "may also be a list of parameter names")
         out[name] = (low, high, str(spec[2]) if len(spec) == 3 else "")
     return out
 
@@ -139,9 +268,9 @@ def evaluate_measures(mf, result):
 
 
 def measure_unit(mf, name):
-    """The SI unit a measure declares (a :class:`~acausal.Measure`), or None."""
-    fn = mf.measures.get(name)
-    return fn.unit if isinstance(fn, Measure) else None
+    """The SI unit a measure declares (a :class:`~acausal.Measure` or the
+    file's ``measure_units``), or None."""
+    return mf.measure_unit(name)
 
 
 def show_measure(mf, name, value):
@@ -152,6 +281,8 @@ def show_measure(mf, name, value):
         return f"{value:.6g}"
     v, unit = fn.shown(value)
     return f"{v:.6g} {unit}" if unit != "1" else f"{v:.6g}"
+
+
 def measure_values(mf, result):
     """(name -> float, name -> reason): every measure of the model file; one
     that cannot be computed from this result (an event that never happened,

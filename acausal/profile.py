@@ -109,7 +109,7 @@ class _Coords:
         k = self.x0.size
         self.log = np.broadcast_to(np.asarray(log, bool), (k,)).copy()
         if np.any(self.log & (self.x0 <= 0)):
-            raise ValueError("a log-scaled parameter must be positive at the optimum")
+            raise ValueError("a log-scaled parameter must be positive at the optimum")  # internal: callers log-scale only positive bounds
         sc = np.abs(self.x0) if scale is None else np.abs(np.asarray(scale, float))
         self.scale = np.where(sc > 0, sc, 1.0)
         lo, hi = (np.full(k, -np.inf), np.full(k, np.inf)) if bounds is None else bounds

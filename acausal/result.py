@@ -3,6 +3,8 @@ import csv
 
 import numpy as np
 
+from .errors import UnknownNameError
+
 
 class Result:
     """What a simulation produced.
@@ -61,7 +63,7 @@ class Result:
         for j, prm in enumerate(cm.params):
             if prm.name == name:
                 return np.full(len(self.t), self.p[j])
-        raise KeyError(f"no variable {name!r} in the result; try one of: "
+        raise UnknownNameError(f"no variable {name!r} in the result; try one of: "
                        + ", ".join(self.names[:12]) + (" ..." if len(self.names) > 12 else ""))
 
     def __contains__(self, name):
@@ -102,7 +104,7 @@ class Result:
         for prm in cm.params:
             if prm.name == name:
                 return prm.unit
-        raise KeyError(f"no variable {name!r} in the result")
+        raise UnknownNameError(f"no variable {name!r} in the result", variable=name)
 
     # -- export --------------------------------------------------------------------
     def to_csv(self, path, names=None):

@@ -15,7 +15,7 @@ from collections import Counter
 import numpy as np
 from sksundae.ida import IDA
 
-from .errors import ChatteringError, LimitError, SolverError
+from .errors import ChatteringError, LimitError, ModelError, SolverError, UsageError
 from .initialize import initial_point, reinitialize
 from .result import Result
 
@@ -49,7 +49,7 @@ class EventState:
         for s, expr in self.cm._subs.items():   # a parameter bound to others
             if s.name == name:
                 return "b", expr
-        raise KeyError(f"event action asked for {name!r}, which is not in the model")
+        raise ModelError(f"event action asked for {name!r}, which is not in the model")
 
     def _index(self):
         idx = getattr(self, "_idx", None)
@@ -66,7 +66,7 @@ class EventState:
     def __setitem__(self, sym, value):
         kind, j = self._find(sym)
         if kind != "d":
-            raise KeyError(f"event actions may only set discrete values, not {sym}")
+            raise ModelError(f"event actions may only set discrete values, not {sym}")
         if self.d[j] != value:
             self.d[j] = float(value)
             self.changed = True
@@ -117,7 +117,7 @@ def _atol_vector(cm, atol, atol_algebraic):
     if atol_algebraic is None:
         return atol
     if not (atol_algebraic > 0 and np.isfinite(atol_algebraic)):
-        raise ValueError(f"atol_algebraic must be a positive number, got {atol_algebraic!r}")
+        raise UsageError(f"atol_algebraic must be a positive number, got {atol_algebraic!r}")
     vec = np.broadcast_to(np.asarray(atol, dtype=float), (len(cm.dae.y),)).copy()
     vec[cm.dae.n_states:] = float(atol_algebraic)
     return vec

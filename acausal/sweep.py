@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from .checkpoint import Checkpoint, input_key
+from .errors import UsageError
 
 __all__ = ["parse_param", "grid", "run_sweep", "plot_sweep", "SweepRows", "SweepAborted"]
 
@@ -72,9 +73,9 @@ def _number(text: str, spec: str, what: str) -> float:
     try:
         value = float(text)
     except ValueError:
-        raise ValueError(f"bad parameter spec {spec!r}: {what} {text.strip()!r} is not a number") from None
+        raise UsageError(f"bad parameter spec {spec!r}: {what} {text.strip()!r} is not a number") from None
     if not math.isfinite(value):
-        raise ValueError(f"bad parameter spec {spec!r}: {what} must be finite, got {text.strip()!r}")
+        raise UsageError(f"bad parameter spec {spec!r}: {what} must be finite, got {text.strip()!r}")
     return value
 
 
@@ -82,17 +83,17 @@ def _range_values(text: str, spec: str) -> np.ndarray:
     """Values of ``start:stop:count`` (inclusive linspace)."""
     parts = text.split(":")
     if len(parts) != 3:
-        raise ValueError(f"bad parameter spec {spec!r}: a range is start:stop:count, e.g. 'x=3.0:5.0:21'")
+        raise UsageError(f"bad parameter spec {spec!r}: a range is start:stop:count, e.g. 'x=3.0:5.0:21'")
     start = _number(parts[0], spec, "start")
     stop = _number(parts[1], spec, "stop")
     try:
         count = int(parts[2])
     except ValueError:
-        raise ValueError(f"bad parameter spec {spec!r}: count {parts[2].strip()!r} must be an integer >= 1") from None
+        raise UsageError(f"bad parameter spec {spec!r}: count {parts[2].strip()!r} must be an integer >= 1") from None
     if count < 1:
-        raise ValueError(f"bad parameter spec {spec!r}: count must be an integer >= 1, got {count}")
+        raise UsageError(f"bad parameter spec {spec!r}: count must be an integer >= 1, got {count}")
     if count == 1 and start != stop:
-        raise ValueError(f"bad parameter spec {spec!r}: count 1 is only allowed with start == stop")
+        raise UsageError(f"bad parameter spec {spec!r}: count 1 is only allowed with start == stop")
     return np.linspace(start, stop, count)
 
 
@@ -106,18 +107,18 @@ def parse_param(spec: str) -> tuple[str, np.ndarray]:
     integer >= 1.
     """
     if not isinstance(spec, str) or "=" not in spec:
-        raise ValueError(f"bad parameter spec {spec!r}: expected name=values, e.g. 'contact.K=1e5,1e6'")
+        raise UsageError(f"bad parameter spec {spec!r}: expected name=values, e.g. 'contact.K=1e5,1e6'")
     name, text = (part.strip() for part in spec.split("=", 1))
     if not _NAME.match(name):
-        raise ValueError(f"bad parameter spec {spec!r}: {name!r} is not a (dotted) parameter name")
+        raise UsageError(f"bad parameter spec {spec!r}: {name!r} is not a (dotted) parameter name")
     if not text:
-        raise ValueError(f"bad parameter spec {spec!r}: no values after '='")
+        raise UsageError(f"bad parameter spec {spec!r}: no values after '='")
     if ":" in text:
         values = _range_values(text, spec)
     else:
         values = np.array([_number(item, spec, "value") for item in text.split(",")], dtype=float)
     if len(np.unique(values)) != len(values):
-        raise ValueError(f"bad parameter spec {spec!r}: values repeat")
+        raise UsageError(f"bad parameter spec {spec!r}: values repeat")
     return name, values
 
 
@@ -129,7 +130,7 @@ def grid(params: Sequence[tuple[str, Iterable[float]]]) -> list[dict[str, float]
     """
     names = [name for name, _ in params]
     if len(set(names)) != len(names):
-        raise ValueError(f"parameter names repeat: {names}")
+        raise UsageError(f"parameter names repeat: {names}")
     value_lists = [[float(v) for v in np.asarray(values, dtype=float).ravel()] for _, values in params]
     return [dict(zip(names, combo)) for combo in itertools.product(*value_lists)]
 
@@ -164,7 +165,7 @@ def _measure_values(result: Any, measures: Sequence[str]) -> dict[str, float | s
         raise TypeError(f"task must return a dict of measures, got {type(result).__name__}")
     missing = [m for m in measures if m not in result]
     if missing:
-        raise KeyError(f"task result lacks measures {missing}")
+        raise UsageError(f"task result lacks measures {missing}")
     return {m: _scalar(m, result[m]) for m in measures}
 
 
@@ -245,7 +246,7 @@ def _repair_tail(path: Path) -> None:
 
 def _check_header(path: Path, header: list[str], columns: Sequence[str]) -> None:
     if len(set(header)) != len(header) or set(header) != set(columns):
-        raise ValueError(
+        raise UsageError(
             f"{path} holds a sweep with columns {header}, but this sweep writes {list(columns)}; "
             "use another out_csv (or delete it) instead of mixing sweeps"
         )
@@ -267,7 +268,7 @@ def _load_cells(path: Path, params: Sequence[str], measures: Sequence[str]) -> t
             cells = dict(zip(header, line))
             try:
                 if len(line) != len(header) or cells["status"] not in ("ok", "failed"):
-                    raise ValueError
+                    raise ValueError  # internal: control flow, caught just below
                 _parse_row(cells, params, measures)
                 cells_by_key[_key(cells, params)] = cells
             except ValueError:
@@ -335,7 +336,7 @@ def _open_journal(out_csv: Path, params, measures, checkpoint, inputs) -> _Journ
 def _parse_cells(saved: Any, params: Sequence[str], measures: Sequence[str]) -> dict[str, str]:
     """Checkpointed cells, checked like a CSV row."""
     if not isinstance(saved, dict) or saved.get("status") not in ("ok", "failed"):
-        raise ValueError("not a sweep row")
+        raise ValueError("not a sweep row")  # internal: control flow, the caller skips the record
     cells = {c: str(saved[c]) for c in [*params, *measures, *RESERVED]}
     _parse_row(cells, params, measures)
     return cells
@@ -348,26 +349,26 @@ def _parse_cells(saved: Any, params: Sequence[str], measures: Sequence[str]) -> 
 
 def _param_names(points: Sequence[Mapping]) -> tuple[str, ...]:
     if not points:
-        raise ValueError("run_sweep needs at least one point")
+        raise UsageError("run_sweep needs at least one point")
     names = tuple(points[0])
     for point in points:
         if tuple(point) != names:
-            raise ValueError(f"all points must have the same parameters {list(names)}, got {list(point)}")
+            raise UsageError(f"all points must have the same parameters {list(names)}, got {list(point)}")
     clash = [n for n in names if n in RESERVED]
     if clash:
-        raise ValueError(f"parameter names {clash} are reserved CSV columns")
+        raise UsageError(f"parameter names {clash} are reserved CSV columns")
     return names
 
 
 def _check_measures(measures: Sequence[str], params: Sequence[str]) -> tuple[str, ...]:
     measures = (measures,) if isinstance(measures, str) else tuple(measures)
     if not measures or not all(isinstance(m, str) and m for m in measures):
-        raise ValueError(f"measures must be a non-empty list of names, got {measures!r}")
+        raise UsageError(f"measures must be a non-empty list of names, got {measures!r}")
     if len(set(measures)) != len(measures):
-        raise ValueError(f"measure names repeat: {list(measures)}")
+        raise UsageError(f"measure names repeat: {list(measures)}")
     clash = [m for m in measures if m in RESERVED or m in params]
     if clash:
-        raise ValueError(f"measure names {clash} clash with parameters or reserved columns")
+        raise UsageError(f"measure names {clash} clash with parameters or reserved columns")
     return measures
 
 
@@ -497,7 +498,7 @@ def _series_param(rows: Sequence[Mapping], x: str, by: str | None) -> str | None
         return by
     others = [p for p in rows.params if p != x and len({r[p] for r in rows}) > 1]
     if len(others) > 1:
-        raise ValueError(f"rows vary in {others} besides {x!r}; pass by= and rows with the others fixed")
+        raise UsageError(f"rows vary in {others} besides {x!r}; pass by= and rows with the others fixed")
     return others[0] if others else None
 
 
@@ -510,7 +511,7 @@ def _series(rows: Sequence[Mapping], x: str, by: str | None) -> list[tuple[Any, 
     for value, group in groups.items():
         xs = [r[x] for r in group]
         if len(set(xs)) != len(xs):
-            raise ValueError(f"several rows share one {x!r} value in a line; pass by= (or fix other parameters)")
+            raise UsageError(f"several rows share one {x!r} value in a line; pass by= (or fix other parameters)")
         series.append((value, sorted(group, key=lambda r: r[x])))
     return series
 

@@ -179,9 +179,16 @@ MEASURES = {
                                desc="approach speed at the first contact"),
 }
 
+# the conditions an experiment sets, with the range the report's drive covers
+# (Table 2: 3.3-4.5 m/s): a dataset must set at least one of them (else every
+# experiment would silently run at the default v_impact), and acausal.design
+# searches this range for the next experiment
+CONDITIONS = {"v_impact": (3.0, 5.0, "m/s")}
+
 free_parameters = dict(FREE_PARAMETERS)
 experiment = release_experiment(model)
 measures = dict(MEASURES)
+conditions = dict(CONDITIONS)
 
 
 def plot(res, path):

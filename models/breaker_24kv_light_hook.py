@@ -24,6 +24,7 @@ Same sign convention, run and measures as the base file, plus ``n_impacts``
 (impacts of the armature on the hook before release).
 Run: ``acausal simulate models/breaker_24kv_light_hook.py --plot FILE``.
 """
+from breaker_24kv import CONDITIONS
 from breaker_24kv import (BH_CAL, FREE_PARAMETERS, K_CAL, MEASURES, build,
                          release_experiment, t_first_contact)
 
@@ -44,6 +45,7 @@ measures = {
     "n_impacts": Measure(lambda res: ct.n_impacts(res, "contact"), "1",
                          desc="impacts between armature and hook"),
 }
+conditions = dict(CONDITIONS)
 
 
 def plot(res, path):

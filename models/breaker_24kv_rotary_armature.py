@@ -26,6 +26,7 @@ Run: ``acausal simulate models/breaker_24kv_rotary_armature.py --plot FILE``.
 import math
 
 import sympy as sp
+from breaker_24kv import CONDITIONS
 from breaker_24kv import (BH_CAL, FREE_PARAMETERS, GAP0, K_CAL, MEASURES, MainShaft,
                          THETA1_0, TriggerHook, release_experiment, t_first_contact)
 
@@ -105,6 +106,7 @@ measures = {
     "n_impacts": Measure(lambda res: ct.n_impacts(res, "contact"), "1",
                          desc="impacts between armature and hook"),
 }
+conditions = dict(CONDITIONS)
 
 
 def plot(res, path):

@@ -30,6 +30,7 @@ Run: ``acausal simulate models/breaker_24kv_two_stage.py --plot FILE``.
 """
 import math
 
+from breaker_24kv import CONDITIONS
 from breaker_24kv import (Armature, BH_CAL, FREE_PARAMETERS, K_CAL, MEASURES, MainShaft,
                          THETA1_0, TriggerHook, release_experiment, t_first_contact)
 
@@ -119,6 +120,7 @@ measures = {
     "n_latch_impacts": Measure(lambda res: ct.n_impacts(res, "latch_contact"), "1",
                                desc="impacts between lever and hook"),
 }
+conditions = dict(CONDITIONS)
 
 
 def plot(res, path):

@@ -3,12 +3,19 @@
 The versions this run used are printed at the end of every run (also under
 ``-q``), so that a red run on a fresh machine shows what moved since the
 last green one: CI installs the newest versions pip resolves.
+
+Tests may add lines to the same terminal summary through the
+``terminal_report`` fixture (e.g. the fuzz tier's counts), printed with or
+without ``-s``.
 """
 import platform
 from importlib import metadata
 
+import pytest
+
 VERSIONED = ("numpy", "scipy", "sympy", "scikit-sundae", "matplotlib", "pint", "click",
              "tqdm", "dask", "distributed", "hypothesis", "casadi", "pytest")
+SUMMARY = pytest.StashKey[list]()
 
 
 def _versions():
@@ -21,6 +28,17 @@ def _versions():
     return out
 
 
-def pytest_terminal_summary(terminalreporter):
+@pytest.fixture
+def terminal_report(request):
+    """A list; lines appended to it are printed in the terminal summary."""
+    return request.config.stash.setdefault(SUMMARY, [])
+
+
+def pytest_terminal_summary(terminalreporter, config):
+    lines = config.stash.get(SUMMARY, [])
+    if lines:
+        terminalreporter.write_sep("-", "acausal summaries")
+        for line in lines:
+            terminalreporter.write_line(line)
     terminalreporter.write_sep("-", "versions")
     terminalreporter.write_line(", ".join(_versions()))

@@ -1,12 +1,18 @@
 """Measured data: experiments, instrument and traces read from a folder of CSV files.
 
-Folder format (every file: UTF-8, one record per line, blank lines and lines
+Folder format (every file: UTF-8, a BOM allowed, comma-separated with a
+decimal point, one record per line, blank lines and lines
 starting with ``#`` ignored, line numbers in errors count every physical line).
 Units in header brackets are pint expressions (``m/s``, ``N/m**1.5``, ``deg``;
 ``[]``, ``[-]`` or ``[1]`` mean dimensionless).  pint counts angles as
 dimensionless, so ``deg`` is converted to rad but cannot be told from a ratio.
 Literal ``nan``/``inf`` cells are errors.  Every problem raises
-:class:`DataError`, whose message starts ``file:LINE: column 'NAME':``.
+:class:`DataError` (an :class:`~acausal.errors.AcausalError`), whose message
+starts ``file:LINE: column 'NAME':``; a byte that is not UTF-8 is named
+with its line.  :func:`acausal.calibrate.model_dataset` also checks each
+column's dimension against the model's parameter, measure (the model file's
+``measure_units``) or variable, and that the dataset sets at least one of
+the model file's ``conditions``.
 
 ``experiments.csv`` (required)
     One row per experiment.  Column ``name`` names it (unique, no ``/``, not

@@ -74,7 +74,18 @@ def _experiment_uses(table: Table) -> list[str]:
     return uses
 
 
-def _read_experiments(folder: Path, parameters, measures) -> list[Experiment]:
+def _check_conditions(table: Table, columns, conditions) -> None:
+    """A DataError unless the columns set one of ``conditions`` (if any)."""
+    given = {name for name, role, _, _ in columns if role == "condition"}
+    if conditions and not given & set(conditions):
+        raise DataError("sets none of the model's conditions (" + ", ".join(conditions)
+                        + "): every experiment would run at the model's default; add a "
+                        f"column such as '{conditions[0]} [unit]'", table.file,
+                        table.header_line)
+
+
+def _read_experiments(folder: Path, parameters, measures, conditions=()
+                      ) -> list[Experiment]:
     """Experiments of ``experiments.csv``, values in SI, no traces yet."""
     table = read_table(folder / EXPERIMENTS)
     names = _experiment_names(table)
@@ -88,6 +99,7 @@ def _read_experiments(folder: Path, parameters, measures) -> list[Experiment]:
             convert = converter(table.units[k], expected.get(name),
                                 table.header(k), name, where)
             columns.append((name, role, convert, k))
+    _check_conditions(table, columns, list(conditions or ()))
     values = {name: convert(table.numbers(k, role == "condition"))
               for name, role, convert, k in columns}
     return [Experiment(names[i], _row(columns, values, i, "condition"),
@@ -188,19 +200,22 @@ def _instrument_row(table: Table, line: int, cells: list[str],
 
 def load_dataset(folder, *, parameters: Optional[Units] = None,
                  measures: Optional[Units] = None,
-                 variables: Optional[Units] = None) -> Dataset:
+                 variables: Optional[Units] = None,
+                 conditions: Iterable[str] = ()) -> Dataset:
     """Load a dataset folder (format: module docstring); values in SI.
 
     ``parameters``, ``measures`` and ``variables`` map names to the SI unit the
     model expects (``{"v_impact": "m/s"}``; a unit None, or a plain list of
     names, skips the unit check).  Given both ``parameters`` and ``measures``,
     any other column of experiments.csv is an error; given ``variables``, any
-    other trace column is.  Raises :class:`DataError` on any problem.
+    other trace column is.  Given ``conditions`` (parameter names), the
+    dataset must set at least one of them.  Raises :class:`DataError` on any
+    problem.
     """
     folder = Path(folder)
     parameters, measures = _as_units(parameters), _as_units(measures)
     variables = _as_units(variables)
-    experiments = _read_experiments(folder, parameters, measures)
+    experiments = _read_experiments(folder, parameters, measures, conditions)
     _attach_traces(folder, experiments, variables)
     units = {**(variables or {}), **(measures or {})}
     known = set(units).union(*(e.measures for e in experiments),

@@ -8,23 +8,9 @@ from typing import Optional
 
 import numpy as np
 
+from ..errors import DataError, UnknownNameError
 
-class DataError(ValueError):
-    """A problem in a data file, located by ``file``, ``line`` and ``column``.
-
-    The message reads ``file:LINE: column 'NAME': reason``; parts that are
-    unknown (``None``) are left out.
-    """
-
-    def __init__(self, reason, file=None, line=None, column=None):
-        self.reason, self.file, self.line, self.column = reason, file, line, column
-        where = "" if file is None else str(file)
-        where += "" if line is None else f":{line}"
-        col = "" if column is None else f"column '{column}': "
-        super().__init__(f"{where}: {col}{reason}" if where else col + reason)
-
-    def __reduce__(self):  # keep the attributes when pickled (e.g. by dask)
-        return type(self), (self.reason, self.file, self.line, self.column)
+__all__ = ["DataError", "Instrument", "Trace", "Experiment", "Dataset"]
 
 
 @dataclass
@@ -89,8 +75,9 @@ class Dataset:
         return list(dict.fromkeys(n for e in self.experiments for n in e.measures))
 
     def experiment(self, name: str) -> Experiment:
-        """The experiment called ``name`` (KeyError if there is none)."""
+        """The experiment called ``name`` (UnknownNameError, also a KeyError,
+        if there is none)."""
         for e in self.experiments:
             if e.name == name:
                 return e
-        raise KeyError(f"no experiment {name!r}")
+        raise UnknownNameError(f"no experiment {name!r}", file=self.folder)

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import csv
+import io
 import math
 import re
 from dataclasses import dataclass
@@ -61,18 +62,46 @@ def number(cell: str, required: bool, where: tuple) -> float:
     return value
 
 
-def read_table(path: Path) -> Table:
-    """Read a CSV file: header, unit brackets, rows of the header's width."""
+def _text(path: Path) -> str:
+    """The file's text (UTF-8, a BOM allowed); a DataError naming the line
+    and column of the first byte that is not UTF-8, or of a NUL byte."""
     if not path.is_file():
         raise DataError("file not found", path)
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise DataError(f"cannot read: {exc.strerror or exc}", path) from None
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        col = exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1
+        raise DataError(f"byte 0x{data[exc.start]:02x} (byte {col} of the line) is not UTF-8 "
+                        "(save the file as UTF-8)", path, line) from None
+    if "\0" in text:
+        raise DataError("NUL byte (not a text file?)", path,
+                        text.count("\n", 0, text.index("\0")) + 1)
+    return text
+
+
+def _rows(path: Path, text: str) -> list[tuple[int, list[str]]]:
+    """(line, cells) of the non-blank, non-comment lines of ``text``."""
     rows = []
-    with path.open(newline="", encoding="utf-8-sig") as f:
-        for line, text in enumerate(f, start=1):
-            if text.strip() and not text.lstrip().startswith("#"):
-                rows.append((line, [c.strip() for c in next(csv.reader([text]))]))
-    if not rows:
-        raise DataError("no header row", path)
-    (line, header), rows = rows[0], rows[1:]
+    for line, raw in enumerate(io.StringIO(text, newline=""), start=1):
+        if raw.strip() and not raw.lstrip().startswith("#"):
+            try:
+                cells = next(csv.reader([raw], strict=True))
+            except csv.Error as exc:
+                raise DataError(f"cannot read the row as CSV: {exc}", path, line) from None
+            rows.append((line, [c.strip() for c in cells]))
+    return rows
+
+
+def _header(path: Path, line: int, header: list[str]) -> tuple[list[str], list]:
+    """Names and units of a header row."""
+    if len(header) == 1 and ";" in header[0]:
+        raise DataError("the header is separated by ';': acausal reads comma-separated "
+                        "files (decimal point '.')", path, line)
     names, units = [], []
     for text in header:
         match = _HEADER.match(text)
@@ -83,6 +112,16 @@ def read_table(path: Path) -> Table:
             raise DataError("duplicate column", path, line, match["name"])
         names.append(match["name"])
         units.append(match["unit"])
+    return names, units
+
+
+def read_table(path: Path) -> Table:
+    """Read a CSV file: header, unit brackets, rows of the header's width."""
+    rows = _rows(path, _text(path))
+    if not rows:
+        raise DataError("no header row (empty file)", path)
+    (line, header), rows = rows[0], rows[1:]
+    names, units = _header(path, line, header)
     for row_line, cells in rows:
         if len(cells) != len(names):
             column = names[len(cells)] if len(cells) < len(names) else None

@@ -16,8 +16,10 @@ def ureg():
     return pint.UnitRegistry()
 
 
+@functools.lru_cache(maxsize=1024)
 def parse_unit(text: str):
-    """Parse a unit; ``''``, ``'-'`` and ``'1'`` mean dimensionless."""
+    """Parse a unit; ``''``, ``'-'`` and ``'1'`` mean dimensionless.
+    Cached: pint's parser is slow and data files repeat their units."""
     text = text.strip()
     return ureg().parse_units("" if text in ("-", "1") else text)
 
@@ -32,6 +34,14 @@ def read_unit(text: str, where: tuple):
     except Exception:  # pint raises AssertionError, TokenError, ... on bad syntax
         reason = "not a unit expression"
     raise DataError(f"cannot read unit [{text}]: {reason}", *where)
+
+
+def si_unit(text: Optional[str]) -> Optional[str]:
+    """The SI base unit of the same dimension as ``text`` (``'ms'`` ->
+    ``'second'``); None stays None. Raises pint's errors if unparseable."""
+    if text is None:
+        return None
+    return str(ureg().Quantity(1.0, parse_unit(text)).to_base_units().units)
 
 
 def kind(unit) -> str:
@@ -59,7 +69,10 @@ def converter(unit_text: Optional[str], expected: Optional[str], label: str,
     """
     target = None
     if expected is not None:
-        target = parse_unit(expected)  # programming error if unparseable
+        try:
+            target = parse_unit(expected)
+        except Exception:  # a model unit pint cannot read ('N/m^gamma'): no check
+            target = None
     if unit_text is None:
         return lambda values: values
     unit = read_unit(unit_text, where)
@@ -68,7 +81,17 @@ def converter(unit_text: Optional[str], expected: Optional[str], label: str,
                         f"'{name}' is {kind(target)} [{expected}]", *where)
     if target is None:
         target = ureg().Quantity(1.0, unit).to_base_units().units
-    return lambda values: ureg().Quantity(values, unit).to(target).magnitude
+    scale, offset = _affine(unit, target)
+    return lambda values: np.asarray(values, dtype=float) * scale + offset
+
+
+@functools.lru_cache(maxsize=1024)
+def _affine(unit, target) -> tuple[float, float]:
+    """(scale, offset) with ``x [target] = scale * x [unit] + offset``; every
+    pint conversion is affine (offsets: degC, degF)."""
+    q = ureg().Quantity
+    offset = float(q(0.0, unit).to(target).magnitude)
+    return float(q(1.0, unit).to(target).magnitude) - offset, offset
 
 
 def from_si(values: np.ndarray, unit_text: Optional[str]) -> np.ndarray:

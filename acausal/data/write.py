@@ -9,7 +9,7 @@ from typing import Mapping, Optional
 import numpy as np
 
 from .load import EXPERIMENTS, INSTRUMENT
-from .records import Dataset
+from .records import DataError, Dataset
 from .units import from_si
 
 
@@ -47,7 +47,7 @@ def write_dataset(folder, dataset: Dataset, units: Optional[Mapping[str, str]] =
     names = dataset.condition_names + dataset.measure_names
     for e in dataset.experiments:
         if set(e.conditions) != set(dataset.condition_names):
-            raise ValueError(f"experiment {e.name!r} lacks a condition value")
+            raise DataError(f"experiment {e.name!r} lacks a condition value")
     columns = [[e.name for e in dataset.experiments]]
     for n in names:
         values = [{**e.measures, **e.conditions}.get(n, math.nan)

@@ -8,11 +8,18 @@ from __future__ import annotations
 import importlib
 from types import SimpleNamespace
 
+from ..errors import DiagnosisError
+
 DEFAULT = "acausal.diagnose.hypotheses"
 
 
 def load_library(name: str | None = None) -> SimpleNamespace:
-    mod = importlib.import_module(name or DEFAULT)
+    try:
+        mod = importlib.import_module(name or DEFAULT)
+    except ImportError as exc:
+        if name is None:
+            raise  # the package's own library: a broken install, not a user error
+        raise DiagnosisError(f"hypothesis library {name!r} cannot be imported: {exc}") from None
     graph = getattr(mod, "ModelGraph", None)
     if graph is None:
         graph = importlib.import_module("acausal.diagnose.graph").ModelGraph

@@ -37,7 +37,7 @@ import numpy as np
 
 from ..calibrate import model_dataset
 from ..data import DataError
-from ..errors import AcausalError
+from ..errors import DiagnosisError
 from ..executor import open_executor, worker_cache
 from ..modelfile import compile_file
 from . import stats as st
@@ -54,10 +54,6 @@ BUDGET_MIN_S = 60.0   # ... but at least this long [s] (machine-dependent: rarel
 SMALL_N = 100         # at most this many values and ...
 SMALL_EXPERIMENTS = 12  # ... experiments: exact leave-one-out for the SMALL_TOP ...
 SMALL_TOP = 6         # ... best candidates (the linearised shortcut is poor on few data)
-
-
-class DiagnosisError(AcausalError):
-    """The diagnosis cannot run on this input (no data, unknown hypothesis...)."""
 
 
 # ---------------------------------------------------------------------------
@@ -239,7 +235,8 @@ def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
     try:
         ds = model_dataset(model_path, data_folder)
     except DataError as exc:
-        raise DiagnosisError(str(exc)) from None
+        raise DiagnosisError(exc.message, file=exc.file, line=exc.line,
+                             column=exc.column) from None
     if not ds.experiments:
         raise DiagnosisError(f"{data_folder}: no experiments")
     if not any(e.measures or e.trace is not None for e in ds.experiments):

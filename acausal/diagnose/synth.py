@@ -29,6 +29,7 @@ import numpy as np
 from scipy import optimize
 
 from ..data import Dataset, Experiment, Instrument, Trace, write_dataset
+from ..errors import UsageError
 from ..modelfile import compile_file, evaluate_measures
 from .library import load_library
 
@@ -55,7 +56,7 @@ def _conditions(conditions):
         names = list(conditions)
         n = {len(v) for v in conditions.values()}
         if len(n) != 1:
-            raise ValueError("every condition needs the same number of values")
+            raise UsageError("every condition needs the same number of values")
         return [{k: float(conditions[k][i]) for k in names} for i in range(n.pop())]
     return [dict(c) for c in conditions]
 
@@ -109,13 +110,13 @@ def synthesize(model_path, folder, *, conditions, hypothesis=None, location=None
     conds = _conditions(conditions)
     measures, traces = list(measures), list(traces)
     if not measures and not traces:
-        raise ValueError("record at least one measure or trace")
+        raise UsageError("record at least one measure or trace")
     if traces and not sample_rate:
-        raise ValueError("traces need a sample_rate")
+        raise UsageError("traces need a sample_rate")
     mf, cm = compile_file(model_path)
     for m in measures:
         if m not in mf.measures:
-            raise ValueError(f"the model file has no measure {m!r}")
+            raise UsageError(f"the model file has no measure {m!r}")
     truth_free = {}
     for name, (lo, hi) in mf.free.items():
         v = (free or {}).get(name)
@@ -151,7 +152,7 @@ def synthesize(model_path, folder, *, conditions, hypothesis=None, location=None
                     pair, truth_free, ext_values, first, sign, target, conds, ref,
                     measures, traces, floors, sample_rate)
             else:
-                raise ValueError("give values, magnitude or effect for the hidden extension")
+                raise UsageError("give values, magnitude or effect for the hidden extension")
     runs = _simulate(pair, {**truth_free, **ext_values}, conds)
     if hypothesis is not None:
         ref = _simulate((mf, cm), truth_free, conds)
@@ -189,7 +190,7 @@ def _solve_effect(pair, free, values, spec, sign, target, conds, ref, measures, 
     lo_b, hi_b = float(spec.low), float(spec.high)
     limit = hi_b if sign > 0 else -lo_b
     if not limit > 0:
-        raise ValueError(f"{spec.name}: no room for sign {sign:+g} in "
+        raise UsageError(f"{spec.name}: no room for sign {sign:+g} in "
                          f"[{spec.low}, {spec.high}]")
 
     def eff(logm):

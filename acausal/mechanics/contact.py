@@ -72,6 +72,7 @@ import sympy as sp
 from sympy import Eq, Piecewise
 
 from acausal import Component, Discrete, Event, Flange, Model, Parameter, Variable, der
+from acausal.errors import MeasureError, ParameterError
 
 from .partials import PartialCompliant
 
@@ -118,18 +119,18 @@ def hertz_stiffness(R_i, R_j, E_i, E_j, nu_i=0.3, nu_j=0.3):
     """
     for name, v in (("R_i", R_i), ("R_j", R_j), ("E_i", E_i), ("E_j", E_j)):
         if not (v > 0 or (name.startswith("R") and v < 0)) or v != v:
-            raise ValueError(f"hertz_stiffness: {name} = {v!r} must be a non-zero number "
+            raise ParameterError(f"hertz_stiffness: {name} = {v!r} must be a non-zero number "
                              "(E > 0)")
     for name, v in (("nu_i", nu_i), ("nu_j", nu_j)):
         if not -1.0 < v < 0.5 + 1e-12:
-            raise ValueError(f"hertz_stiffness: Poisson ratio {name} = {v!r} must lie in "
+            raise ParameterError(f"hertz_stiffness: Poisson ratio {name} = {v!r} must lie in "
                              "(-1, 0.5]")
     if math.isinf(R_i) and math.isinf(R_j):
-        raise ValueError("hertz_stiffness: two planes (R_i = R_j = inf) have no Hertz "
+        raise ParameterError("hertz_stiffness: two planes (R_i = R_j = inf) have no Hertz "
                          "stiffness")
     R = 1.0 / (1.0 / R_i + 1.0 / R_j)   # R_i R_j / (R_i + R_j), safe with inf
     if R <= 0:
-        raise ValueError(f"hertz_stiffness: effective radius {R:g} m <= 0 (a concave "
+        raise ParameterError(f"hertz_stiffness: effective radius {R:g} m <= 0 (a concave "
                          "surface must be larger than the convex one)")
     h_i = (1.0 - nu_i ** 2) / (math.pi * E_i)
     h_j = (1.0 - nu_j ** 2) / (math.pi * E_j)
@@ -145,7 +146,7 @@ def damping_chi(law, e):
         return 3 * (1 - e ** 2) / 4
     if law == "flores":
         return 8 * (1 - e) / (5 * e)
-    raise ValueError(f"no restitution-based chi for law {law!r}")
+    raise ParameterError(f"no restitution-based chi for law {law!r}")
 
 
 class PartialContact(Component):
@@ -412,7 +413,7 @@ def impacts(res, path):
 def _pick(res, path, k, field):
     imp = impacts(res, path)
     if not imp:
-        raise ValueError(f"contact {path!r} had no impact")
+        raise MeasureError(f"contact {path!r} had no impact", component=path)
     return getattr(imp[k], field)
 
 

@@ -35,6 +35,7 @@ import sympy as sp
 from sympy import Eq, Max, Min, cos, sin, sqrt
 
 from acausal import Assertion, Component, Parameter, RotFlange, Start, Variable
+from acausal.errors import ParameterError
 
 
 def _closed_form(th1, e, f, r1, r2, r3, mode, lib):
@@ -80,7 +81,7 @@ def fourbar_angles(theta1, e=0.0002, f=0.125, r1=0.116, r2=0.036, r3=0.0533, mod
     main shaft start at 0."""
     th2, th3, c = _closed_form(float(theta1), e, f, r1, r2, r3, mode, _Math)
     if abs(c) > 1.0:
-        raise ValueError(f"four-bar cannot close at theta1 = {theta1:g} rad: "
+        raise ParameterError(f"four-bar cannot close at theta1 = {theta1:g} rad: "
                          f"cos(lambda) = {c:.6g}")
     return th2, th3
 

@@ -10,6 +10,7 @@ from acausal import Experiment
 from acausal.modelfile import compile_file, run_file
 from acausal.simulate import _atol_vector
 from acausal.mechanics.fourbar import fourbar_angles
+from acausal.errors import UsageError
 
 EXAMPLE = os.path.join(os.path.dirname(__file__), "..", "..", "models", "examples",
                        "fourbar.py")
@@ -28,7 +29,7 @@ def test_vector_puts_the_algebraic_tolerance_after_the_states():
 @pytest.mark.parametrize("bad", [0.0, -1e-3, float("nan"), float("inf")])
 def test_bad_value_is_refused(bad):
     _, cm = compile_file(EXAMPLE)
-    with pytest.raises(ValueError, match="atol_algebraic"):
+    with pytest.raises(UsageError, match="atol_algebraic"):
         cm.simulate(t_end=0.1, atol_algebraic=bad)
 
 

@@ -252,5 +252,5 @@ def test_round_trip(tmp_path, units):
 
 def test_write_rejects_missing_condition(tmp_path):
     data = Dataset(None, [Experiment("a", {"v": 1.0}), Experiment("b", {})])
-    with pytest.raises(ValueError, match="'b' lacks a condition"):
+    with pytest.raises(DataError, match="'b' lacks a condition"):
         write_dataset(tmp_path, data)

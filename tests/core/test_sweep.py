@@ -13,6 +13,7 @@ import pytest
 from acausal.executor import clear_worker_cache, open_executor, worker_cache
 from acausal.sweep import SweepAborted, grid, parse_param, plot_sweep, run_sweep
 from tests.core import sweep_tasks
+from acausal.errors import UsageError
 
 
 def read_csv(path):
@@ -65,14 +66,14 @@ def test_parse_param_range_is_inclusive():
      "x=1:2:n", "x=a", "x=1,,2", "x=1,", "x=1,nan", "x=inf", "x=1:2:1", "x=1,1"],
 )
 def test_parse_param_bad_names_the_spec(spec):
-    with pytest.raises(ValueError, match=re.escape(repr(spec))):
+    with pytest.raises(UsageError, match=re.escape(repr(spec))):
         parse_param(spec)
 
 
 def test_parse_param_count_message():
-    with pytest.raises(ValueError, match="integer >= 1"):
+    with pytest.raises(UsageError, match="integer >= 1"):
         parse_param("x=0:1:0")
-    with pytest.raises(ValueError, match="integer >= 1"):
+    with pytest.raises(UsageError, match="integer >= 1"):
         parse_param("x=0:1:2.5")
 
 
@@ -83,7 +84,7 @@ def test_grid_order_last_parameter_fastest():
         {"a": 2.0, "b.c": 10.0}, {"a": 2.0, "b.c": 20.0}, {"a": 2.0, "b.c": 30.0},
     ]
     assert all(type(v) is float for p in points for v in p.values())
-    with pytest.raises(ValueError, match="repeat"):
+    with pytest.raises(UsageError, match="repeat"):
         grid([("a", [1]), ("a", [2])])
 
 
@@ -119,7 +120,7 @@ def test_process_pool_executor_runs_tasks():
 
 @pytest.mark.parametrize(
     "scheduler, workers, error",
-    [("bogus", None, ValueError), ("serial", 2, ValueError), (None, 0, ValueError), (42, None, TypeError)],
+    [("bogus", None, UsageError), ("serial", 2, UsageError), (None, 0, UsageError), (42, None, TypeError)],
 )
 def test_open_executor_rejects_bad_arguments(scheduler, workers, error):
     with pytest.raises(error):
@@ -128,7 +129,7 @@ def test_open_executor_rejects_bad_arguments(scheduler, workers, error):
 
 def test_missing_dask_gives_install_hint(monkeypatch):
     monkeypatch.setitem(sys.modules, "distributed", None)  # makes `import distributed` fail
-    with pytest.raises(ImportError, match=r"acausal\[dask\]"):
+    with pytest.raises(UsageError, match=r"acausal\[dask\]"):
         with open_executor("tcp://127.0.0.1:8786"):
             pass
 
@@ -189,7 +190,7 @@ def test_bad_task_results_fail_the_point(tmp_path):
     with open_executor("serial") as ex:
         rows = run_sweep(sweep_tasks.square, xs(2), tmp_path / "s.csv", executor=ex, measures=["nope"], progress=False)
     assert [r["status"] for r in rows] == ["failed", "failed"]
-    assert rows[0]["error"].startswith("KeyError")
+    assert rows[0]["error"].startswith("UsageError")
 
 
 def test_resume_after_keyboard_interrupt_serial(tmp_path, log_dir):
@@ -254,9 +255,9 @@ def test_existing_csv_with_other_columns_is_refused(tmp_path):
     with open_executor("serial") as ex:
         run_sweep(sweep_tasks.square, xs(2), out, executor=ex, measures=["y"], progress=False)
         before = out.read_text()
-        with pytest.raises(ValueError, match="columns"):
+        with pytest.raises(UsageError, match="columns"):
             run_sweep(sweep_tasks.square, xs(2), out, executor=ex, measures=["z"], progress=False)
-        with pytest.raises(ValueError, match="columns"):
+        with pytest.raises(UsageError, match="columns"):
             run_sweep(sweep_tasks.square, grid([("x", [1]), ("k", [1])]), out, executor=ex,
                       measures=["y"], progress=False)
     assert out.read_text() == before
@@ -343,7 +344,7 @@ def test_plot_sweep_2d_with_failures(tmp_path, log_dir):
     png = plot_sweep(rows, "x", "y", tmp_path / "y.png")
     assert png.stat().st_size > 1000
     plot_sweep(list(rows), "x", "y", tmp_path / "y2.png", by="k")  # plain list: by= explicit
-    with pytest.raises(ValueError, match="by="):
+    with pytest.raises(UsageError, match="by="):
         plot_sweep(list(rows), "x", "y", tmp_path / "y3.png")
     assert ("matplotlib.pyplot" in sys.modules) == pyplot_loaded  # no pyplot state touched
 

@@ -8,6 +8,7 @@ import pytest
 from acausal.calibrate import model_dataset
 from acausal.diagnose.synth import synthesize
 from acausal.modelfile import compile_file
+from acausal.errors import UsageError
 
 HERE = os.path.dirname(__file__)
 LATCH = os.path.join(HERE, "..", "..", "models", "latch_striker.py")
@@ -79,12 +80,12 @@ def test_magnitude_range_and_seed(tmp_path):
 
 
 def test_bad_requests(tmp_path):
-    with pytest.raises(ValueError, match="at least one measure or trace"):
+    with pytest.raises(UsageError, match="at least one measure or trace"):
         synthesize(LATCH, tmp_path, conditions=COND)
-    with pytest.raises(ValueError, match="sample_rate"):
+    with pytest.raises(UsageError, match="sample_rate"):
         synthesize(LATCH, tmp_path, conditions=COND, traces=["latch.s"])
-    with pytest.raises(ValueError, match="no measure 'thrt'"):
+    with pytest.raises(UsageError, match="no measure 'thrt'"):
         synthesize(LATCH, tmp_path, conditions=COND, measures=["thrt"])
-    with pytest.raises(ValueError, match="values, magnitude or effect"):
+    with pytest.raises(UsageError, match="values, magnitude or effect"):
         synthesize(LATCH, tmp_path, conditions=COND, measures=["trip_time"],
                    hypothesis="constant_load", location="latch", library=STUB)

@@ -456,11 +456,11 @@ def test_hertz_stiffness_by_hand():
     Estar = 1 / ((1 - 0.3 ** 2) / 2.1e11 + (1 - 0.33 ** 2) / 7e10)
     K2 = hertz_stiffness(0.005, math.inf, 2.1e11, 7e10, 0.3, 0.33)
     assert K2 == pytest.approx(4 / 3 * Estar * math.sqrt(0.005), rel=1e-12)
-    with pytest.raises(ValueError, match="E_j"):
+    with pytest.raises(ParameterError, match="E_j"):
         hertz_stiffness(0.01, 0.01, 2e11, -1.0)
-    with pytest.raises(ValueError, match="nu_i"):
+    with pytest.raises(ParameterError, match="nu_i"):
         hertz_stiffness(0.01, 0.01, 2e11, 2e11, nu_i=0.7)
-    with pytest.raises(ValueError, match="two planes"):
+    with pytest.raises(ParameterError, match="two planes"):
         hertz_stiffness(math.inf, math.inf, 2e11, 2e11)
 
 

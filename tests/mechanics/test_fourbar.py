@@ -246,7 +246,7 @@ def test_parameter_validation_names_the_parameter():
         FourBar(mode=0)
     with pytest.raises(ParameterError, match=r"FourBar\.sin_min = 1"):
         FourBar(sin_min=1.0)
-    with pytest.raises(ValueError, match="cannot close at theta1 = 3.14159"):
+    with pytest.raises(ParameterError, match="cannot close at theta1 = 3.14159"):
         fourbar_angles(np.pi, **LOCKING)
 
 
