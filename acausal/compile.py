@@ -72,8 +72,11 @@ class CompiledModel:
         self.stop_events = []
         roots = [self.resolve(e.expr) for e in self.events] + \
                 [self.resolve(a.expr) for a in self.assertions]
-        self.source, self._make = generate(self.dae, self.param_syms, self.disc_syms,
-                                           roots, observed)
+        fixed_rows = [k for k, n in enumerate(self.var_names)
+                      if flat.variables[n].start.fixed]
+        gen = generate(self.dae, self.param_syms, self.disc_syms, roots, observed, fixed_rows)
+        self.source, self._make, self._fixjac = gen.source, gen.make, gen.fixjac
+        self.sparsity = gen.sparsity
         self.n_roots = len(roots)
         self.compile_s = _time.perf_counter() - t0
 
@@ -157,24 +160,19 @@ class CompiledModel:
         return float(value)
 
     def fixed_jacobian(self):
-        """A function (y, yp) -> d(fixed-start variables)/d(y, y'_states),
-        generated once: the rows the initialisation adds for fixed starts."""
-        fn = getattr(self, "_fixed_jac", None)
-        if fn is None:
-            ns = self.dae.n_states
-            zs = list(self.dae.y) + [s for s in self.dae.yp[:ns]]
-            rows = []
-            for name in self.var_names:
-                if self.flat.variables[name].start.fixed:
-                    e = self.resolve(sp.Symbol(name))
-                    rows.append([sp.diff(e, z) for z in zs])
-            ysyms = list(self.dae.y)
-            ypsyms = [s if s is not None else sp.Dummy() for s in self.dae.yp]
-            args = [time] + ysyms + ypsyms + self.param_syms + self.disc_syms
-            fn = sp.lambdify(args, sp.Matrix(rows) if rows else sp.zeros(0, len(zs)),
-                             "numpy")
-            self._fixed_jac = fn
-        return fn
+        """A function ``(t, *y, *yp, *p, *d)`` -> d(fixed-start variables)/d(y,
+        y'_states) as a dense array: the rows the initialisation adds for
+        fixed starts (generated with the other callbacks, non-zeros only)."""
+        n, ns = len(self.dae.y), self.dae.n_states
+        n_fixed = sum(1 for name in self.var_names if self.flat.variables[name].start.fixed)
+        npar = len(self.param_syms)
+        fill = self._fixjac
+
+        def fixed_jac(t, *args):
+            F = np.zeros((n_fixed, n + ns))
+            fill(t, args[:n], args[n:2 * n], args[2 * n:2 * n + npar], args[2 * n + npar:], F)
+            return F
+        return fixed_jac
 
     def state_slot_of(self, name):
         """(slot, sign) when variable ``name`` is ±(one state slot), else None."""
