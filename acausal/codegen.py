@@ -22,7 +22,8 @@ _counter = [0]
 
 class _Printer(PythonCodePrinter):
     def __init__(self):
-        super().__init__({"fully_qualified_modules": False, "standard": "python3"})
+        super().__init__({"fully_qualified_modules": False, "standard": "python3",
+                          "order": "none"})
 
     def _print_Heaviside(self, expr):
         return f"heaviside({self._print(expr.args[0])})"

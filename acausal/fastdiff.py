@@ -4,9 +4,10 @@
 an expression, and each new node queries sympy's assumption system; on the
 polynomial-like residuals of mechanisms that is most of the cost of a
 Jacobian. :func:`diff` applies the sum, product and power rules directly to
-``Add``, ``Mul`` and ``Pow`` nodes (and skips sub-trees free of the
-variable), and hands every other node (functions, ``Piecewise``, ``Abs``...)
-to ``sympy.diff``, so the result is the same derivative.
+``Add``, ``Mul``, ``Pow``, ``Piecewise`` (piece by piece) and one-argument
+functions (chain rule with the function's own ``fdiff``), skips sub-trees
+free of the variable, and hands every other node (``Abs``, ``Max``...) to
+``sympy.diff``, so the result is the same derivative.
 """
 import sympy as sp
 
@@ -29,4 +30,15 @@ def diff(expr, x):
     if expr.is_Pow and not expr.exp.has(x):
         base, p = expr.args
         return p * base ** (p - 1) * diff(base, x)
+    if isinstance(expr, sp.Piecewise) and not any(c.has(x) for _, c in expr.args):
+        # the conditions are those of an evaluated Piecewise already: keep them
+        pieces = [(diff(e, x), c) for e, c in expr.args]
+        if all(d == 0 for d, _ in pieces):
+            return sp.S.Zero
+        return sp.Piecewise(*pieces, evaluate=False)
+    if (isinstance(expr, sp.Function) and len(expr.args) == 1
+            and type(expr)._eval_derivative is sp.Function._eval_derivative):
+        # chain rule, as Function._eval_derivative (not for Abs & co., which
+        # define their own derivative)
+        return expr.fdiff(1) * diff(expr.args[0], x)
     return sp.diff(expr, x)
