@@ -21,9 +21,39 @@ _counter = [0]
 
 
 class _Printer(PythonCodePrinter):
-    def __init__(self):
+    """Python code of sympy expressions in which every sub-expression that
+    has a name in ``temps`` (common sub-expressions, see :func:`_cse_print`)
+    is written as that name, without rebuilding any expression."""
+
+    def __init__(self, temps=None, symbols=None):
         super().__init__({"fully_qualified_modules": False, "standard": "python3",
                           "order": "none"})
+        self.temps = temps or {}
+        self.symbols = symbols or {}
+        self._root = None
+        self._not_supported, self._number_symbols = set(), set()
+
+    def code(self, expr):
+        """Code of ``expr`` (``doprint`` without its walk of the whole tree
+        for ``UnevaluatedExpr``, which the compiler never creates)."""
+        return self._print(expr)
+
+    def _print_Symbol(self, expr):
+        name = self.symbols.get(expr)
+        return name if name is not None else super()._print_Symbol(expr)
+
+    def _print(self, expr, **kw):
+        if self.temps and expr is not self._root:
+            name = self.temps.get(expr)
+            if name is not None:
+                return name
+        self._root = None
+        return super()._print(expr, **kw)
+
+    def definition(self, expr):
+        """Code of ``expr`` itself (not its own name), its parts by name."""
+        self._root = expr
+        return self._print(expr)
 
     def _print_Heaviside(self, expr):
         return f"heaviside({self._print(expr.args[0])})"
@@ -60,6 +90,20 @@ class Names:
         from .symbols import time
         self.map[time] = _real("t")
         self.allowed = set(self.map.values())
+        self.code = {s: v.name for s, v in self.map.items()}
+
+    def check(self, exprs, what):
+        """``exprs`` as sympy expressions, checked to use only the DAE's
+        symbols (printed with :attr:`code`, not renamed: no rebuilding)."""
+        out = []
+        for e in exprs:
+            e = sp.sympify(e)
+            bad = [s for s in e.free_symbols if s not in self.map]
+            if bad:
+                raise ValueError(f"internal: {what} refers to {bad[0]} which is not "
+                                 "a state, algebraic unknown, parameter or discrete value")
+            out.append(e)
+        return out
 
     def rename(self, exprs, what):
         out = []
@@ -73,18 +117,61 @@ class Names:
         return out
 
 
-def _body(exprs, targets, indent="        "):
+def _body(exprs, targets, indent="        ", symbols=None):
     """Lines computing ``targets[i] = exprs[i]`` with common sub-expressions."""
-    reps, printed = _cse_print(exprs, indent)
+    reps, printed = _cse_print(exprs, indent, symbols=symbols)
     return reps + [f"{indent}{t} = {e}" for t, e in zip(targets, printed)]
 
 
-def _cse_print(exprs, indent="        ", prefix="c_"):
-    """(lines of the common sub-expressions, printed reduced expressions)."""
-    printer = _Printer()
-    reps, reduced = sp.cse(exprs, symbols=sp.numbered_symbols(prefix), order="none")
-    lines = [f"{indent}{printer.doprint(v)} = {printer.doprint(e)}" for v, e in reps]
-    return lines, [printer.doprint(e) for e in reduced]
+def _cse_print(exprs, indent="        ", prefix="c_", symbols=None):
+    """(lines of the common sub-expressions, printed expressions).
+
+    Common sub-expression elimination by hash-consing (as sympy's
+    ``tree_cse``, without its rebuilding of every expression and its search
+    for common sub-sums and sub-products, which dominated compile time on
+    large models): every non-atomic sub-expression met twice gets a name,
+    defined after the names it uses; work linear in the size of the
+    expressions."""
+    repeated = _repeated(exprs)
+    names = {e: f"{prefix}{k}" for k, e in enumerate(repeated)}
+    printer = _Printer(names, symbols)
+    lines = [f"{indent}{names[e]} = {printer.definition(e)}" for e in repeated]
+    return lines, [printer.code(e) for e in exprs]
+
+
+def _shareable(e):
+    return isinstance(e, sp.Expr) and not e.is_Atom and bool(e.args)
+
+
+def _repeated(exprs):
+    """Sub-expressions met more than once, each after the ones inside it."""
+    seen, repeated = set(), set()
+
+    def visit(e):
+        if not isinstance(e, sp.Basic) or e.is_Atom:
+            return
+        if e in seen:
+            if _shareable(e):
+                repeated.add(e)
+            return
+        seen.add(e)
+        for a in e.args:
+            visit(a)
+    for e in exprs:
+        visit(e)
+    order, done = [], set()
+
+    def post(e):
+        if not isinstance(e, sp.Basic) or e.is_Atom or e in done:
+            return
+        done.add(e)
+        for a in e.args:
+            post(a)
+        if e in repeated:
+            order.append(e)
+    for e in exprs:
+        post(e)
+    return order
 
 
 def _unpack(prefix, n, src, indent="        ", array=True):
@@ -185,8 +272,8 @@ def generate(dae, params, discretes, roots, observed, fixed_rows=()):
     n = len(dae.y)
     names = Names(dae.y, dae.yp, params, discretes)
     res = names.rename(dae.residuals, "a residual")
-    g = names.rename(roots, "an event")
-    obs = names.rename(observed, "an observed variable")
+    g = names.check(roots, "an event")
+    obs = names.check(observed, "an observed variable")
     ysyms = [_real(f"y{i}") for i in range(n)]
     ypsyms = [_real(f"yp{i}") if dae.yp[i] is not None else None for i in range(n)]
     cj = sp.Symbol("cj")
@@ -196,8 +283,9 @@ def generate(dae, params, discretes, roots, observed, fixed_rows=()):
     jyp = [(i, j, dyp) for i, j, _, dyp in entries if dyp != 0]
     jcomb = [(i, j, dy + cj * dyp) for i, j, dy, dyp in entries]
     csc_pos = {(i, j): k for k, (i, j) in enumerate(zip(sparsity.rows, sparsity.cols))}
-    fixed = _fixed_entries(obs, fixed_rows, ysyms, ypsyms,
-                           dae.n_states)
+    fixed = _fixed_entries(dict(zip(fixed_rows, names.rename([obs[k] for k in fixed_rows],
+                                                             "a fixed start"))),
+                           fixed_rows, ysyms, ypsyms, dae.n_states)
     npar, nd = len(params), len(discretes)
     unpack = _unpack("y", n, "y") + _unpack("yp", n, "yp")
     L = ["def make(p, d):"]
@@ -215,14 +303,14 @@ def generate(dae, params, discretes, roots, observed, fixed_rows=()):
     L += [f"        J[{csc_pos[i, j]}] = {e}" for (i, j, _), e in zip(jcomb, jprinted)]
     L += ["        pass"]
     L += ["    def roots(t, y, yp, g):"] + unpack
-    L += _body(g, [f"g[{i}]" for i in range(len(g))]) or ["        pass"]
+    L += _body(g, [f"g[{i}]" for i in range(len(g))], symbols=names.code) or ["        pass"]
     L += ["    def jacs(t, y, yp, Jy, Jyp):"] + unpack
     L += _body([e for _, _, e in jy] + [e for _, _, e in jyp],
                [f"Jy[{i}, {j}]" for i, j, _ in jy] + [f"Jyp[{i}, {j}]" for i, j, _ in jyp]) \
         or ["        pass"]
     L += ["    def observe(t, y, yp):"] + unpack
     L += ["        o = [0.0] * %d" % len(obs)]
-    L += _body(obs, [f"o[{i}]" for i in range(len(obs))])
+    L += _body(obs, [f"o[{i}]" for i in range(len(obs))], symbols=names.code)
     L += ["        return o"]
     L += ["    return res, jac, roots, jacs, observe, count, jac_csc"]
     L += ["def fixjac(t, y, yp, p, d, F):"]

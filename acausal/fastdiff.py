@@ -4,8 +4,8 @@
 an expression, and each new node queries sympy's assumption system; on the
 polynomial-like residuals of mechanisms that is most of the cost of a
 Jacobian. :func:`diff` applies the sum, product and power rules directly to
-``Add``, ``Mul``, ``Pow``, ``Piecewise`` (piece by piece) and one-argument
-functions (chain rule with the function's own ``fdiff``), skips sub-trees
+``Add``, ``Mul``, ``Pow``, ``Piecewise`` (piece by piece) and functions
+(chain rule with the function's own ``fdiff``), skips sub-trees
 free of the variable, and hands every other node (``Abs``, ``Max``...) to
 ``sympy.diff``, so the result is the same derivative.
 """
@@ -36,9 +36,13 @@ def diff(expr, x):
         if all(d == 0 for d, _ in pieces):
             return sp.S.Zero
         return sp.Piecewise(*pieces, evaluate=False)
-    if (isinstance(expr, sp.Function) and len(expr.args) == 1
+    if (isinstance(expr, sp.Function)
             and type(expr)._eval_derivative is sp.Function._eval_derivative):
         # chain rule, as Function._eval_derivative (not for Abs & co., which
         # define their own derivative)
-        return expr.fdiff(1) * diff(expr.args[0], x)
+        try:
+            return sp.Add(*[expr.fdiff(k + 1) * diff(a, x)
+                            for k, a in enumerate(expr.args) if a.has(x)])
+        except sp.ArgumentIndexError:
+            pass
     return sp.diff(expr, x)
