@@ -126,8 +126,10 @@ class CompiledModel:
         e = e.xreplace(self._alias)
         if self.dae.explicit:
             e = e.xreplace(self.dae.explicit)
-        known = set(self.dae.y) | {s for s in self.dae.yp if s is not None} | \
-            set(self.param_syms) | set(self.disc_syms) | {time}
+        known = self.__dict__.get("_known")
+        if known is None:
+            known = self._known = set(self.dae.y) | {s for s in self.dae.yp if s is not None} \
+                | set(self.param_syms) | set(self.disc_syms) | {time}
         bad = [s for s in e.free_symbols if s not in known]
         if bad:
             raise ModelError(f"{expr} cannot be evaluated: {bad[0].name} is not available "
@@ -218,7 +220,10 @@ class CompiledModel:
             sign = 1.0
             if isinstance(e, sp.Mul) and len(e.args) == 2 and e.args[0] == -1:
                 sign, e = -1.0, e.args[1]
-            slots = {s: i for i, s in enumerate(self.dae.y[:self.dae.n_states])}
+            slots = self.__dict__.get("_state_slots")
+            if slots is None:
+                slots = self._state_slots = {s: i for i, s in
+                                             enumerate(self.dae.y[:self.dae.n_states])}
             cache[name] = (slots[e], sign) if e in slots else None
         return cache[name]
 
