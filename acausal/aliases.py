@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from .errors import ModelError, StructuralError
+from .fastdiff import diff
 from .symbols import base_and_order, der, is_der, time
 
 
@@ -104,7 +105,7 @@ def _alias_form(expr, unknowns):
     coeffs = []
     rest = expr
     for s in syms:
-        c = sp.diff(expr, s)
+        c = diff(expr, s)
         if c not in (1, -1):
             return None
         coeffs.append(c)

@@ -17,6 +17,7 @@ from scipy.sparse.csgraph import connected_components, maximum_bipartite_matchin
 import sympy as sp
 
 from .errors import StructuralError
+from .fastdiff import diff
 
 
 @dataclass
@@ -123,7 +124,7 @@ def _numeric(expr, values):
 def _solve_linear(expr, u, params, values=None):
     """u = -rest/coeff when expr is linear in u with a coefficient made of
     numbers and parameters only (never zero in a valid model)."""
-    coeff = sp.diff(expr, u)
+    coeff = diff(expr, u)
     if coeff == 0 or coeff.has(u) or not _safe_coefficient(coeff, params):
         return None
     if not coeff.free_symbols <= params:

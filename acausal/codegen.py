@@ -9,20 +9,58 @@ for one parameter vector and one set of discrete values.
 """
 import linecache
 import math
+from dataclasses import dataclass
 
 import numpy as np
 import sympy as sp
 from sympy.printing.pycode import PythonCodePrinter
 
+from .fastdiff import diff
+
 _counter = [0]
 
 
 class _Printer(PythonCodePrinter):
-    def __init__(self):
-        super().__init__({"fully_qualified_modules": False, "standard": "python3"})
+    """Python code of sympy expressions in which every sub-expression that
+    has a name in ``temps`` (common sub-expressions, see :func:`_cse_print`)
+    is written as that name, without rebuilding any expression."""
+
+    def __init__(self, temps=None, symbols=None):
+        super().__init__({"fully_qualified_modules": False, "standard": "python3",
+                          "order": "none"})
+        self.temps = temps or {}
+        self.symbols = symbols or {}
+        self._root = None
+        self._not_supported, self._number_symbols = set(), set()
+
+    def code(self, expr):
+        """Code of ``expr`` (``doprint`` without its walk of the whole tree
+        for ``UnevaluatedExpr``, which the compiler never creates)."""
+        return self._print(expr)
+
+    def _print_Symbol(self, expr):
+        name = self.symbols.get(expr)
+        return name if name is not None else super()._print_Symbol(expr)
+
+    def _print(self, expr, **kw):
+        if self.temps and expr is not self._root:
+            name = self.temps.get(expr)
+            if name is not None:
+                return name
+        self._root = None
+        return super()._print(expr, **kw)
+
+    def definition(self, expr):
+        """Code of ``expr`` itself (not its own name), its parts by name."""
+        self._root = expr
+        return self._print(expr)
 
     def _print_Heaviside(self, expr):
         return f"heaviside({self._print(expr.args[0])})"
+
+
+def _real(name):
+    return sp.Symbol(name, real=True)
 
 
 def _namespace():
@@ -33,22 +71,39 @@ def _namespace():
 
 
 class Names:
-    """Maps symbols to the names used in generated code."""
+    """Maps symbols to the names used in generated code. The new symbols are
+    real (every quantity is): derivatives are then taken over real
+    symbols, so that d|x|/dx is sign(x), not an expression of re(x), im(x)
+    the printer cannot write."""
 
     def __init__(self, y, yp, params, discretes):
         self.map = {}
         for i, s in enumerate(y):
-            self.map[s] = sp.Symbol(f"y{i}")
+            self.map[s] = _real(f"y{i}")
         for i, s in enumerate(yp):
             if s is not None:
-                self.map[s] = sp.Symbol(f"yp{i}")
+                self.map[s] = _real(f"yp{i}")
         for i, s in enumerate(params):
-            self.map[s] = sp.Symbol(f"p{i}")
+            self.map[s] = _real(f"p{i}")
         for i, s in enumerate(discretes):
-            self.map[s] = sp.Symbol(f"d{i}")
+            self.map[s] = _real(f"d{i}")
         from .symbols import time
-        self.map[time] = sp.Symbol("t")
+        self.map[time] = _real("t")
         self.allowed = set(self.map.values())
+        self.code = {s: v.name for s, v in self.map.items()}
+
+    def check(self, exprs, what):
+        """``exprs`` as sympy expressions, checked to use only the DAE's
+        symbols (printed with :attr:`code`, not renamed: no rebuilding)."""
+        out = []
+        for e in exprs:
+            e = sp.sympify(e)
+            bad = [s for s in e.free_symbols if s not in self.map]
+            if bad:
+                raise ValueError(f"internal: {what} refers to {bad[0]} which is not "
+                                 "a state, algebraic unknown, parameter or discrete value")
+            out.append(e)
+        return out
 
     def rename(self, exprs, what):
         out = []
@@ -63,13 +118,61 @@ class Names:
         return out
 
 
-def _body(exprs, targets, indent="        "):
+def _body(exprs, targets, indent="        ", symbols=None):
     """Lines computing ``targets[i] = exprs[i]`` with common sub-expressions."""
-    printer = _Printer()
-    reps, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("c_"), order="none")
-    lines = [f"{indent}{printer.doprint(v)} = {printer.doprint(e)}" for v, e in reps]
-    lines += [f"{indent}{t} = {printer.doprint(e)}" for t, e in zip(targets, reduced)]
-    return lines
+    reps, printed = _cse_print(exprs, indent, symbols=symbols)
+    return reps + [f"{indent}{t} = {e}" for t, e in zip(targets, printed)]
+
+
+def _cse_print(exprs, indent="        ", prefix="c_", symbols=None):
+    """(lines of the common sub-expressions, printed expressions).
+
+    Common sub-expression elimination by hash-consing (as sympy's
+    ``tree_cse``, without its rebuilding of every expression and its search
+    for common sub-sums and sub-products, which dominated compile time on
+    large models): every non-atomic sub-expression met twice gets a name,
+    defined after the names it uses; work linear in the size of the
+    expressions."""
+    repeated = _repeated(exprs)
+    names = {e: f"{prefix}{k}" for k, e in enumerate(repeated)}
+    printer = _Printer(names, symbols)
+    lines = [f"{indent}{names[e]} = {printer.definition(e)}" for e in repeated]
+    return lines, [printer.code(e) for e in exprs]
+
+
+def _shareable(e):
+    return isinstance(e, sp.Expr) and not e.is_Atom and bool(e.args)
+
+
+def _repeated(exprs):
+    """Sub-expressions met more than once, each after the ones inside it."""
+    seen, repeated = set(), set()
+
+    def visit(e):
+        if not isinstance(e, sp.Basic) or e.is_Atom:
+            return
+        if e in seen:
+            if _shareable(e):
+                repeated.add(e)
+            return
+        seen.add(e)
+        for a in e.args:
+            visit(a)
+    for e in exprs:
+        visit(e)
+    order, done = [], set()
+
+    def post(e):
+        if not isinstance(e, sp.Basic) or e.is_Atom or e in done:
+            return
+        done.add(e)
+        for a in e.args:
+            post(a)
+        if e in repeated:
+            order.append(e)
+    for e in exprs:
+        post(e)
+    return order
 
 
 def _unpack(prefix, n, src, indent="        ", array=True):
@@ -79,67 +182,154 @@ def _unpack(prefix, n, src, indent="        ", array=True):
     return [f"{indent}{names}, = {src}{'.tolist()' if array else ''}"]
 
 
-def generate(dae, params, discretes, roots, observed):
-    """Return (source, namespace-populated functions).
+@dataclass
+class Sparsity:
+    """Structure of the iteration matrix ``J = dF/dy + cj dF/dy'``: its
+    non-zero entries (``rows``, ``cols``, in compressed-sparse-column order,
+    the order of the flat array a sparse solver fills) and its lower and
+    upper bandwidths."""
+    n: int
+    rows: list
+    cols: list
+    lband: int
+    uband: int
+
+    @property
+    def nnz(self):
+        return len(self.rows)
+
+    def matrix(self):
+        """The pattern as a ``scipy.sparse.csc_matrix`` of ones."""
+        import scipy.sparse as sps
+        return sps.csc_matrix((np.ones(self.nnz), (self.rows, self.cols)),
+                              shape=(self.n, self.n))
+
+
+def _jacobian_entries(res, ysyms, ypsyms):
+    """Non-zero entries (i, j, dF_i/dy_j, dF_i/dy'_j) of the residuals'
+    Jacobians, by differentiating each residual only with respect to the
+    unknowns it contains (work linear in the number of non-zeros)."""
+    index = {s: ("y", j) for j, s in enumerate(ysyms)}
+    index.update({s: ("yp", j) for j, s in enumerate(ypsyms) if s is not None})
+    out = []
+    for i, r in enumerate(res):
+        cols = {}
+        for s in r.free_symbols:
+            hit = index.get(s)
+            if hit is not None:
+                cols.setdefault(hit[1], {})[hit[0]] = diff(r, s)
+        for j in sorted(cols):
+            dy = cols[j].get("y", sp.S.Zero)
+            dyp = cols[j].get("yp", sp.S.Zero)
+            if dy != 0 or dyp != 0:
+                out.append((i, j, dy, dyp))
+    return out
+
+
+def _sparsity(n, entries):
+    csc = sorted(((j, i) for i, j, _, _ in entries))
+    rows = [i for _, i in csc]
+    cols = [j for j, _ in csc]
+    lband = max([i - j for i, j in zip(rows, cols)] + [0])
+    uband = max([j - i for i, j in zip(rows, cols)] + [0])
+    return Sparsity(n, rows, cols, lband, uband)
+
+
+def _fixed_entries(obs, fixed_rows, ysyms, ypsyms, ns):
+    """Non-zero entries (a, k, expr) of d(observed[fixed_rows[a]])/dz with
+    z = (y, y' of the states): the rows initialisation adds for fixed starts."""
+    zs = list(ysyms) + list(ypsyms[:ns])
+    index = {s: k for k, s in enumerate(zs) if s is not None}
+    out = []
+    for a, k in enumerate(fixed_rows):
+        e = obs[k]
+        hits = sorted((index[s], s) for s in e.free_symbols if s in index)
+        for col, s in hits:
+            d = diff(e, s)
+            if d != 0:
+                out.append((a, col, d))
+    return out
+
+
+@dataclass
+class Generated:
+    """What :func:`generate` returns: the source, ``make(p, d)`` (the
+    callbacks for one parameter vector and set of discrete values),
+    ``fixjac(t, y, yp, p, d, F)`` (fills the fixed-start rows ``F``) and the
+    iteration matrix's :class:`Sparsity`."""
+    source: str
+    make: object
+    fixjac: object
+    sparsity: Sparsity
+
+
+def generate(dae, params, discretes, roots, observed, fixed_rows=()):
+    """Generate and compile the callbacks (see :class:`Generated`).
 
     ``roots``: list of root expressions (resolved); ``observed``: list of
-    expressions (resolved) for every reported variable.
+    expressions (resolved) for every reported variable; ``fixed_rows``:
+    indices into ``observed`` of the variables with fixed start values.
     """
     n = len(dae.y)
     names = Names(dae.y, dae.yp, params, discretes)
     res = names.rename(dae.residuals, "a residual")
-    g = names.rename(roots, "an event")
-    obs = names.rename(observed, "an observed variable")
-    # differentiate over real symbols (every quantity is real): d|x|/dx is
-    # then sign(x), not an expression of re(x), im(x) the printer cannot write
-    real = {s: sp.Symbol(s.name, real=True) for s in names.allowed}
-    res = [r.xreplace(real) for r in res]
-    ysyms = [real.get(sp.Symbol(f"y{i}"), sp.Symbol(f"y{i}")) for i in range(n)]
-    ypsyms = [real.get(sp.Symbol(f"yp{i}"), sp.Symbol(f"yp{i}")) if dae.yp[i] is not None
-              else None for i in range(n)]
+    g = names.check(roots, "an event")
+    obs = names.check(observed, "an observed variable")
+    ysyms = [_real(f"y{i}") for i in range(n)]
+    ypsyms = [_real(f"yp{i}") if dae.yp[i] is not None else None for i in range(n)]
     cj = sp.Symbol("cj")
-    jy, jyp, jcomb = [], [], []
-    for i, r in enumerate(res):
-        fs = r.free_symbols
-        for j in range(n):
-            dy = sp.diff(r, ysyms[j]) if ysyms[j] in fs else sp.Integer(0)
-            dyp = sp.diff(r, ypsyms[j]) if ypsyms[j] is not None and ypsyms[j] in fs \
-                else sp.Integer(0)
-            if dy != 0:
-                jy.append((i, j, dy))
-            if dyp != 0:
-                jyp.append((i, j, dyp))
-            if dy != 0 or dyp != 0:
-                jcomb.append((i, j, dy + cj * dyp))
+    entries = _jacobian_entries(res, ysyms, ypsyms)
+    sparsity = _sparsity(n, entries)
+    jy = [(i, j, dy) for i, j, dy, _ in entries if dy != 0]
+    jyp = [(i, j, dyp) for i, j, _, dyp in entries if dyp != 0]
+    jcomb = [(i, j, dy + cj * dyp) for i, j, dy, dyp in entries]
+    csc_pos = {(i, j): k for k, (i, j) in enumerate(zip(sparsity.rows, sparsity.cols))}
+    fixed = _fixed_entries(dict(zip(fixed_rows, names.rename([obs[k] for k in fixed_rows],
+                                                             "a fixed start"))),
+                           fixed_rows, ysyms, ypsyms, dae.n_states)
     npar, nd = len(params), len(discretes)
+    unpack = _unpack("y", n, "y") + _unpack("yp", n, "yp")
     L = ["def make(p, d):"]
     L += _unpack("p", npar, "p", "    ", False) + _unpack("d", nd, "d", "    ", False)
     L += ["    count = [0, None]  # step attempts: distinct times the residual sees"]
     L += ["    def res(t, y, yp, r):"]
     L += ["        if t != count[1]:", "            count[0] += 1", "            count[1] = t"]
-    L += _unpack("y", n, "y") + _unpack("yp", n, "yp")
+    L += unpack
     L += _body(res, [f"r[{i}]" for i in range(n)])
-    L += ["    def jac(t, y, yp, r, cj, J):"]
-    L += _unpack("y", n, "y") + _unpack("yp", n, "yp")
-    L += _body([e for _, _, e in jcomb], [f"J[{i}, {j}]" for i, j, _ in jcomb]) or ["        pass"]
-    L += ["    def roots(t, y, yp, g):"]
-    L += _unpack("y", n, "y") + _unpack("yp", n, "yp")
-    L += _body(g, [f"g[{i}]" for i in range(len(g))]) or ["        pass"]
-    L += ["    def jacs(t, y, yp, Jy, Jyp):"]
-    L += _unpack("y", n, "y") + _unpack("yp", n, "yp")
+    reps, jprinted = _cse_print([e for _, _, e in jcomb])
+    L += ["    def jac(t, y, yp, r, cj, J):"] + unpack + reps
+    L += [f"        J[{i}, {j}] = {e}" for (i, j, _), e in zip(jcomb, jprinted)]
+    L += ["        pass"]
+    L += ["    def jac_csc(t, y, yp, r, cj, J):"] + unpack + reps
+    L += [f"        J[{csc_pos[i, j]}] = {e}" for (i, j, _), e in zip(jcomb, jprinted)]
+    L += ["        pass"]
+    L += ["    def roots(t, y, yp, g):"] + unpack
+    L += _body(g, [f"g[{i}]" for i in range(len(g))], symbols=names.code) or ["        pass"]
+    L += ["    def jacs(t, y, yp, Jy, Jyp):"] + unpack
     L += _body([e for _, _, e in jy] + [e for _, _, e in jyp],
                [f"Jy[{i}, {j}]" for i, j, _ in jy] + [f"Jyp[{i}, {j}]" for i, j, _ in jyp]) \
         or ["        pass"]
-    L += ["    def observe(t, y, yp):"]
-    L += _unpack("y", n, "y") + _unpack("yp", n, "yp")
+    L += ["    def observe(t, y, yp):"] + unpack
     L += ["        o = [0.0] * %d" % len(obs)]
-    L += _body(obs, [f"o[{i}]" for i in range(len(obs))])
+    L += _body(obs, [f"o[{i}]" for i in range(len(obs))], symbols=names.code)
     L += ["        return o"]
-    L += ["    return res, jac, roots, jacs, observe, count"]
+    L += ["    return res, jac, roots, jacs, observe, count, jac_csc"]
+    L += ["def fixjac(t, y, yp, p, d, F):"]
+    L += _unpack("p", npar, "p", "    ", False) + _unpack("d", nd, "d", "    ", False)
+    L += _unpack("y", n, "y", "    ", False) + _unpack("yp", n, "yp", "    ", False)
+    L += _body([e for _, _, e in fixed], [f"F[{a}, {k}]" for a, k, _ in fixed], "    ")
+    L += ["    pass"]
     src = "\n".join(L) + "\n"
+    make, fixjac = load(src)
+    return Generated(src, make, fixjac, sparsity)
+
+
+def load(src):
+    """Compile generated source; returns its (make, fixjac). Used again when
+    a compiled model is read back from the cache."""
     _counter[0] += 1
     fname = f"<acausal-generated-{_counter[0]}>"
     linecache.cache[fname] = (len(src), None, src.splitlines(True), fname)
     ns = _namespace()
     exec(compile(src, fname, "exec"), ns)
-    return src, ns["make"]
+    return ns["make"], ns["fixjac"]

@@ -11,7 +11,8 @@ import sympy as sp
 
 from .aliases import eliminate_aliases
 from .causalize import build_dae
-from .codegen import generate
+from . import cache as _cache
+from .codegen import generate, load as load_generated
 from .declare import Start
 from .errors import ModelError, ParameterError
 from .flatten import flatten
@@ -29,15 +30,28 @@ class ParamEntry:
     owner: str
 
 
+BAND_MIN_SIZE = 40        # unknowns from which a narrow band beats the dense solver
+BAND_MAX_FRACTION = 0.25  # a band at most this fraction of n wide counts as narrow
+
+
+@dataclass
+class LinearSolver:
+    """IDA's linear solver for a model: its ``kind``, the keyword ``options``
+    for ``sksundae.ida.IDA`` and ``jac_index``, the position in
+    :meth:`CompiledModel.callbacks` of the Jacobian callback that fills the
+    storage this solver uses (1: 2-D array, 6: CSC array)."""
+    kind: str
+    options: dict
+    jac_index: int
+
+
 class CompiledModel:
     """A model turned into solver callbacks. Use :meth:`simulate`."""
 
-    def __init__(self, model):
+    def __init__(self, model, cache=True):
         t0 = _time.perf_counter()
         self.model = model
         flat = self.flat = flatten(model)
-        red = self.reduced = eliminate_aliases(flat)
-        check_structure(red.equations, red.unknowns, flat)
         self.params = [ParamEntry(i.symbol.name, float(i.value), i.decl.unit, i.decl.desc,
                                   i.decl, i.owner)
                        for i in flat.params.values()
@@ -49,6 +63,34 @@ class CompiledModel:
         self.param_syms = [sp.Symbol(p.name) for p in self.params]
         self.discretes = list(flat.discretes.values())
         self.disc_syms = [d.symbol for d in self.discretes]
+        self.var_names = list(flat.variables)
+        self.events = list(flat.events)
+        self.assertions = list(flat.assertions)
+        self.stop_events = []
+        self.n_roots = len(self.events) + len(self.assertions)
+        self._start_fns = {}
+        key = _cache.model_key(flat) if cache and _cache.cache_dir() is not None else None
+        entry = _cache.load(key) if key is not None else None
+        self.cache_hit = entry is not None
+        if entry is None:
+            entry, make, fixjac = self._compile(flat, key)
+            if key is not None:
+                _cache.store(entry)
+        else:
+            make, fixjac = load_generated(entry.source)
+        self.reduced, self.graph, self.dae = entry.reduced, entry.graph, entry.dae
+        self._root_starts = entry.root_starts
+        self._subs = dict(self.reduced.param_subs)
+        self._alias = self.reduced.subs
+        self.source, self._make, self._fixjac = entry.source, make, fixjac
+        self.sparsity = entry.sparsity
+        self.compile_s = _time.perf_counter() - t0
+
+    def _compile(self, flat, key):
+        """The compile stages after flattening: an :class:`acausal.cache.Entry`
+        and the compiled ``make`` and ``fixjac``."""
+        red = self.reduced = eliminate_aliases(flat)
+        check_structure(red.equations, red.unknowns, flat)
         g = self.graph = Graph(red.equations, red.unknowns)
         pantelides(g)
         self._root_starts, self._root_via = _alias_starts(flat, red)
@@ -60,19 +102,16 @@ class CompiledModel:
         if not self.dae.y:
             raise ModelError(_nothing_to_integrate(flat))
         self._subs = dict(red.param_subs)
-        self._start_fns = {}
         self._alias = red.subs
-        self.var_names = list(flat.variables)
         observed = [self.resolve(flat.variables[n].symbol) for n in self.var_names]
-        self.events = list(flat.events)
-        self.assertions = list(flat.assertions)
-        self.stop_events = []
         roots = [self.resolve(e.expr) for e in self.events] + \
                 [self.resolve(a.expr) for a in self.assertions]
-        self.source, self._make = generate(self.dae, self.param_syms, self.disc_syms,
-                                           roots, observed)
-        self.n_roots = len(roots)
-        self.compile_s = _time.perf_counter() - t0
+        fixed_rows = [k for k, n in enumerate(self.var_names)
+                      if flat.variables[n].start.fixed]
+        gen = generate(self.dae, self.param_syms, self.disc_syms, roots, observed, fixed_rows)
+        entry = _cache.Entry(key, red, g, self._root_starts, self.dae, gen.source,
+                             gen.sparsity)
+        return entry, gen.make, gen.fixjac
 
     # -- symbol resolution -------------------------------------------------
     def resolve(self, expr):
@@ -84,8 +123,10 @@ class CompiledModel:
         e = e.xreplace(self._alias)
         if self.dae.explicit:
             e = e.xreplace(self.dae.explicit)
-        known = set(self.dae.y) | {s for s in self.dae.yp if s is not None} | \
-            set(self.param_syms) | set(self.disc_syms) | {time}
+        known = self.__dict__.get("_known")
+        if known is None:
+            known = self._known = set(self.dae.y) | {s for s in self.dae.yp if s is not None} \
+                | set(self.param_syms) | set(self.disc_syms) | {time}
         bad = [s for s in e.free_symbols if s not in known]
         if bad:
             raise ModelError(f"{expr} cannot be evaluated: {bad[0].name} is not available "
@@ -185,24 +226,19 @@ class CompiledModel:
         return float(value)
 
     def fixed_jacobian(self):
-        """A function (y, yp) -> d(fixed-start variables)/d(y, y'_states),
-        generated once: the rows the initialisation adds for fixed starts."""
-        fn = getattr(self, "_fixed_jac", None)
-        if fn is None:
-            ns = self.dae.n_states
-            zs = list(self.dae.y) + [s for s in self.dae.yp[:ns]]
-            rows = []
-            for name in self.var_names:
-                if self.flat.variables[name].start.fixed:
-                    e = self.resolve(sp.Symbol(name))
-                    rows.append([sp.diff(e, z) for z in zs])
-            ysyms = list(self.dae.y)
-            ypsyms = [s if s is not None else sp.Dummy() for s in self.dae.yp]
-            args = [time] + ysyms + ypsyms + self.param_syms + self.disc_syms
-            fn = sp.lambdify(args, sp.Matrix(rows) if rows else sp.zeros(0, len(zs)),
-                             "numpy")
-            self._fixed_jac = fn
-        return fn
+        """A function ``(t, *y, *yp, *p, *d)`` -> d(fixed-start variables)/d(y,
+        y'_states) as a dense array: the rows the initialisation adds for
+        fixed starts (generated with the other callbacks, non-zeros only)."""
+        n, ns = len(self.dae.y), self.dae.n_states
+        n_fixed = sum(1 for name in self.var_names if self.flat.variables[name].start.fixed)
+        npar = len(self.param_syms)
+        fill = self._fixjac
+
+        def fixed_jac(t, *args):
+            F = np.zeros((n_fixed, n + ns))
+            fill(t, args[:n], args[n:2 * n], args[2 * n:2 * n + npar], args[2 * n + npar:], F)
+            return F
+        return fixed_jac
 
     def state_slot_of(self, name):
         """(slot, sign) when variable ``name`` is ±(one state slot), else None."""
@@ -212,7 +248,10 @@ class CompiledModel:
             sign = 1.0
             if isinstance(e, sp.Mul) and len(e.args) == 2 and e.args[0] == -1:
                 sign, e = -1.0, e.args[1]
-            slots = {s: i for i, s in enumerate(self.dae.y[:self.dae.n_states])}
+            slots = self.__dict__.get("_state_slots")
+            if slots is None:
+                slots = self._state_slots = {s: i for i, s in
+                                             enumerate(self.dae.y[:self.dae.n_states])}
             cache[name] = (slots[e], sign) if e in slots else None
         return cache[name]
 
@@ -287,11 +326,44 @@ class CompiledModel:
         return [float(d.start.value) for d in self.discretes]
 
     def callbacks(self, p, d):
+        """(res, jac, roots, jacs, observe, count, jac_csc) for parameter vector
+        ``p`` and discrete values ``d``: ``jac`` fills a 2-D (dense or band)
+        matrix, ``jac_csc`` the flat compressed-sparse-column array of
+        :attr:`sparsity`."""
         return self._make(list(map(float, p)), list(map(float, d)))
+
+    def linear_solver(self, kind="auto"):
+        """The IDA linear solver for this model's iteration matrix, chosen from
+        its structure (:attr:`sparsity`): a :class:`LinearSolver`.
+
+        ``kind``: ``"dense"``, ``"band"`` (bandwidths from the pattern),
+        ``"sparse"`` (SuperLU_MT on the CSC pattern; the Jacobian callback is
+        then ``callbacks(...)[6]``) or ``"auto"``: dense below
+        :data:`BAND_MIN_SIZE` unknowns or when the band is not narrow, else
+        band."""
+        sp_ = self.sparsity
+        n = sp_.n
+        if kind == "auto":
+            narrow = sp_.lband + sp_.uband + 1 <= BAND_MAX_FRACTION * n
+            kind = "band" if n >= BAND_MIN_SIZE and narrow else "dense"
+        if kind == "dense":
+            return LinearSolver("dense", {}, 1)
+        if kind == "band":
+            return LinearSolver("band", dict(linsolver="band", lband=int(sp_.lband),
+                                             uband=int(sp_.uband)), 1)
+        if kind == "sparse":
+            return LinearSolver("sparse", dict(linsolver="sparse", sparsity=sp_.matrix()), 6)
+        raise ValueError(f"linear solver {kind!r}: choose 'auto', 'dense', 'band' or 'sparse'")
 
     def simulate(self, **kw):
         from .simulate import simulate
         return simulate(self, **kw)
+
+    def simulate_batch(self, param_sets, **kw):
+        """One simulation per parameter set, in parallel worker processes that
+        hold this compiled model: see :func:`acausal.batch.simulate_batch`."""
+        from .batch import simulate_batch
+        return simulate_batch(self, param_sets, **kw)
 
 
 def _alias_starts(flat, red):
@@ -357,6 +429,8 @@ def _is_zero(v):
         return False
 
 
-def compile_model(model):
-    """Compile ``model`` (flatten, reduce, generate)."""
-    return CompiledModel(model)
+def compile_model(model, cache=True):
+    """Compile ``model`` (flatten, reduce, generate). With ``cache`` (and the
+    cache not disabled by ``ACAUSAL_CACHE=off``) the compiled stages are read
+    from / written to the on-disk cache (:mod:`acausal.cache`)."""
+    return CompiledModel(model, cache=cache)

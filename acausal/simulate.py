@@ -154,12 +154,14 @@ class _Run:
         alg = list(range(self.cm.dae.n_states, len(self.cm.dae.y)))
         if alg:
             kw["algebraic_idx"] = alg
+        lin = self.cm.linear_solver(self.linsolver)
+        kw.update(lin.options)
 
         def res(t, y, yp, r):
             self.cb[0](t, y, yp, r)
 
         def jac(t, y, yp, r, cj, J):
-            self.cb[1](t, y, yp, r, cj, J)
+            self.cb[lin.jac_index](t, y, yp, r, cj, J)
         if self.cm.n_roots:
             def roots(t, y, yp, g):
                 self.cb[2](t, y, yp, g)
@@ -183,7 +185,8 @@ class _Run:
 
 def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_step=None,
              output_times=None, max_step=None, max_steps=100000, atol_algebraic=None,
-             max_rows=MAX_ROWS, max_wall=None, max_total_steps=None, progress=False):
+             max_rows=MAX_ROWS, max_wall=None, max_total_steps=None, progress=False,
+             linsolver="auto"):
     """Simulate a :class:`CompiledModel` from ``t0`` to ``t_end`` (or until a
     terminal event). ``params`` overrides parameter values, and the start
     values of variables whose start is fixed, by dotted path (both are
@@ -210,13 +213,18 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
     stderr, shown once a run has lasted 2 s (it does not change the
     solution). With a wall or step limit the time span is integrated in
     windows of about a quarter of a second of wall time each (see
-    :class:`_Watch`)."""
+    :class:`_Watch`).
+
+    ``linsolver``: IDA's linear solver, see
+    :meth:`acausal.compile.CompiledModel.linear_solver` (``"auto"`` chooses
+    band for large models with a narrow band, else dense)."""
     wall0 = _time.perf_counter()
     params, starts = cm.split_overrides(params)
     p = cm.param_vector(params)
     d = cm.discrete_start()
     run = _Run(cm, p, t0, t_end, rtol, _atol_vector(cm, atol, atol_algebraic), max_step,
                max_steps)
+    run.linsolver = linsolver
     cb = cm.callbacks(p, d)
     run.cb_d = list(d)
     y, yp = initial_point(cm, p, d, cb, t0, starts)

@@ -18,6 +18,7 @@ from scipy.sparse.csgraph import maximum_bipartite_matching
 import sympy as sp
 
 from .errors import StructuralError
+from .fastdiff import diff
 from .symbols import base_and_order, der, total_derivative
 
 
@@ -253,7 +254,7 @@ def _select_columns(g, rows, cols, values, prefer_state):
     for a, i in enumerate(rows):
         for b, j in enumerate(cols):
             if j in g.inc[i]:
-                d = sp.diff(g.eexpr[i], g.vsym[j])
+                d = diff(g.eexpr[i], g.vsym[j])
                 try:
                     jac[a, b] = float(d.xreplace(values))
                 except (TypeError, ValueError):

@@ -1,0 +1,104 @@
+"""Compile and simulate times of large models, and how they grow with size.
+
+Two scalable mechanisms: a chain of N masses joined by spring-dampers, one
+end fixed (``benchmarks/chains.py``), and Newton's cradle with N balls
+(``models/examples/newtons_cradle.py``). For each N it prints
+
+* compile: flatten -> ... -> codegen, with the on-disk cache off;
+* cached: the same compile again, read back from the on-disk cache;
+* first: the first simulation (initialisation, IDA set-up);
+* sim: a second simulation of the same compiled model;
+* dense/band: the second simulation with IDA's dense and band linear
+  solvers (chain only; "auto" picks band for large narrow-banded models);
+
+then the growth exponent b of t ~ N^b fitted over N >= 20 (the small sizes
+are dominated by fixed costs). Targets (issue 10): chain N = 100 compile +
+first simulation <= 10 s on 2 cores; Newton's cradle N = 50 runs; compile
+and first simulation grow no faster than N^1.3 up to N = 200.
+
+    python benchmarks/scaling.py [--sizes 5 10 20 50 100 200] [--models chain cradle]
+
+OpenBLAS is limited to one thread (set before numpy loads): on a loaded
+2-core machine its spinning threads made the initialisation's least
+squares 50-80x slower.
+"""
+import argparse
+import os
+import sys
+import tempfile
+import time
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+sys.path.insert(0, os.path.join(ROOT, "benchmarks"))
+sys.path.insert(0, os.path.join(ROOT, "models", "examples"))
+
+from acausal import compile_model  # noqa: E402
+from chains import chain  # noqa: E402
+import newtons_cradle  # noqa: E402
+
+RUNS = {
+    # model builder, simulate options, a variable to print (sanity)
+    "chain": (chain, dict(t_end=0.1, rtol=1e-6, atol=1e-9), "m0.s"),
+    "cradle": (newtons_cradle.build, dict(t_end=1.5e-3, rtol=1e-6, atol=1e-10), "ball1.v"),
+}
+
+
+def timed(fn):
+    t0 = time.perf_counter()
+    out = fn()
+    return out, time.perf_counter() - t0
+
+
+def measure(name, n):
+    build, opts, probe = RUNS[name]
+    cm, t_compile = timed(lambda: compile_model(build(n)))
+    _, t_cached = timed(lambda: compile_model(build(n)))
+    res, t_first = timed(lambda: cm.simulate(**opts))
+    _, t_sim = timed(lambda: cm.simulate(**opts))
+    row = dict(model=name, n=n, unknowns=len(cm.dae.y), compile=t_compile, cached=t_cached,
+               first=t_first, sim=t_sim, lin=cm.linear_solver().kind,
+               events=len(res.events), probe=float(res.final()[probe]))
+    if name == "chain":
+        for kind in ("dense", "band"):
+            _, row[kind] = timed(lambda: cm.simulate(linsolver=kind, **opts))
+    return row
+
+
+def exponent(rows, key, n_min=20):
+    pts = [(r["n"], r[key]) for r in rows if r["n"] >= n_min and r.get(key)]
+    if len(pts) < 2:
+        return float("nan")
+    n, t = np.log([p[0] for p in pts]), np.log([p[1] for p in pts])
+    return float(np.polyfit(n, t, 1)[0])
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--sizes", type=int, nargs="+", default=[5, 10, 20, 50, 100, 200])
+    ap.add_argument("--models", nargs="+", default=["chain", "cradle"], choices=list(RUNS))
+    args = ap.parse_args()
+    with tempfile.TemporaryDirectory() as cache:
+        os.environ["ACAUSAL_CACHE"] = cache          # measure a cold cache, then a hit
+        for name in args.models:
+            rows = []
+            print(f"\n{name}: N, unknowns, compile, cached compile, first simulate, simulate"
+                  + (", dense, band" if name == "chain" else "") + " [s]; linear solver; events")
+            for n in args.sizes:
+                r = measure(name, n)
+                rows.append(r)
+                extra = f" {r['dense']:7.2f} {r['band']:7.2f}" if name == "chain" else ""
+                print(f"  N={n:4d} {r['unknowns']:5d} {r['compile']:8.2f} {r['cached']:7.2f} "
+                      f"{r['first']:7.2f} {r['sim']:7.2f}{extra}  {r['lin']:5s} {r['events']:4d}"
+                      f"  ({r['compile'] + r['first']:.2f} s to the first result)", flush=True)
+            print(f"  growth exponent (N >= 20): compile {exponent(rows, 'compile'):.2f}, "
+                  f"first simulate {exponent(rows, 'first'):.2f}, simulate "
+                  f"{exponent(rows, 'sim'):.2f}, cached compile {exponent(rows, 'cached'):.2f}")
+
+
+if __name__ == "__main__":
+    main()
