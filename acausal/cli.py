@@ -46,14 +46,16 @@ def main():
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object")
 @click.option("--rtol", type=float)
 @click.option("--atol", type=float)
-def simulate(file, t_end, sets, out, plot, as_json, rtol, atol):
+@click.option("--backend", type=click.Choice(["sundae", "casadi"]),
+              help="integrator backend (default: acausal.simulate.DEFAULT_BACKEND)")
+def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, backend):
     """Simulate a model file."""
     from .modelfile import compile_file, evaluate_measures
     try:
         params = _parse_sets(sets)
         mf, cm = compile_file(file)
         opts = mf.experiment.run_options()
-        for k, v in dict(t_end=t_end, rtol=rtol, atol=atol).items():
+        for k, v in dict(t_end=t_end, rtol=rtol, atol=atol, backend=backend).items():
             if v is not None:
                 opts[k] = v
         try:
