@@ -46,7 +46,7 @@ def main():
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object")
 @click.option("--rtol", type=float)
 @click.option("--atol", type=float)
-@click.option("--backend", type=click.Choice(["sundae", "casadi"]),
+@click.option("--backend", type=click.Choice(["sundae", "compiled"]),
               help="integrator backend (default: acausal.simulate.DEFAULT_BACKEND)")
 def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, backend):
     """Simulate a model file."""

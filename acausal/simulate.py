@@ -140,6 +140,7 @@ class _Run:
         """The segment solver of this run (:mod:`acausal.backends`), made once."""
         if getattr(self, "_solver", None) is None:
             self._solver = make_solver(self.backend, self.cm, self.p, self.opts)
+            self.backend = self._solver.name
         return self._solver
 
     def result(self, status="ok", message=""):
@@ -148,6 +149,8 @@ class _Run:
         solver = getattr(self, "_solver", None)
         if solver is not None and solver.detail:
             stats["backend_detail"] = solver.detail
+        if solver is not None and solver.fallback:
+            stats["backend_fallback"] = solver.fallback
         n = len(self.cm.dae.y)
         cat = (lambda blocks, w: np.concatenate(blocks) if blocks else np.zeros((0, w)))
         return Result(self.cm, self.p, cat(self.T, 0) if self.T else np.zeros(0),
@@ -174,7 +177,7 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
     states'. Default ``None``: ``atol`` for all, as before.
 
     ``backend`` chooses the integrator (:mod:`acausal.backends`): ``"sundae"``
-    (the reference) or ``"casadi"``; ``None`` takes :data:`DEFAULT_BACKEND`.
+    (the reference) or ``"compiled"`` (IDA calling generated C); ``None`` takes :data:`DEFAULT_BACKEND`.
     ``res.stats["backend"]`` says which one ran."""
     wall0 = _time.perf_counter()
     backend = _backend(backend)

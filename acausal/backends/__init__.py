@@ -14,11 +14,12 @@ Backends:
 ``"sundae"``
     scikit-sundae's IDA calling the generated Python callbacks (the
     reference); :mod:`acausal.backends.sundae`.
-``"casadi"``
-    SUNDIALS IDAS driving CasADi-generated code (compiled with a C compiler
-    when one exists, else CasADi's SX virtual machine), with no Python call
-    per residual, Jacobian or root evaluation;
-    :mod:`acausal.backends.casadi` (needs the optional ``casadi`` package).
+``"compiled"``
+    SUNDIALS IDA (the library the scikit-sundae wheel ships) calling
+    generated C compiled with the system's C compiler, with no Python call
+    per residual, Jacobian or root evaluation; :mod:`acausal.backends.compiled`.
+    Without a C compiler it falls back to ``"sundae"`` and says so in
+    ``res.stats["backend_fallback"]``.
 """
 from dataclasses import dataclass, field
 
@@ -26,7 +27,7 @@ import numpy as np
 
 from ..errors import AcausalError
 
-BACKENDS = ("sundae", "casadi")
+BACKENDS = ("sundae", "compiled")
 
 
 @dataclass
@@ -66,6 +67,7 @@ class SegmentSolver:
     returns a :class:`Segment`."""
     name = "?"
     detail = ""
+    fallback = None   # why another backend runs in place of the one asked for
 
     def solve(self, cb, d, t, y, yp, tout, every_step):
         raise NotImplementedError
@@ -82,24 +84,24 @@ def make_solver(name, cm, p, opts):
     if name in (None, "sundae"):
         from .sundae import SundaeSolver
         return SundaeSolver(cm, p, opts)
-    if name == "casadi":
+    if name == "compiled":
+        from .compiled import CompiledSolver, Unavailable
         try:
-            import casadi  # noqa: F401
-        except ModuleNotFoundError:
-            raise BackendError("backend 'casadi' needs the optional package casadi "
-                               "(pip install 'acausal[fast]'); the 'sundae' backend needs "
-                               "nothing more") from None
-        from .casadi import CasadiSolver
-        return CasadiSolver(cm, p, opts)
+            return CompiledSolver(cm, p, opts)
+        except Unavailable as exc:
+            from .sundae import SundaeSolver
+            solver = SundaeSolver(cm, p, opts)
+            solver.fallback = f"compiled backend unavailable: {exc}"
+            return solver
     raise BackendError(f"unknown backend {name!r}; choose one of: {', '.join(BACKENDS)}")
 
 
-def available():
-    """The backends that can run here."""
-    out = ["sundae"]
+def compiled_available():
+    """None when the compiled backend can run here, else the reason."""
+    from .compiled import Unavailable, _compiler, _sundials_libs
     try:
-        import casadi  # noqa: F401
-        out.append("casadi")
-    except ImportError:
-        pass
-    return out
+        _compiler()
+        _sundials_libs()
+    except Unavailable as exc:
+        return str(exc)
+    return None
