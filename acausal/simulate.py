@@ -8,6 +8,7 @@ integration restarts. Output: requested times, plus both sides of every
 event. A burst of events in a tiny window stops the run with a
 :class:`ChatteringError` naming the component.
 """
+import os
 import time as _time
 
 import numpy as np
@@ -177,7 +178,8 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
     states'. Default ``None``: ``atol`` for all, as before.
 
     ``backend`` chooses the integrator (:mod:`acausal.backends`): ``"sundae"``
-    (the reference) or ``"compiled"`` (IDA calling generated C); ``None`` takes :data:`DEFAULT_BACKEND`.
+    (the reference) or ``"compiled"`` (IDA calling generated C); ``None`` takes
+    the environment variable ``ACAUSAL_BACKEND``, else :data:`DEFAULT_BACKEND`.
     ``res.stats["backend"]`` says which one ran."""
     wall0 = _time.perf_counter()
     backend = _backend(backend)
@@ -227,7 +229,9 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
 
 
 def _backend(name):
-    name = DEFAULT_BACKEND if name is None else name
+    """The backend to run: ``name``, else the ``ACAUSAL_BACKEND`` environment
+    variable, else :data:`DEFAULT_BACKEND`."""
+    name = name or os.environ.get("ACAUSAL_BACKEND") or DEFAULT_BACKEND
     if name not in BACKENDS:
         raise BackendError(f"unknown backend {name!r}; choose one of: {', '.join(BACKENDS)}")
     return name
