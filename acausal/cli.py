@@ -4,6 +4,7 @@ Exit codes: 0 success, 2 a model or input error (one readable message on
 stderr), 3 a solver failure (time and component named).
 """
 import json
+import os
 import sys
 
 import click
@@ -32,8 +33,38 @@ def _parse_sets(sets):
 
 @click.group()
 @click.version_option(package_name="acausal")
-def main():
+@click.option("--backend", "global_backend", type=click.Choice(["sundae", "compiled"]),
+              help="integrator backend of every simulation of the command, local worker "
+                   "processes included (default: 'compiled' for calibrate, sweep and "
+                   "diagnose, which run many simulations; the library's default, "
+                   "'sundae', for one simulation)")
+@click.pass_context
+def main(ctx, global_backend):
     """Equation-based simulation of mechanisms."""
+    choice = global_backend or os.environ.get("ACAUSAL_BACKEND") or \
+        ("compiled" if ctx.invoked_subcommand in MANY_RUNS else None)
+    if choice:
+        _set_backend(ctx, choice)
+
+
+# commands that run many simulations: the compiled backend's one-off C build
+# (cached on disk) pays for itself there; it falls back to sundae without a
+# C compiler (benchmarks/anchors.py, tests/backends/test_agreement.py)
+MANY_RUNS = {"calibrate", "sweep", "diagnose"}
+
+
+def _set_backend(ctx, name):
+    """ACAUSAL_BACKEND for this command (local worker processes inherit it),
+    restored when the command ends."""
+    old = os.environ.get("ACAUSAL_BACKEND")
+    os.environ["ACAUSAL_BACKEND"] = name
+
+    def restore():
+        if old is None:
+            os.environ.pop("ACAUSAL_BACKEND", None)
+        else:
+            os.environ["ACAUSAL_BACKEND"] = old
+    ctx.call_on_close(restore)
 
 
 @main.command()
@@ -79,12 +110,16 @@ def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, backend):
             "events": [{"t": t, "name": n} for t, n in res.events],
             "measures": measures,
             "stats": {k: res.stats.get(k) for k in ("nfev", "steps", "wall_s", "compile_s",
-                                                    "njev", "events")},
+                                                    "njev", "events", "backend",
+                                                    "backend_fallback")},
         }, indent=1))
     else:
         click.echo(f"simulated {mf.path}: t = {res.t[0]:g} .. {res.t[-1]:g} s, "
                    f"{len(res.events)} events, {res.stats['steps']} steps, "
-                   f"{res.stats['wall_s'] * 1e3:.1f} ms (compile {cm.compile_s:.2f} s)")
+                   f"{res.stats['wall_s'] * 1e3:.1f} ms (compile {cm.compile_s:.2f} s, "
+                   f"backend {res.stats['backend']})")
+        if res.stats.get("backend_fallback"):
+            click.echo(f"  note: {res.stats['backend_fallback']}; ran sundae")
         for k, v in measures.items():
             click.echo(f"  {k} = {v:.6g}")
 

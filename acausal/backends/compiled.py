@@ -86,15 +86,32 @@ def _cache_dir():
     return d
 
 
-def _build(csrc):
-    """Path of the shared library for ``csrc``, compiled once per cache."""
+def _key(cm, cc, libs):
+    """Cache key of a model's library: the model's generated Python source
+    (which fixes its DAE, roots and symbols), the C generator, the driver,
+    the compiler and the SUNDIALS libraries; so a cached library is found
+    without generating C again."""
+    import acausal.codegen_c as gen
+    parts = [cm.source, cc] + libs
+    for path in (_DRIVER, gen.__file__):
+        with open(path) as fh:
+            parts.append(fh.read())
+    return hashlib.sha256("\0".join(parts).encode()).hexdigest()[:24]
+
+
+def _build(cm):
+    """Path of the shared library of ``cm`` (compiled once per cache) and
+    whether it was compiled now."""
     cc, libs = _compiler(), _sundials_libs()
-    with open(_DRIVER) as fh:
-        driver = fh.read()
-    key = hashlib.sha256("\0".join([driver, csrc.text, cc] + libs).encode()).hexdigest()[:24]
-    out = os.path.join(_cache_dir(), f"acs_{key}.so")
+    out = os.path.join(_cache_dir(), f"acs_{_key(cm, cc, libs)}.so")
     if os.path.exists(out):
         return out, False
+    try:
+        csrc = generate_c(cm)
+    except PrintMethodNotImplementedError as exc:
+        raise Unavailable("an expression of the model has no C form: "
+                          + str(exc).splitlines()[0]
+                          + " (give its sympy Function a _ccode method)") from None
     tmpdir = tempfile.mkdtemp(dir=os.path.dirname(out))
     try:
         model_c = os.path.join(tmpdir, "model.c")
@@ -118,13 +135,8 @@ class _Library:
     """The loaded shared library of one compiled model."""
 
     def __init__(self, cm):
-        try:
-            self.csrc = generate_c(cm)
-        except PrintMethodNotImplementedError as exc:
-            raise Unavailable("an expression of the model has no C form: "
-                              + str(exc).splitlines()[0]
-                              + " (give its sympy Function a _ccode method)") from None
-        self.path, self.built = _build(self.csrc)
+        self.n_pd = len(cm.param_syms) + len(cm.disc_syms)
+        self.path, self.built = _build(cm)
         lib = self.lib = ctypes.CDLL(self.path)
         dp, ip = ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_int)
         vp = ctypes.c_void_p
@@ -174,7 +186,7 @@ class CompiledSolver(SegmentSolver):
         self.dirs = np.array([e.direction for e in cm.events] + [-1] * len(cm.assertions)
                              or [0], dtype=np.intc)
         self.terminal = [not e.observer for e in cm.events] + [True] * len(cm.assertions)
-        self.h = L.lib.acs_new(n, self.nr, L.csrc.n_pd, float(opts["rtol"]), _ptr(atol),
+        self.h = L.lib.acs_new(n, self.nr, L.n_pd, float(opts["rtol"]), _ptr(atol),
                                _ptr(ident), _ptr(self.dirs, ctypes.c_int),
                                float(opts.get("max_step") or 0.0), int(opts["max_num_steps"]))
         if not self.h:
