@@ -235,9 +235,12 @@ class CasadiIDAS:
         a, b = 0.0, span
         ga = float(self.gf(x, z, pd, ta, span, 0.0)[i])
         gb, xb, zb = g_at(b)
-        side = 0
+        side, c_last = 0, np.inf
         for _ in range(60):
             c = (a * gb - b * ga) / (gb - ga)
+            if abs(c - c_last) <= tol * max(abs(ta), span):
+                break     # converged (to the noise of a restarted integration)
+            c_last = c
             gc, xc, zc = g_at(c)
             if gc * gb > 0:
                 b, gb, xb, zb = c, gc, xc, zc
