@@ -27,6 +27,11 @@ import tempfile
 import weakref
 
 import numpy as np
+
+try:
+    import fcntl
+except ImportError:   # pragma: no cover - not on Windows (where the backend falls back)
+    fcntl = None
 from sympy.printing.codeprinter import PrintMethodNotImplementedError
 
 from ..codegen_c import generate_c
@@ -103,9 +108,24 @@ def _build(cm):
     """Path of the shared library of ``cm`` (compiled once per cache) and
     whether it was compiled now."""
     cc, libs = _compiler(), _sundials_libs()
-    out = os.path.join(_cache_dir(), f"acs_{_key(cm, cc, libs)}.so")
-    if os.path.exists(out):
-        return out, False
+    try:
+        out = os.path.join(_cache_dir(), f"acs_{_key(cm, cc, libs)}.so")
+        if os.path.exists(out):
+            return out, False
+        # one build per library: concurrent processes (sweep workers) wait for it
+        with open(out + ".lock", "w") as lock:
+            if fcntl is not None:
+                fcntl.flock(lock, fcntl.LOCK_EX)
+            if os.path.exists(out):
+                return out, False
+            _compile(cm, cc, libs, out)
+    except OSError as exc:
+        raise Unavailable(f"cannot write the compiled-library cache: {exc} "
+                          "(set ACAUSAL_CACHE_DIR to a writable folder)") from None
+    return out, True
+
+
+def _compile(cm, cc, libs, out):
     try:
         csrc = generate_c(cm)
     except PrintMethodNotImplementedError as exc:
@@ -125,10 +145,9 @@ def _build(cm):
         if proc.returncode != 0:
             raise Unavailable("the C compiler failed on the generated code: "
                               + (proc.stderr.strip().splitlines() or ["?"])[-1])
-        os.replace(tmp_so, out)   # atomic: a concurrent build writes the same file
+        os.replace(tmp_so, out)   # atomic: a reader never sees a partial file
     finally:
         shutil.rmtree(tmpdir, ignore_errors=True)
-    return out, True
 
 
 class _Library:
