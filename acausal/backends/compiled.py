@@ -139,7 +139,7 @@ def _compile(cm, cc, libs, out):
             fh.write(csrc.text)
         tmp_so = os.path.join(tmpdir, "lib.so")
         libdir = os.path.dirname(libs[0])
-        cmd = cc.split() + ["-O2", "-shared", "-fPIC", "-o", tmp_so, _DRIVER, model_c] + \
+        cmd = cc.split() + ["-O1", "-shared", "-fPIC", "-o", tmp_so, _DRIVER, model_c] + \
             libs + [f"-Wl,-rpath,{libdir}", "-lm"]
         proc = subprocess.run(cmd, capture_output=True, text=True)
         if proc.returncode != 0:
