@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 import sympy as sp
 
-FORMAT = 1
+FORMAT = 2
 _OFF = {"off", "0", "none", "false", "no"}
 _COMPILER_MODULES = ("flatten", "aliases", "structure", "causalize", "codegen", "compile",
                      "fastdiff", "symbols", "cache", "declare")
@@ -49,6 +49,7 @@ class Entry:
     dae: object
     source: str
     sparsity: object
+    root_via: dict = None   # root -> (alias name, sign, offset): start values set per run
     format: int = FORMAT
 
 

@@ -7,6 +7,7 @@ traceback and exits with 1.
 """
 import contextlib
 import json
+import os
 import sys
 
 import click
@@ -39,8 +40,40 @@ def _parse_sets(sets):
 
 @click.group()
 @click.version_option(package_name="acausal")
-def main():
+@click.option("--backend", "global_backend", type=click.Choice(["sundae", "compiled"]),
+              help="integrator backend of every simulation of the command, local worker "
+                   "processes included (default: 'compiled' for calibrate and sweep, "
+                   "which run many simulations of one model; the library's default, "
+                   "'sundae', otherwise)")
+@click.pass_context
+def main(ctx, global_backend):
     """Equation-based simulation of mechanisms."""
+    choice = global_backend or os.environ.get("ACAUSAL_BACKEND") or \
+        ("compiled" if ctx.invoked_subcommand in MANY_RUNS else None)
+    if choice:
+        _set_backend(ctx, choice)
+
+
+# commands that run many simulations of one model: the compiled backend's
+# one-off C build (about 2-3 s, cached on disk) pays for itself there; it
+# falls back to sundae without a C compiler (benchmarks/anchors.py,
+# tests/backends/test_agreement.py). diagnose compiles dozens of hypothesis
+# models: not measured yet, so it keeps the reference.
+MANY_RUNS = {"calibrate", "sweep"}
+
+
+def _set_backend(ctx, name):
+    """ACAUSAL_BACKEND for this command (local worker processes inherit it),
+    restored when the command ends."""
+    old = os.environ.get("ACAUSAL_BACKEND")
+    os.environ["ACAUSAL_BACKEND"] = name
+
+    def restore():
+        if old is None:
+            os.environ.pop("ACAUSAL_BACKEND", None)
+        else:
+            os.environ["ACAUSAL_BACKEND"] = old
+    ctx.call_on_close(restore)
 
 
 @main.command()
@@ -62,15 +95,18 @@ def main():
 @click.option("--progress/--no-progress", default=None,
               help="progress bar on stderr for runs longer than 2 s "
                    "(default: when stderr is a terminal)")
+@click.option("--backend", type=click.Choice(["sundae", "compiled"]),
+              help="integrator backend (default: acausal.simulate.DEFAULT_BACKEND)")
 def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, max_rows, max_wall, max_steps,
-             progress):
+             progress, backend):
     """Simulate a model file."""
     from .modelfile import compile_file, measure_values
     try:
         params = _parse_sets(sets)
         mf, cm = compile_file(file)
         opts = _simulate_options(mf, dict(t_end=t_end, rtol=rtol, atol=atol, max_rows=max_rows,
-                                          max_wall=max_wall, max_total_steps=max_steps),
+                                          max_wall=max_wall, max_total_steps=max_steps,
+                                          backend=backend),
                                  progress, dense=bool(out or plot))
         with _c_stdout_to_stderr() if as_json else contextlib.nullcontext():
             res, error = _run_keeping_partial(cm, params, opts)
@@ -160,7 +196,8 @@ def _result_dict(mf, res, measures, missing, error):
         "units": {"time": "s", "final": {n: res.unit(n) for n in final},
                   "measures": {k: measure_unit(mf, k) for k in measures}},
         "stats": {k: res.stats.get(k) for k in ("nfev", "steps", "wall_s", "compile_s",
-                                                "njev", "events")},
+                                                "njev", "events", "backend",
+                                                "backend_fallback")},
     }
 
 
@@ -169,7 +206,10 @@ def _print_run(mf, cm, res, measures, missing):
     from .modelfile import show_measure
     click.echo(f"simulated {mf.path}: t = {res.t[0]:g} .. {res.t[-1]:g} s, "
                f"{len(res.events)} events, {res.stats['steps']} steps, "
-               f"{res.stats['wall_s'] * 1e3:.1f} ms (compile {cm.compile_s:.2f} s)")
+               f"{res.stats['wall_s'] * 1e3:.1f} ms (compile {cm.compile_s:.2f} s, "
+               f"backend {res.stats.get('backend')})")
+    if res.stats.get("backend_fallback"):
+        click.echo(f"  note: {res.stats['backend_fallback']}; ran sundae")
     for k, v in measures.items():
         if k in missing:
             click.echo(f"  {k} = missing ({missing[k]})")

@@ -14,7 +14,7 @@ from .causalize import build_dae
 from . import cache as _cache
 from .codegen import generate, load as load_generated
 from .declare import Start
-from .errors import ModelError, ParameterError
+from .errors import ModelError, ParameterError, UsageError
 from .flatten import flatten
 from .structure import Graph, check_structure, dummy_derivatives, pantelides
 from .symbols import base_and_order, der, time
@@ -79,7 +79,7 @@ class CompiledModel:
         else:
             make, fixjac = load_generated(entry.source)
         self.reduced, self.graph, self.dae = entry.reduced, entry.graph, entry.dae
-        self._root_starts = entry.root_starts
+        self._root_starts, self._root_via = entry.root_starts, entry.root_via or {}
         self._subs = dict(self.reduced.param_subs)
         self._alias = self.reduced.subs
         self.source, self._make, self._fixjac = entry.source, make, fixjac
@@ -110,7 +110,7 @@ class CompiledModel:
                       if flat.variables[n].start.fixed]
         gen = generate(self.dae, self.param_syms, self.disc_syms, roots, observed, fixed_rows)
         entry = _cache.Entry(key, red, g, self._root_starts, self.dae, gen.source,
-                             gen.sparsity)
+                             gen.sparsity, self._root_via)
         return entry, gen.make, gen.fixjac
 
     # -- symbol resolution -------------------------------------------------
@@ -353,7 +353,7 @@ class CompiledModel:
                                              uband=int(sp_.uband)), 1)
         if kind == "sparse":
             return LinearSolver("sparse", dict(linsolver="sparse", sparsity=sp_.matrix()), 6)
-        raise ValueError(f"linear solver {kind!r}: choose 'auto', 'dense', 'band' or 'sparse'")
+        raise UsageError(f"linear solver {kind!r}: choose 'auto', 'dense', 'band' or 'sparse'")
 
     def simulate(self, **kw):
         from .simulate import simulate

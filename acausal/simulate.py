@@ -8,13 +8,14 @@ integration restarts. Output: requested times, plus both sides of every
 event. A burst of events in a tiny window stops the run with a
 :class:`ChatteringError` naming the component.
 """
+import os
 import sys
 import time as _time
 from collections import Counter
 
 import numpy as np
-from sksundae.ida import IDA
 
+from .backends import BACKENDS, BackendError, make_solver
 from .errors import ChatteringError, LimitError, ModelError, SolverError, UsageError
 from .initialize import initial_point, reinitialize
 from .result import Result
@@ -22,6 +23,7 @@ from .result import Result
 CHATTER_COUNT = 100     # this many events ...
 CHATTER_SPAN = 1e-9     # ... within this fraction of the time span is chattering
 MAX_ITER = 20           # event iterations at one instant
+DEFAULT_BACKEND = "sundae"
 MAX_ROWS = 1_000_000    # stored output rows, by default (each 8 bytes per unknown, twice)
 WINDOW_S = 0.25         # wall time per integration window when watched [s]
 PROGRESS_DELAY_S = 2.0  # a progress bar shows once a run has lasted this long [s]
@@ -124,16 +126,16 @@ def _atol_vector(cm, atol, atol_algebraic):
 
 
 class _Run:
-    def __init__(self, cm, p, t0, t_end, rtol, atol, max_step, max_steps):
+    def __init__(self, cm, p, t0, t_end, rtol, atol, max_step, max_steps, backend="sundae",
+                 linsolver="auto"):
         self.cm, self.p = cm, np.asarray(p, float)
+        self.backend = backend
         self.t0, self.t_end = t0, t_end
         self.opts = dict(rtol=rtol, atol=atol, max_step=max_step or 0.0,
-                         max_num_steps=max_steps)
+                         max_num_steps=max_steps, linsolver=linsolver)
         self.T, self.Y, self.YP, self.D = [], [], [], []
         self.events, self.event_log = [], []
         self.nfev = self.njev = self.steps = self.rows = 0
-        ev = cm.events
-        self.directions = [e.direction for e in ev] + [-1] * len(cm.assertions)
 
     def record(self, t, y, yp, d):
         self.T.append(np.atleast_1d(np.asarray(t, float)))
@@ -142,40 +144,21 @@ class _Run:
         self.D.append(np.tile(np.asarray(d, float), (len(self.T[-1]), 1)))
         self.rows += len(self.T[-1])
 
-    def solver(self, cb):
-        """The IDA object of this run, made once: its callbacks dispatch to the
-        current mode's generated functions (``self.cb``), so a mode change
-        only swaps them (creating an IDA object costs more than a segment of
-        a short contact)."""
-        self.cb = cb
-        if getattr(self, "_ida", None) is not None:
-            return self._ida
-        kw = dict(self.opts)
-        alg = list(range(self.cm.dae.n_states, len(self.cm.dae.y)))
-        if alg:
-            kw["algebraic_idx"] = alg
-        lin = self.cm.linear_solver(self.linsolver)
-        kw.update(lin.options)
-
-        def res(t, y, yp, r):
-            self.cb[0](t, y, yp, r)
-
-        def jac(t, y, yp, r, cj, J):
-            self.cb[lin.jac_index](t, y, yp, r, cj, J)
-        if self.cm.n_roots:
-            def roots(t, y, yp, g):
-                self.cb[2](t, y, yp, g)
-            roots.terminal = [not e.observer for e in self.cm.events] + \
-                [True] * len(self.cm.assertions)
-            self._roots = roots
-            roots.direction = list(self.directions)
-            kw.update(eventsfn=roots, num_events=self.cm.n_roots)
-        self._ida = IDA(res, jacfn=jac, **kw)
-        return self._ida
+    def solver(self):
+        """The segment solver of this run (:mod:`acausal.backends`), made once."""
+        if getattr(self, "_solver", None) is None:
+            self._solver = make_solver(self.backend, self.cm, self.p, self.opts)
+            self.backend = self._solver.name
+        return self._solver
 
     def result(self, status="ok", message=""):
         stats = dict(nfev=self.nfev, njev=self.njev, steps=self.steps,
-                     events=len(self.events))
+                     events=len(self.events), backend=self.backend)
+        solver = getattr(self, "_solver", None)
+        if solver is not None and solver.detail:
+            stats["backend_detail"] = solver.detail
+        if solver is not None and solver.fallback:
+            stats["backend_fallback"] = solver.fallback
         n = len(self.cm.dae.y)
         cat = (lambda blocks, w: np.concatenate(blocks) if blocks else np.zeros((0, w)))
         return Result(self.cm, self.p, cat(self.T, 0) if self.T else np.zeros(0),
@@ -185,8 +168,8 @@ class _Run:
 
 def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_step=None,
              output_times=None, max_step=None, max_steps=100000, atol_algebraic=None,
-             max_rows=MAX_ROWS, max_wall=None, max_total_steps=None, progress=False,
-             linsolver="auto"):
+             backend=None, max_rows=MAX_ROWS, max_wall=None, max_total_steps=None,
+             progress=False, linsolver="auto"):
     """Simulate a :class:`CompiledModel` from ``t0`` to ``t_end`` (or until a
     terminal event). ``params`` overrides parameter values, and the start
     values of variables whose start is fixed, by dotted path (both are
@@ -204,6 +187,11 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
     scikit-sundae does not expose); their accuracy then follows from the
     states'. Default ``None``: ``atol`` for all, as before.
 
+    ``backend`` chooses the integrator (:mod:`acausal.backends`): ``"sundae"``
+    (the reference) or ``"compiled"`` (IDA calling generated C); ``None`` takes
+    the environment variable ``ACAUSAL_BACKEND``, else :data:`DEFAULT_BACKEND`.
+    ``res.stats["backend"]`` says which one ran.
+
     Limits (each stops the run with a :class:`~acausal.errors.LimitError`
     that keeps the partial result and names the component whose events
     dominate): ``max_rows`` stored output rows (checked before the run for
@@ -219,12 +207,12 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
     :meth:`acausal.compile.CompiledModel.linear_solver` (``"auto"`` chooses
     band for large models with a narrow band, else dense)."""
     wall0 = _time.perf_counter()
+    backend = _backend(backend)
     params, starts = cm.split_overrides(params)
     p = cm.param_vector(params)
     d = cm.discrete_start()
     run = _Run(cm, p, t0, t_end, rtol, _atol_vector(cm, atol, atol_algebraic), max_step,
-               max_steps)
-    run.linsolver = linsolver
+               max_steps, backend, linsolver)
     cb = cm.callbacks(p, d)
     run.cb_d = list(d)
     y, yp = initial_point(cm, p, d, cb, t0, starts)
@@ -237,36 +225,25 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
     try:
         while not stop and t < t_end:
             tspan = _tspan(t, tout, t_end, watch.horizon(t))
-            ida = run.solver(watch.wrap(cb, tspan))
-            # two points: IDA reports every internal step (output_step=0)
-            _reset_event_log(getattr(run, "_roots", None))
-            sol = watch.solve(ida, tspan, y, yp)
-            if len(tspan) == 2 and output_step != 0 and len(sol.t) > 2:
-                # IDA reported every internal step; keep what was asked for
-                keep = np.r_[0, len(sol.t) - 1]
-                sol_t, sol_y, sol_yp = sol.t[keep], sol.y[keep], sol.yp[keep]
-            else:
-                sol_t, sol_y, sol_yp = sol.t, sol.y, sol.yp
-            run.nfev += sol.nfev
-            run.njev += sol.njev
-            run.steps += cb[5][0]
-            cb[5][0] = 0
-            if sol.status < 0:
-                if len(sol_t) > 1:
-                    run.record(sol_t[1:], sol_y[1:], sol_yp[1:], d)
-                raise _failure(run, cm, sol, cb)
-            run.record(sol_t[1:], sol_y[1:], sol_yp[1:], d)
-            t, y, yp = float(sol.t[-1]), np.array(sol.y[-1]), np.array(sol.yp[-1])
+            seg = watch.solve(run.solver(), watch.wrap(cb, tspan), d, tspan, y, yp,
+                              every_step=output_step == 0)
+            run.nfev += seg.nfev
+            run.njev += seg.njev
+            run.steps += seg.steps
+            if len(seg.t) > 1:
+                run.record(seg.t[1:], seg.y[1:], seg.yp[1:], d)
+            if seg.status < 0:
+                raise _failure(run, cm, seg, cb)
+            t, y, yp = float(seg.t[-1]), np.array(seg.y[-1]), np.array(seg.yp[-1])
             watch.check(t)
-            d, final_fired = _observers(run, cb, sol, d)
+            d, fired = _observers(run, cb, seg, d)
             if d != run.cb_d:
                 cb = cm.callbacks(run.p, d)
             run.cb_d = list(d)
-            if sol.status != 2:
+            if seg.status != 2:
                 if tspan[-1] < t_end:   # the end of a window of the watch
                     continue
                 break
-            fired = final_fired
             d_before = list(d)
             y, yp, d, cb, stop = _handle(run, cb, t, y, yp, d, fired)
             if list(d) != d_before:
@@ -281,6 +258,7 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
     res.stats["wall_s"] = _time.perf_counter() - wall0
     res.stats["compile_s"] = cm.compile_s
     return res
+
 
 
 # ---------------------------------------------------------------------------
@@ -389,11 +367,14 @@ class _Watch:
                 and self.run.rows + steps_now > self.max_rows):
             raise _HardStop("rows")  # every step is stored (a two-point span)
 
-    def solve(self, ida, tspan, y, yp):
+    def solve(self, solver, cb, d, tspan, y, yp, every_step):
+        """One segment of ``solver`` (:mod:`acausal.backends`) over ``tspan``;
+        a limit far exceeded inside it (seen by the wrapped residual of a
+        Python backend) stops the run."""
         self.t_call = _time.perf_counter()
         self.every_step = len(tspan) == 2
         try:
-            return ida.solve(tspan, y, yp)
+            return solver.solve(cb, d, float(tspan[0]), y, yp, tspan[1:], every_step)
         except _HardStop as exc:
             self.run.steps += self.counter[0]
             self.counter[0] = 0
@@ -469,28 +450,33 @@ def _reset_event_log(roots):
         roots._i_cnt[:] = 0
 
 
-def _observers(run, cb, sol, d):
-    """Run the actions of observer events IDA located during the segment (it
+def _backend(name):
+    """The backend to run: ``name``, else the ``ACAUSAL_BACKEND`` environment
+    variable, else :data:`DEFAULT_BACKEND`."""
+    name = name or os.environ.get("ACAUSAL_BACKEND") or DEFAULT_BACKEND
+    if name not in BACKENDS:
+        raise BackendError(f"unknown backend {name!r}; choose one of: {', '.join(BACKENDS)}")
+    return name
+
+
+def _observers(run, cb, seg, d):
+    """Run the actions of observer events located during the segment (it
     did not stop for them), in time order; the discrete values they record
     are written into the rows from their time on. Returns the discrete
     values and the events that ended the segment (without its observers)."""
     cm = run.cm
-    roots = getattr(run, "_roots", None)
-    if roots is None or not getattr(roots, "_i", None):
-        return d, [i for i, s_ in enumerate(sol.i_events[-1]) if s_ != 0] \
-            if sol.status == 2 else []
     d = list(d)
     n_ev = len(cm.events)
     final = []
-    last = len(roots._i) - 1
-    for k, (flags, te, ye, ype) in enumerate(zip(roots._i, roots._t, roots._y, roots._yp)):
-        fired = [i for i, s_ in enumerate(flags) if s_ != 0]
-        obs = [i for i in fired if i < n_ev and cm.events[i].observer]
-        if k == last and sol.status == 2:
-            final = [i for i in fired if i not in obs]
+    last = len(seg.roots) - 1
+    for k, root in enumerate(seg.roots):
+        obs = [i for i in root.fired if i < n_ev and cm.events[i].observer]
+        if k == last and seg.status == 2:
+            final = [i for i in root.fired if i not in obs]
         if not obs:
             continue
-        state = EventState(cm, run.p, d, te, cb[4](te, ye, ype))
+        te = root.t
+        state = EventState(cm, run.p, d, te, cb[4](te, root.y, root.yp))
         before = list(d)
         for i in obs:
             _log_event(run, te, cm.events[i])

@@ -106,6 +106,10 @@ class PosPow(sp.Function):
         x, g = (printer._print(a) for a in self.args)
         return f"(({x})**({g}) if ({x}) > 0 else 0.0)"
 
+    def _ccode(self, printer):   # the compiled backend (acausal/codegen_c.py)
+        x, g = (printer._print(a) for a in self.args)
+        return f"(({x}) > 0 ? pow({x}, {g}) : 0.0)"
+
 
 def hertz_stiffness(R_i, R_j, E_i, E_j, nu_i=0.3, nu_j=0.3):
     """Hertz stiffness of two spheres [N/m^1.5] (the report's eqs. 3, 4,

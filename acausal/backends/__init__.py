@@ -1,0 +1,107 @@
+"""Segment solvers: what the hybrid loop (:mod:`acausal.simulate`) asks of an
+integrator.
+
+A *segment* is a stretch of integration in one mode (one set of discrete
+values) from a consistent point ``(t, y, y')``: the backend integrates it
+over the requested output times until the first terminal root or the end,
+and reports every root it located on the way (observer roots, which did not
+stop it, and the terminal one), in time order. Everything hybrid (event
+actions, re-initialisation, event iteration, the chattering guard) stays in
+the loop, so a second backend only has to implement :class:`SegmentSolver`.
+
+Backends:
+
+``"sundae"``
+    scikit-sundae's IDA calling the generated Python callbacks (the
+    reference); :mod:`acausal.backends.sundae`.
+``"compiled"``
+    SUNDIALS IDA (the library the scikit-sundae wheel ships) calling
+    generated C compiled with the system's C compiler, with no Python call
+    per residual, Jacobian or root evaluation; :mod:`acausal.backends.compiled`.
+    Without a C compiler it falls back to ``"sundae"`` and says so in
+    ``res.stats["backend_fallback"]``.
+"""
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import AcausalError
+
+BACKENDS = ("sundae", "compiled")
+
+
+@dataclass
+class Root:
+    """A located root: time, point and the indices of the root functions
+    that crossed zero there (events first, then assertions)."""
+    t: float
+    y: np.ndarray
+    yp: np.ndarray
+    fired: list
+
+
+@dataclass
+class Segment:
+    """What a segment solve produced. ``t, y, yp``: output rows, the first
+    being the start point; ``status``: 0 reached the end, 2 stopped at a
+    terminal root (the last row), < 0 failed (``message`` says why);
+    ``roots``: every located root in time order."""
+    t: np.ndarray
+    y: np.ndarray
+    yp: np.ndarray
+    status: int
+    message: str
+    roots: list = field(default_factory=list)
+    nfev: int = 0
+    njev: int = 0
+    steps: int = 0
+
+
+class SegmentSolver:
+    """Interface of a backend. ``solve(cb, d, t, y, yp, tout, every_step)``
+    integrates from the consistent point ``(t, y, yp)`` in the mode given by
+    the discrete values ``d`` (``cb``: that mode's generated Python
+    callbacks, which a compiled backend may ignore) over the output times
+    ``tout`` (increasing, all > t, the last one the end of the segment),
+    with a row at every internal step as well when ``every_step``, and
+    returns a :class:`Segment`."""
+    name = "?"
+    detail = ""
+    fallback = None   # why another backend runs in place of the one asked for
+
+    def solve(self, cb, d, t, y, yp, tout, every_step):
+        raise NotImplementedError
+
+
+class BackendError(AcausalError):
+    """A backend was asked for that does not exist or cannot run here."""
+
+
+def make_solver(name, cm, p, opts):
+    """A :class:`SegmentSolver` of backend ``name`` for model ``cm`` with
+    parameter vector ``p`` and options ``opts`` (rtol, atol, max_step,
+    max_num_steps)."""
+    if name in (None, "sundae"):
+        from .sundae import SundaeSolver
+        return SundaeSolver(cm, p, opts)
+    if name == "compiled":
+        from .compiled import CompiledSolver, Unavailable
+        try:
+            return CompiledSolver(cm, p, opts)
+        except Unavailable as exc:
+            from .sundae import SundaeSolver
+            solver = SundaeSolver(cm, p, opts)
+            solver.fallback = f"compiled backend unavailable: {exc}"
+            return solver
+    raise BackendError(f"unknown backend {name!r}; choose one of: {', '.join(BACKENDS)}")
+
+
+def compiled_available():
+    """None when the compiled backend can run here, else the reason."""
+    from .compiled import Unavailable, _compiler, _sundials_libs
+    try:
+        _compiler()
+        _sundials_libs()
+    except Unavailable as exc:
+        return str(exc)
+    return None

@@ -1,0 +1,260 @@
+"""The compiled backend: SUNDIALS IDA calling generated C, with no Python
+call per residual, Jacobian or root evaluation.
+
+The model's residual, iteration matrix and root functions are generated as
+C (:mod:`acausal.codegen_c`), compiled with the system's C compiler together
+with a small segment driver (``ida_driver.c``), and linked against the
+SUNDIALS 7 libraries that the scikit-sundae wheel ships, so nothing but pip
+and a C compiler is needed. The library is cached on disk, keyed by a hash
+of its sources, the compiler and the SUNDIALS libraries. Python sees one
+call per segment (and one per located root or full output buffer).
+
+IDA is set up as :mod:`acausal.backends.sundae` sets it up, so both
+backends run the same integrator; the hybrid loop is shared.
+
+When there is no C compiler or no SUNDIALS library to link against,
+:class:`Unavailable` says why and :func:`acausal.backends.make_solver`
+falls back to the reference backend (``res.stats["backend_fallback"]``).
+"""
+import ctypes
+import glob
+import hashlib
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import weakref
+
+import numpy as np
+
+try:
+    import fcntl
+except ImportError:   # pragma: no cover - not on Windows (where the backend falls back)
+    fcntl = None
+from sympy.printing.codeprinter import PrintMethodNotImplementedError
+
+from ..codegen_c import generate_c
+from . import Root, Segment, SegmentSolver
+
+_DRIVER = os.path.join(os.path.dirname(os.path.abspath(__file__)), "ida_driver.c")
+_LIBS = ("sundials_core", "sundials_nvecserial", "sundials_sunmatrixdense",
+         "sundials_sunlinsoldense", "sundials_ida")
+_ROOT, _FULL = 2, 99
+_MESSAGES = {
+    -1: "the maximum number of steps was taken before reaching the output time",
+    -2: "the requested accuracy could not be achieved",
+    -3: "Error tests failed too many times, or reached min step size.",
+    -4: "the corrector (Newton) iteration failed to converge too many times",
+    -5: "the linear solver's setup failed",
+    -6: "the linear solver's solve failed",
+    -8: "the residual function failed",
+    -10: "the root function failed",
+}
+_loaded = weakref.WeakKeyDictionary()   # CompiledModel -> _Library
+
+
+class Unavailable(Exception):
+    """The compiled backend cannot run here (the message says why)."""
+
+
+def _compiler():
+    cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc") or \
+        shutil.which("clang")
+    if not cc or not shutil.which(cc.split()[0]):
+        raise Unavailable(f"no C compiler found ({cc or 'cc, gcc, clang'})")
+    return cc
+
+
+def _sundials_libs():
+    """Full paths of the SUNDIALS shared libraries of the scikit-sundae wheel."""
+    try:
+        import sksundae
+    except ImportError as exc:   # pragma: no cover - a core dependency
+        raise Unavailable(f"scikit-sundae cannot be imported: {exc}") from None
+    base = os.path.dirname(os.path.dirname(os.path.abspath(sksundae.__file__)))
+    paths = []
+    for lib in _LIBS:
+        hits = sorted(glob.glob(os.path.join(base, "scikit_sundae.libs", f"lib{lib}-*.so*")))
+        if not hits:
+            raise Unavailable(f"no {lib} library in the scikit-sundae installation "
+                              f"({sys.platform}); the compiled backend needs the Linux wheel")
+        paths.append(hits[0])
+    return paths
+
+
+def _cache_dir():
+    d = os.environ.get("ACAUSAL_CACHE_DIR") or os.path.join(
+        os.path.expanduser("~"), ".cache", "acausal")
+    d = os.path.join(d, "compiled")
+    os.makedirs(d, exist_ok=True)
+    return d
+
+
+def _key(cm, cc, libs):
+    """Cache key of a model's library: the model's generated Python source
+    (which fixes its DAE, roots and symbols), the C generator, the driver,
+    the compiler and the SUNDIALS libraries; so a cached library is found
+    without generating C again."""
+    import acausal.codegen_c as gen
+    parts = [cm.source, cc] + libs
+    for path in (_DRIVER, gen.__file__):
+        with open(path) as fh:
+            parts.append(fh.read())
+    return hashlib.sha256("\0".join(parts).encode()).hexdigest()[:24]
+
+
+def _build(cm):
+    """Path of the shared library of ``cm`` (compiled once per cache) and
+    whether it was compiled now."""
+    cc, libs = _compiler(), _sundials_libs()
+    try:
+        out = os.path.join(_cache_dir(), f"acs_{_key(cm, cc, libs)}.so")
+        if os.path.exists(out):
+            return out, False
+        # one build per library: concurrent processes (sweep workers) wait for it
+        with open(out + ".lock", "w") as lock:
+            if fcntl is not None:
+                fcntl.flock(lock, fcntl.LOCK_EX)
+            if os.path.exists(out):
+                return out, False
+            _compile(cm, cc, libs, out)
+    except OSError as exc:
+        raise Unavailable(f"cannot write the compiled-library cache: {exc} "
+                          "(set ACAUSAL_CACHE_DIR to a writable folder)") from None
+    return out, True
+
+
+def _compile(cm, cc, libs, out):
+    try:
+        csrc = generate_c(cm)
+    except PrintMethodNotImplementedError as exc:
+        raise Unavailable("an expression of the model has no C form: "
+                          + str(exc).splitlines()[0]
+                          + " (give its sympy Function a _ccode method)") from None
+    tmpdir = tempfile.mkdtemp(dir=os.path.dirname(out))
+    try:
+        model_c = os.path.join(tmpdir, "model.c")
+        with open(model_c, "w") as fh:
+            fh.write(csrc.text)
+        tmp_so = os.path.join(tmpdir, "lib.so")
+        libdir = os.path.dirname(libs[0])
+        cmd = cc.split() + ["-O1", "-shared", "-fPIC", "-o", tmp_so, _DRIVER, model_c] + \
+            libs + [f"-Wl,-rpath,{libdir}", "-lm"]
+        proc = subprocess.run(cmd, capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise Unavailable("the C compiler failed on the generated code: "
+                              + (proc.stderr.strip().splitlines() or ["?"])[-1])
+        os.replace(tmp_so, out)   # atomic: a reader never sees a partial file
+    finally:
+        shutil.rmtree(tmpdir, ignore_errors=True)
+
+
+class _Library:
+    """The loaded shared library of one compiled model."""
+
+    def __init__(self, cm):
+        self.n_pd = len(cm.param_syms) + len(cm.disc_syms)
+        self.path, self.built = _build(cm)
+        lib = self.lib = ctypes.CDLL(self.path)
+        dp, ip = ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_int)
+        vp = ctypes.c_void_p
+        lib.acs_new.restype = vp
+        lib.acs_new.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_int, ctypes.c_double, dp,
+                                dp, ip, ctypes.c_double, ctypes.c_long]
+        lib.acs_free.argtypes = [vp]
+        lib.acs_start.argtypes = [vp, ctypes.c_double, dp, dp, dp, ctypes.c_double]
+        lib.acs_advance.argtypes = [vp, dp, ctypes.c_int, ip, ctypes.c_int, dp, dp, dp,
+                                    ctypes.c_int, ip, dp, dp, dp, ip]
+        lib.acs_counters.argtypes = [vp, ctypes.POINTER(ctypes.c_long)]
+        lib.acs_flag_name.restype = ctypes.c_char_p
+        lib.acs_flag_name.argtypes = [ctypes.c_long]
+        lib.acs_eval.argtypes = [ctypes.c_int, ctypes.c_double, dp, dp, dp, ctypes.c_double,
+                                 dp]
+
+
+def library(cm):
+    """The compiled library of ``cm``, generated, built and loaded once."""
+    lib = _loaded.get(cm)
+    if lib is None:
+        lib = _loaded[cm] = _Library(cm)
+    return lib
+
+
+def _ptr(a, kind=ctypes.c_double):
+    return a.ctypes.data_as(ctypes.POINTER(kind))
+
+
+class CompiledSolver(SegmentSolver):
+    """A segment solver on the compiled library of ``cm``: one IDA handle
+    per run, re-initialised at each segment with that mode's discrete
+    values (``pd`` = parameters then discrete values)."""
+    name = "compiled"
+
+    def __init__(self, cm, p, opts):
+        self.cm, self.p = cm, np.asarray(p, float)
+        L = self.L = library(cm)
+        self.detail = "SUNDIALS IDA calling generated C" + (" (compiled now)" if L.built
+                                                              else " (from the cache)")
+        L.built = False
+        n = self.n = len(cm.dae.y)
+        self.nr = cm.n_roots
+        atol = np.ascontiguousarray(np.broadcast_to(np.asarray(opts["atol"], float), (n,)))
+        ident = np.zeros(n)
+        ident[:cm.dae.n_states] = 1.0
+        self.dirs = np.array([e.direction for e in cm.events] + [-1] * len(cm.assertions)
+                             or [0], dtype=np.intc)
+        self.terminal = [not e.observer for e in cm.events] + [True] * len(cm.assertions)
+        self.h = L.lib.acs_new(n, self.nr, L.n_pd, float(opts["rtol"]), _ptr(atol),
+                               _ptr(ident), _ptr(self.dirs, ctypes.c_int),
+                               float(opts.get("max_step") or 0.0), int(opts["max_num_steps"]))
+        if not self.h:
+            raise Unavailable("SUNDIALS refused the solver settings")
+        self._free = weakref.finalize(self, L.lib.acs_free, ctypes.c_void_p(self.h))
+        self.troot = np.zeros(1)
+        self.yroot, self.yproot = np.zeros(n), np.zeros(n)
+        self.rootinfo = np.zeros(max(self.nr, 1), dtype=np.intc)
+        self.counters = np.zeros(3, dtype=np.int_)
+
+    def solve(self, cb, d, t, y, yp, tout, every_step):
+        L, n = self.L.lib, self.n
+        tout = np.ascontiguousarray(tout, dtype=float)
+        y0, yp0 = np.ascontiguousarray(y, float), np.ascontiguousarray(yp, float)
+        pd = np.ascontiguousarray(np.concatenate([self.p, np.asarray(d, float)]))
+        flag = L.acs_start(self.h, float(t), _ptr(y0), _ptr(yp0), _ptr(pd), float(tout[-1]))
+        if flag < 0:
+            return Segment(np.array([t]), y0[None], yp0[None], flag, self._message(flag))
+        cap = 1024 if every_step else len(tout) + 1
+        T, Y, YP = [np.array([t])], [y0[None]], [yp0[None]]
+        roots, iout, nrows = [], ctypes.c_int(0), ctypes.c_int(0)
+        while True:
+            bt, by, byp = np.empty(cap), np.empty((cap, n)), np.empty((cap, n))
+            flag = L.acs_advance(self.h, _ptr(tout), len(tout), ctypes.byref(iout),
+                                 int(bool(every_step)), _ptr(bt), _ptr(by), _ptr(byp), cap,
+                                 ctypes.byref(nrows), _ptr(self.troot), _ptr(self.yroot),
+                                 _ptr(self.yproot), _ptr(self.rootinfo, ctypes.c_int))
+            k = nrows.value
+            if k:
+                T.append(bt[:k]), Y.append(by[:k]), YP.append(byp[:k])
+            if flag == _FULL:
+                continue
+            if flag != _ROOT:
+                break
+            fired = [i for i in range(self.nr) if self.rootinfo[i] != 0]
+            roots.append(Root(float(self.troot[0]), self.yroot.copy(), self.yproot.copy(),
+                              fired))
+            if any(self.terminal[i] for i in fired):
+                T.append(self.troot.copy()), Y.append(self.yroot[None].copy())
+                YP.append(self.yproot[None].copy())
+                break
+        L.acs_counters(self.h, self.counters.ctypes.data_as(ctypes.POINTER(ctypes.c_long)))
+        steps, nfev, njev = (int(c) for c in self.counters)
+        return Segment(np.concatenate(T), np.concatenate(Y), np.concatenate(YP),
+                       int(flag) if flag < 0 else (_ROOT if flag == _ROOT else 0),
+                       self._message(flag), roots, nfev, njev, steps)
+
+    def _message(self, flag):
+        if flag >= 0:
+            return "ok"
+        name = self.L.lib.acs_flag_name(flag)
+        return _MESSAGES.get(flag, "IDA failed") + (f" ({name.decode()})" if name else "")

@@ -1,0 +1,102 @@
+"""Stage 5b: generate C for the residual, its iteration matrix and the root
+functions, from the same reduced DAE as :mod:`acausal.codegen` (Python).
+
+The compiled backend (:mod:`acausal.backends.compiled`) links it with a
+small driver around SUNDIALS IDA, so that IDA calls it with no Python in
+between. Parameters and discrete values are one input array ``pd``
+(parameters first), so that one compiled library serves every mode and
+every parameter set. Sub-expressions are shared through ``sympy.cse``
+(common-subexpression elimination, as in the Python code);
+sympy's C99 printer writes the expressions (Piecewise as ``?:``).
+"""
+from dataclasses import dataclass
+
+import sympy as sp
+from sympy.printing.c import C99CodePrinter
+
+from .codegen import Names
+
+
+class _Printer(C99CodePrinter):
+    def _print_Heaviside(self, expr):   # the Python code's heaviside: 1/2 at 0
+        return f"acs_heaviside({self._print(expr.args[0])})"
+
+
+@dataclass(frozen=True)
+class CSource:
+    """The generated C and its sizes."""
+    text: str
+    n: int
+    n_roots: int
+    n_pd: int
+
+
+def _decls(n, has_yp):
+    lines = [f"  const double y{i} = y[{i}];" for i in range(n)]
+    lines += [f"  const double yp{i} = yp[{i}];" for i in range(n) if has_yp[i]]
+    return lines
+
+
+def _body(exprs, targets):
+    printer = _Printer()
+    if not exprs:
+        return []
+    reps, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("c_"), order="none")
+    lines = [f"  const double {v} = {printer.doprint(e)};" for v, e in reps]
+    lines += [f"  {t} = {printer.doprint(e)};" for t, e in zip(targets, reduced)]
+    return lines
+
+
+def _pd_decls(npar, nd):
+    return [f"  const double p{i} = pd[{i}];" for i in range(npar)] + \
+        [f"  const double d{j} = pd[{npar + j}];" for j in range(nd)]
+
+
+def _function(name, extra_args, decl, body):
+    head = (f"void {name}(double t, const double* y, const double* yp, const double* pd"
+            f"{extra_args})")
+    return [head, "{", "  (void)t; (void)y; (void)yp; (void)pd;"] + decl + body + ["}", ""]
+
+
+def generate_c(cm):
+    """C source of ``acs_res``, ``acs_jac`` (column-major ``J = dF/dy + cj
+    dF/dy'``, every entry written) and ``acs_roots`` for compiled model
+    ``cm`` (events first, then assertions, as in ``cm.callbacks``)."""
+    dae = cm.dae
+    n = len(dae.y)
+    names = Names(dae.y, dae.yp, cm.param_syms, cm.disc_syms)
+    roots = [cm.resolve(e.expr) for e in cm.events] + \
+        [cm.resolve(a.expr) for a in cm.assertions]
+    res = names.rename(dae.residuals, "a residual")
+    g = names.rename(roots, "an event")
+    real = {s: sp.Symbol(s.name, real=True) for s in names.allowed}
+    res = [r.xreplace(real) for r in res]
+    g = [e.xreplace(real) for e in g]
+    # the symbols as they stand in the expressions, found by name (whatever
+    # assumptions Names gives them)
+    by_name = {v.name: v for v in real.values()}
+    ysyms = [by_name.get(f"y{i}", sp.Symbol(f"y{i}", real=True)) for i in range(n)]
+    has_yp = [s is not None for s in dae.yp]
+    ypsyms = [by_name.get(f"yp{i}", sp.Symbol(f"yp{i}", real=True)) if has_yp[i] else None
+              for i in range(n)]
+    cj = sp.Symbol("cj", real=True)
+    jac, targets = [], []
+    for i, r in enumerate(res):
+        fs = r.free_symbols
+        for j in range(n):
+            e = sp.diff(r, ysyms[j]) if ysyms[j] in fs else sp.Integer(0)
+            if ypsyms[j] is not None and ypsyms[j] in fs:
+                e = e + cj * sp.diff(r, ypsyms[j])
+            if e != 0:
+                jac.append(e)
+                targets.append(f"J[{j * n + i}]")
+    decl = _decls(n, has_yp) + _pd_decls(len(cm.param_syms), len(cm.disc_syms))
+    L = ["#include <math.h>", "#include <string.h>",
+         "static double acs_heaviside(double x) { return x > 0 ? 1.0 : (x == 0 ? 0.5 : 0.0); }",
+         ""]
+    L += _function("acs_res", ", double* r", decl, _body(res, [f"r[{i}]" for i in range(n)]))
+    L += _function("acs_jac", ", double cj, double* J", decl,
+                   [f"  memset(J, 0, sizeof(double) * {n * n});"] + _body(jac, targets))
+    L += _function("acs_roots", ", double* g", decl,
+                   _body(g, [f"g[{i}]" for i in range(len(g))]))
+    return CSource("\n".join(L), n, len(g), len(cm.param_syms) + len(cm.disc_syms))
