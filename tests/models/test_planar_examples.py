@@ -1,0 +1,84 @@
+"""Planar reference models (models/examples/*planar*, slider_crank) against
+closed forms and independent scipy solutions."""
+import math
+import os
+import sys
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+from scipy.special import ellipk
+
+from acausal import compile_model
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "..", "models", "examples"))
+
+import pendulum_planar as pp  # noqa: E402
+import slider_crank as sc  # noqa: E402
+
+_CM = {}
+
+
+def compiled(name, build):
+    if name not in _CM:
+        _CM[name] = compile_model(build())
+    return _CM[name]
+
+
+# -- pendulum -------------------------------------------------------------------
+def exact_period(theta0):
+    J = pp.I + pp.M * pp.L**2
+    return 4 * math.sqrt(J / (pp.M * pp.G * pp.L)) * ellipk(math.sin(theta0 / 2) ** 2)
+
+
+def test_pendulum_small_angle_period():
+    cm = compiled("pend", pp.build)
+    th0 = 0.01
+    res = cm.simulate(t_end=4.0, rtol=1e-11, atol=1e-13, output_step=1e-4,
+                      params={"theta0": th0})
+    T, T0 = pp.period(res), pp.small_angle_period()
+    # T0 (1 + theta0^2/16): the first correction is 6e-6 here
+    assert abs(T / T0 - 1 - th0**2 / 16) < 1e-8
+    assert abs(T / exact_period(th0) - 1) < 1e-8
+
+
+def test_pendulum_large_angle_against_scipy_and_elliptic_period():
+    cm = compiled("pend", pp.build)
+    th0 = 2.5
+    ts = np.linspace(0, 4.0, 40001)
+    res = cm.simulate(t_end=4.0, rtol=1e-11, atol=1e-13, output_times=ts,
+                      params={"theta0": th0})
+    J = pp.I + pp.M * pp.L**2
+    k = pp.M * pp.G * pp.L / J
+    ref = solve_ivp(lambda t, z: [z[1], -k * math.sin(z[0])], [0, 4.0], [th0, 0.0],
+                    t_eval=ts, rtol=1e-12, atol=1e-14, method="DOP853")
+    th = res["pin.phi"] + math.pi / 2
+    assert np.max(np.abs(th - ref.y[0])) < 1e-7
+    assert abs(pp.period(res) / exact_period(th0) - 1) < 1e-7
+    assert pp.period(res) > 1.5 * pp.small_angle_period()       # truly nonlinear
+    # the bob on its circle
+    assert np.max(np.abs(np.hypot(res["bob.x"], res["bob.y"]) - pp.L)) < 1e-10
+
+
+# -- slider-crank -----------------------------------------------------------------
+def test_slider_crank_closed_form_kinematics_and_energy():
+    cm = compiled("sc", sc.build)
+    res = cm.simulate(t_end=1.0, rtol=1e-11, atol=1e-12, output_step=1e-3)
+    th, w = res["crank_pin.phi"], res["crank_pin.w"]
+    assert th[-1] - th[0] > 2 * 2 * math.pi                     # over two turns
+    r, l = sc.R, sc.L
+    root = np.sqrt(l**2 - (r * np.sin(th))**2)
+    x = r * np.cos(th) + root
+    v = -r * w * np.sin(th) * (1 + r * np.cos(th) / root)
+    assert np.max(np.abs(res["slider.x"] - x)) < 1e-9
+    assert np.max(np.abs(res["slider.vx"] - v)) < 1e-9
+    assert np.max(np.abs(res["slider.y"])) < 1e-12
+    # the rod's angle (closed form) and its centre half way between the pins
+    beta = np.arcsin(r * np.sin(th) / l)
+    assert np.max(np.abs(res["wrist.phi"] - beta)) < 1e-9
+    assert np.max(np.abs(res["rod_body.x"] - (r * np.cos(th) + x) / 2)) < 1e-9
+    # lossless: kinetic energy constant while the flywheel speed varies
+    E = sc.kinetic_energy(res)
+    assert np.max(np.abs(E / E[0] - 1)) < 1e-8
+    assert np.ptp(w) > 0.01 * sc.W0
