@@ -203,18 +203,48 @@ def _check(cm, full, J, z, fixed, n):
     if not bad.any():
         return
     names = [name for a, (_, _, name) in enumerate(fixed) if bad[n + a]]
+    rows = [k for k in range(n) if bad[k]]
     if names:
         detail = ", ".join(f"{nm} = {v:g}" for (_, v, nm) in fixed if nm in names)
+        owners = [cm.flat.owner_of(sp.Symbol(nm)) for nm in names]
+        hint = _component_explanation(cm, rows, f" (fixed starts {detail})", owners)
+        if hint is not None:
+            raise hint
         raise InitializationError(
             "inconsistent fixed start values: " + detail + " cannot all hold together with "
             "the model's equations (largest violation "
             f"{np.max(np.abs(full[n:])):.3g}); make some of them guesses "
             "(Start(value, fixed=False)) or correct them")
-    rows = [k for k in range(n) if bad[k]]
     origin = cm.dae.origins[rows[0]]
     what = origin.describe() if hasattr(origin, "describe") else str(origin)
-    raise InitializationError(f"no consistent initial point found: {what} "
-                              f"is violated by {full[rows[0]]:.3g}")
+    detail = f"; {what} is violated by {full[rows[0]]:.3g}"
+    hint = _component_explanation(cm, rows, detail)
+    if hint is not None:
+        raise hint
+    raise InitializationError(f"no consistent initial point found{detail}")
+
+
+def _component_explanation(cm, rows, detail, paths=()):
+    """A component class may explain an initialisation failure in its own
+    terms (a planar loop that cannot close names the loop and its joints):
+    the first error returned by ``initialization_failure(model, paths,
+    detail)`` of a component of the model, given the paths of the components
+    whose equations were violated; None when none explains it."""
+    paths = [p for p in paths if p]
+    for k in rows:
+        o = getattr(cm.dae.origins[k], "origin", None)
+        if o and o not in paths:
+            paths.append(o)
+    seen = set()
+    for comp in cm.model.walk():
+        fn = getattr(type(comp), "initialization_failure", None)
+        if fn is None or fn in seen:
+            continue
+        seen.add(fn)
+        err = fn(comp, cm.model, paths, detail)
+        if err is not None:
+            return err
+    return None
 
 
 def reinitialize(cm, cb, t, y, yp):

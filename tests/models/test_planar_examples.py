@@ -82,3 +82,65 @@ def test_slider_crank_closed_form_kinematics_and_energy():
     E = sc.kinetic_energy(res)
     assert np.max(np.abs(E / E[0] - 1)) < 1e-8
     assert np.ptp(w) > 0.01 * sc.W0
+
+
+# -- the report's cam-and-roller four-bar from bodies and joints --------------------
+FOURBAR = os.path.join(HERE, "..", "..", "models", "examples", "fourbar_planar.py")
+GENERIC = dict(e=0.04, f=0.1, r1=0.08, r2=0.03, r3=0.06)    # crank-rocker, large swing
+
+
+def wrap(a):
+    return (a + np.pi) % (2 * np.pi) - np.pi
+
+
+def fourbar_errors(res, geometry):
+    import fourbar_planar as fp
+    from acausal.mechanics.fourbar import fourbar_angles
+    th1, th2, th3 = fp.report_angles(res)
+    ref = np.array([fourbar_angles(a, **geometry) for a in th1])
+    return th1, np.max(np.abs(wrap(th2 - ref[:, 0]))), np.max(np.abs(wrap(th3 - ref[:, 1])))
+
+
+def test_fourbar_planar_report_geometry_matches_closed_form():
+    import fourbar_planar as fp
+    from acausal.modelfile import run_file
+    res, meas = run_file(FOURBAR)
+    th1, e2, e3 = fourbar_errors(res, fp.TABLE1)
+    assert abs(th1[-1] - fp.RA) < 1e-9 and th1[0] == 0.0     # latched -> released
+    assert e2 < 1e-9 and e3 < 1e-9
+    assert 0.0 < meas["t_release_s"] < 0.1
+
+
+def test_fourbar_planar_generic_geometry_over_turns_and_energy():
+    import fourbar_planar as fp
+    from acausal.modelfile import compile_file
+    _, cm = compile_file(FOURBAR)
+    res = cm.simulate(t_end=3.0, rtol=1e-10, atol=1e-12, output_step=1e-3,
+                      params={**GENERIC, "theta1_0": 2.5, "w1_0": 5.0, "spring.c": 0.0})
+    th1, e2, e3 = fourbar_errors(res, GENERIC)
+    assert th1[-1] - th1[0] > 2 * np.pi                       # more than a turn
+    assert e2 < 1e-9 and e3 < 1e-9
+    assert np.ptp(fp.report_angles(res)[2]) > 1.0              # the rocker swings
+    E = 0.5 * fp.JH * res["hook.w"]**2 + 0.5 * fp.JS * res["shaft.w"]**2
+    assert np.max(np.abs(E / E[0] - 1)) < 1e-8
+
+
+def test_unclosable_loop_names_the_loop_and_its_joints():
+    from acausal.mechanics.planar.loops import LoopClosureError
+    from acausal.modelfile import compile_file
+    _, cm = compile_file(FOURBAR)
+    with pytest.raises(LoopClosureError) as err:   # r1 + r2 + r3 < |AD|: too short
+        cm.simulate(t_end=0.01, params={"r1": 0.02})
+    msg = str(err.value)
+    assert "\n" not in msg and "cannot close" in msg
+    for joint in ("hook_pin", "shaft_pin", "roller_pin", "cam_pin"):
+        assert joint in msg
+
+
+@pytest.mark.slow
+def test_fourbar_planar_release_time_equals_the_1d_fourbar():
+    from acausal.modelfile import run_file
+    _, planar = run_file(FOURBAR)
+    _, one_d = run_file(os.path.join(HERE, "..", "..", "models", "examples", "fourbar.py"))
+    assert abs(planar["t_release_s"] - one_d["t_release_s"]) < 1e-9
+    assert abs(planar["theta3_at_release_rad"] - one_d["theta3_at_release_rad"]) < 1e-9

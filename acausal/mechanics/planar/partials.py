@@ -40,6 +40,13 @@ class PartialRigidLink(PartialTwoFrames):
         return [Eq(a.fx + b.fx, 0), Eq(a.fy + b.fy, 0),
                 Eq(a.tau + b.tau + (b.x - a.x) * b.fy - (b.y - a.y) * b.fx, 0)]
 
+    def initialization_failure(self, model, paths, detail=""):
+        """A :class:`~.loops.LoopClosureError` naming the kinematic loop
+        through the components ``paths`` whose equations the start could not
+        meet, or None (see :func:`acausal.initialize.initial_point`)."""
+        from .loops import closure_error
+        return closure_error(model, paths, detail)
+
 
 class PartialLineForce(PartialTwoFrames):
     """A force ``f`` [N] along the line from frame_a to frame_b (tension
