@@ -79,3 +79,9 @@ measures = {
         abs(x - slider_x(th)) for x, th in zip(res["slider.x"], res["crank_pin.phi"])),
     "energy_drift": lambda res: float(max(abs(kinetic_energy(res) / kinetic_energy(res)[0] - 1))),
 }
+
+
+def plot(res, path):
+    """``acausal simulate --plot``: the mechanism at the end of the run."""
+    from acausal.animate import plot_with_mechanism
+    plot_with_mechanism(res, path, title="slider-crank")
