@@ -225,23 +225,30 @@ def _check(cm, full, J, z, fixed, n):
 
 
 def _component_explanation(cm, rows, detail, paths=()):
-    """A component class may explain an initialisation failure in its own
-    terms (a planar loop that cannot close names the loop and its joints):
-    the first error returned by ``initialization_failure(model, paths,
-    detail)`` of a component of the model, given the paths of the components
-    whose equations were violated; None when none explains it."""
+    """The error a component gives for an initialisation failure in its own
+    terms (see :func:`ask_components`), from the violated residual ``rows``
+    and the component ``paths`` involved; None when none explains it."""
     paths = [p for p in paths if p]
     for k in rows:
         o = getattr(cm.dae.origins[k], "origin", None)
         if o and o not in paths:
             paths.append(o)
+    return ask_components(cm.model, "initialization_failure", paths, detail)
+
+
+def ask_components(model, method, paths, *args):
+    """A component class may explain a failure in its own terms (a planar
+    loop that cannot close, or that reached a dead centre, names the loop and
+    its joints): the first error returned by ``method(model, paths, *args)``
+    of a component class of the model (once per class), given the paths of
+    the components involved; None when none explains it."""
     seen = set()
-    for comp in cm.model.walk():
-        fn = getattr(type(comp), "initialization_failure", None)
+    for comp in model.walk():
+        fn = getattr(type(comp), method, None)
         if fn is None or fn in seen:
             continue
         seen.add(fn)
-        err = fn(comp, cm.model, paths, detail)
+        err = fn(comp, model, paths, *args)
         if err is not None:
             return err
     return None

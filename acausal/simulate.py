@@ -14,7 +14,7 @@ import numpy as np
 from sksundae.ida import IDA
 
 from .errors import ChatteringError, SolverError
-from .initialize import initial_point, reinitialize
+from .initialize import ask_components, initial_point, reinitialize
 from .result import Result
 
 CHATTER_COUNT = 100     # this many events ...
@@ -391,8 +391,13 @@ def _failure(run, cm, sol, cb):
                   "them is a small difference of large terms, give them their own absolute "
                   "tolerance (Experiment(atol_algebraic=...) or simulate(atol_algebraic=...), "
                   "in their SI units)")
-    return SolverError(f"IDA failed at t = {t:.9g} s{where}: {r.message}{extra}", t=t,
-                       component=comp, result=run.result("failed", r.message))
+    message = f"IDA failed at t = {t:.9g} s{where}: {r.message}{extra}"
+    result = run.result("failed", r.message)
+    hint = ask_components(cm.model, "solver_failure", [comp] if comp else [], message, t,
+                          result)
+    if hint is not None:
+        return hint
+    return SolverError(message, t=t, component=comp, result=result)
 
 
 def _safe_obs(cb, t, r):

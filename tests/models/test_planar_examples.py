@@ -144,3 +144,21 @@ def test_fourbar_planar_release_time_equals_the_1d_fourbar():
     _, one_d = run_file(os.path.join(HERE, "..", "..", "models", "examples", "fourbar.py"))
     assert abs(planar["t_release_s"] - one_d["t_release_s"]) < 1e-9
     assert abs(planar["theta3_at_release_rad"] - one_d["theta3_at_release_rad"]) < 1e-9
+
+
+def test_dead_centre_names_the_loop():
+    """A crank-rocker whose |AD| reaches r1 + r2 + r3: the coupler and the
+    rocker align (a toggle), where the loop locks; the error names the loop
+    and the partial result ends there."""
+    from acausal.mechanics.planar.loops import LoopSingularityError
+    from acausal.modelfile import compile_file
+    _, cm = compile_file(FOURBAR)
+    locking = dict(e=0.05, f=0.1, r1=0.06, r2=0.03, r3=0.05)
+    with pytest.raises(LoopSingularityError) as err:
+        cm.simulate(t_end=2.0, rtol=1e-10, atol=1e-12,
+                    params={**locking, "spring.c": 0.0, "w1_0": 5.0, "theta1_0": 0.2})
+    msg = str(err.value)
+    assert "\n" not in msg and "dead centre" in msg and "roller_pin" in msg
+    res = err.value.result
+    assert abs(np.sin(res["roller_pin.phi"][-1])) < 0.05         # coupler along rocker
+    assert err.value.t == pytest.approx(res.t[-1])

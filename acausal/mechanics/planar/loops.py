@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 from acausal.component import Model
 from acausal.connectors import Frame
-from acausal.errors import InitializationError
+from acausal.errors import InitializationError, SolverError
 
 from .partials import PartialRigidLink
 
@@ -19,6 +19,12 @@ from .partials import PartialRigidLink
 class LoopClosureError(InitializationError):
     """A kinematic loop cannot be assembled at the start (a link too short or
     too long for the others): the message names the loop and its joints."""
+
+
+class LoopSingularityError(SolverError):
+    """The solver failed in a kinematic loop: most likely a singular
+    configuration (dead centre: links aligned, where the loop locks or
+    switches assembly mode). The message names the loop and its joints."""
 
 
 @dataclass(frozen=True)
@@ -135,3 +141,17 @@ def closure_error(model, paths, detail=""):
     return LoopClosureError(
         f"kinematic {loop.name} cannot close at the start (joints: {joints}): the links "
         f"cannot reach each other with these lengths and start angles{detail}")
+
+
+def singularity_error(model, paths, message, t, result):
+    """A :class:`LoopSingularityError` when the solver failed in a component
+    of a kinematic loop (``paths``), or None."""
+    loop = loop_of(model, paths)
+    if loop is None:
+        return None
+    joints = ", ".join(loop.joints) or "none"
+    return LoopSingularityError(
+        f"kinematic {loop.name} (joints: {joints}) reached a singular configuration at "
+        f"t = {t:.9g} s, most likely a dead centre (links aligned: the loop locks or "
+        f"switches assembly mode there); {message}", t=t, component=paths[0] if paths else None,
+        result=result)

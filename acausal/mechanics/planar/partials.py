@@ -47,6 +47,12 @@ class PartialRigidLink(PartialTwoFrames):
         from .loops import closure_error
         return closure_error(model, paths, detail)
 
+    def solver_failure(self, model, paths, message, t, result):
+        """A :class:`~.loops.LoopSingularityError` when the solver failed in
+        a component of a kinematic loop (see :func:`acausal.simulate`)."""
+        from .loops import singularity_error
+        return singularity_error(model, paths, message, t, result)
+
 
 class PartialLineForce(PartialTwoFrames):
     """A force ``f`` [N] along the line from frame_a to frame_b (tension
