@@ -151,8 +151,9 @@ def _safe_coefficient(c, params):
 def _solve_linear_block(exprs, us, params, values=None, max_size=12, max_varying=2):
     """Solve a block of equations linear in its unknowns, with constant
     (parameter) coefficients, symbolically; None when it is not such a block.
-    Coefficients that depend on variables are accepted for blocks of at most
-    ``max_varying`` unknowns only."""
+    A larger block (more than ``max_varying`` unknowns) whose coefficients
+    depend on variables is first eliminated on constant pivots, if it can be
+    (:func:`_constant_pivot_solve`)."""
     if len(us) > max_size:
         return None
     try:
@@ -163,13 +164,16 @@ def _solve_linear_block(exprs, us, params, values=None, max_size=12, max_varying
         return None
     if any(set(us) & bi.free_symbols for bi in b):
         return None
+    simplify = True
     if not all(a.free_symbols <= params for a in A):
         if len(us) > max_varying:
             # coefficients that move with the variables (a planar body's
             # r x f): pivots fixed at the start values could vanish later in
-            # the motion, so eliminate on constant pivots only, or leave the
-            # block to IDA's Newton
-            return _constant_pivot_solve(A, b, params, values)
+            # the motion, so first try to eliminate on constant pivots only
+            x = _constant_pivot_solve(A, b, params, values)
+            if x is not None:
+                return x
+            simplify = False    # cancel on trigonometric entries costs seconds
         # pivots chosen numerically at the start values (partial pivoting),
         # then imposed on the symbolic LU by reordering the rows: sympy would
         # otherwise take the first structurally non-zero pivot, which can be
@@ -185,7 +189,7 @@ def _solve_linear_block(exprs, us, params, values=None, max_size=12, max_varying
         x = A.LUsolve(b)
     except (ValueError, ZeroDivisionError):
         return None
-    return [sp.cancel(xi) if xi.count_ops() < 200 else xi for xi in x]
+    return [sp.cancel(xi) if simplify and xi.count_ops() < 200 else xi for xi in x]
 
 
 def _constant_pivot_solve(A, b, params, values):
@@ -229,16 +233,20 @@ def _constant_pivot_solve(A, b, params, values):
     return x
 
 
-def _simplified_pivot(M, k, params, values, max_ops=80):
-    """A pivot from the remaining entries that ``trigsimp`` shows to be made
-    of parameters only (a body's ``I + m r^2 (sin^2 + cos^2)``); the entry is
-    replaced by its simplified form. None when there is none."""
-    best = None
+def _simplified_pivot(M, k, params, values, max_ops=30, max_tries=6):
+    """A pivot from the remaining diagonal entries that ``trigsimp`` shows to
+    be made of parameters only (a body's ``I + m r^2 (sin^2 + cos^2)``); the
+    entry is replaced by its simplified form. None when there is none (at
+    most ``max_tries`` small entries are simplified: trigsimp is slow)."""
+    best, tries = None, 0
     for i in range(k, M.rows):
-        for j in range(k, M.cols):
+        for j in (i,):
             a = M[i, j]
             if a == 0 or a.count_ops() > max_ops or not a.has(sp.sin, sp.cos):
                 continue
+            tries += 1
+            if tries > max_tries:
+                return best
             s = sp.trigsimp(a)
             if s == 0 or not s.free_symbols <= params:
                 continue
