@@ -9,7 +9,6 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.special import ellipk
 
-from acausal import compile_model
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "models", "examples"))
@@ -17,13 +16,14 @@ sys.path.insert(0, os.path.join(HERE, "..", "..", "models", "examples"))
 import pendulum_planar as pp  # noqa: E402
 import slider_crank as sc  # noqa: E402
 
-_CM = {}
+EXAMPLES = os.path.join(HERE, "..", "..", "models", "examples")
 
 
-def compiled(name, build):
-    if name not in _CM:
-        _CM[name] = compile_model(build())
-    return _CM[name]
+def compiled(name):
+    """The model file's compiled model (shared with the other tests of this
+    process through the model-file cache)."""
+    from acausal.modelfile import compile_file
+    return compile_file(os.path.join(EXAMPLES, name))[1]
 
 
 # -- pendulum -------------------------------------------------------------------
@@ -33,7 +33,7 @@ def exact_period(theta0):
 
 
 def test_pendulum_small_angle_period():
-    cm = compiled("pend", pp.build)
+    cm = compiled("pendulum_planar.py")
     th0 = 0.01
     res = cm.simulate(t_end=4.0, rtol=1e-11, atol=1e-13, output_step=1e-4,
                       params={"theta0": th0})
@@ -44,7 +44,7 @@ def test_pendulum_small_angle_period():
 
 
 def test_pendulum_large_angle_against_scipy_and_elliptic_period():
-    cm = compiled("pend", pp.build)
+    cm = compiled("pendulum_planar.py")
     th0 = 2.5
     ts = np.linspace(0, 4.0, 40001)
     res = cm.simulate(t_end=4.0, rtol=1e-11, atol=1e-13, output_times=ts,
@@ -63,7 +63,7 @@ def test_pendulum_large_angle_against_scipy_and_elliptic_period():
 
 # -- slider-crank -----------------------------------------------------------------
 def test_slider_crank_closed_form_kinematics_and_energy():
-    cm = compiled("sc", sc.build)
+    cm = compiled("slider_crank.py")
     res = cm.simulate(t_end=1.0, rtol=1e-11, atol=1e-12, output_step=1e-3)
     th, w = res["crank_pin.phi"], res["crank_pin.w"]
     assert th[-1] - th[0] > 2 * 2 * math.pi                     # over two turns
