@@ -2,6 +2,7 @@
 solution of its own equations of motion (written here from first
 principles, not from the components)."""
 import numpy as np
+import pytest
 from scipy.integrate import solve_ivp
 
 from acausal import Model, compile_model
@@ -14,6 +15,7 @@ from acausal.mechanics.planar.parts import Body, Fixed, FixedTranslation
 TOL = dict(rtol=1e-10, atol=1e-12)
 
 
+@pytest.mark.slow
 def test_body_free_flight_and_spin():
     """Projectile under gravity and a constant spin: closed form."""
     m = Model()
@@ -29,6 +31,7 @@ def test_body_free_flight_and_spin():
     assert np.max(np.abs(res["b.phi"] - (0.1 - 4.0 * t))) < 1e-9
 
 
+@pytest.mark.slow
 def test_line_spring_damper_against_scipy():
     """A body on a spring-damper to a fixed point, in 2-D with gravity."""
     mass, c, d, s0, g, x0, y0 = 0.4, 30.0, 0.5, 0.2, 9.81, 0.15, -0.25
