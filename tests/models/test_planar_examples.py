@@ -146,6 +146,7 @@ def test_fourbar_planar_release_time_equals_the_1d_fourbar():
     assert abs(planar["theta3_at_release_rad"] - one_d["theta3_at_release_rad"]) < 1e-9
 
 
+@pytest.mark.slow
 def test_dead_centre_names_the_loop():
     """A crank-rocker whose |AD| reaches r1 + r2 + r3: the coupler and the
     rocker align (a toggle), where the loop locks; the error names the loop
