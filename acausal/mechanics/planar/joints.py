@@ -20,7 +20,11 @@ class Revolute(PartialRigidLink):
     The 1-D ``axis`` flange carries the joint angle (relative: a rotational
     ``Fixed`` on it stands for frame_a); a torsion spring from such a
     ``Fixed`` to ``axis`` acts on frame_b with ``-c*phi`` and on frame_a with
-    ``+c*phi``. Unconnected, it carries no torque (a free pin).
+    ``+c*phi``. End stops: the 1-D library has no rotational stop, so put
+    an ``IdealLever`` (``arm`` [m]) on ``axis`` and a translational
+    :class:`~acausal.mechanics.contact.EndStop` at ``s_limit = arm *
+    phi_limit`` on its ``flange_t``. Unconnected, it carries no torque (a
+    free pin).
 
     Parameters: none. States: ``phi`` [rad] joint angle, ``w`` [rad/s] its
     rate (give their starts to choose the states of a loop).

@@ -120,3 +120,33 @@ def test_prismatic_on_an_inclined_frame_with_spring():
     nx, ny = -np.sin(a), np.cos(a)
     fn = res["slide.frame_b.fx"] * nx + res["slide.frame_b.fy"] * ny
     assert np.max(np.abs(fn + mass * g * np.cos(a))) < 1e-7
+
+
+@pytest.mark.slow
+def test_prismatic_end_stop_on_its_axis_equals_the_1d_mass_on_a_stop():
+    """An end stop is the 1-D EndStop on the joint's axis flange: a slider on
+    a 45 deg guide hits it exactly as a 1-D mass hits the same stop."""
+    from acausal.mechanics.contact import EndStop
+    a, mass = np.radians(45.0), 0.3
+    stop = dict(s_limit=0.05, side="upper", K=1e8, e=0.7, peak_event=False)
+    m = Model()
+    m.ground = Fixed(phi0=a)
+    m.slide = Prismatic(s=0.0, v=2.0)
+    m.b = Body(m=mass, I=0.01)
+    m.stop = EndStop(**stop)
+    m.connect(m.ground.frame, m.slide.frame_a)
+    m.connect(m.slide.frame_b, m.b.frame)
+    m.connect(m.slide.axis, m.stop.flange)
+    r = Model()
+    r.m = tr.Mass(m=mass, s=0.0, v=2.0)
+    r.stop = EndStop(**stop)
+    r.connect(r.m.flange, r.stop.flange)
+    ts = np.linspace(0, 0.06, 301)
+    res = compile_model(m).simulate(t_end=0.06, output_times=ts, **TOL)
+    ref = compile_model(r).simulate(t_end=0.06, output_times=ts, **TOL)
+    i, j = np.searchsorted(res.t, ts), np.searchsorted(ref.t, ts)
+    assert np.max(np.abs(res["slide.s"][i] - ref["m.s"][j])) < 1e-9
+    assert np.max(np.abs(res["b.x"][i] - np.cos(a) * ref["m.s"][j])) < 1e-9
+    assert res["slide.v"][-1] < -1.0                                   # it bounced back
+    assert abs(res["slide.v"][-1] - ref["m.v"][-1]) < 1e-8
+    assert [n for _, n in res.events][:2] == ["stop.onset", "stop.release"]
