@@ -8,7 +8,7 @@ from sympy import Eq, Piecewise, cos, exp, sin, sqrt  # noqa: F401  (for model f
 
 from .component import Component, Model
 from .compile import CompiledModel, compile_model
-from .connectors import Flange, Port, RotFlange
+from .connectors import Flange, Frame, Port, RotFlange
 from .declare import Assertion, Discrete, Event, Parameter, Start, Variable, guess
 from .experiment import Experiment, Measure, Stop
 from .errors import (AcausalError, ChatteringError, InitializationError, LimitError, ModelError,
@@ -16,7 +16,7 @@ from .errors import (AcausalError, ChatteringError, InitializationError, LimitEr
 from .symbols import der, time
 
 __all__ = [
-    "Component", "Model", "CompiledModel", "compile_model", "Flange", "RotFlange", "Port",
+    "Component", "Model", "CompiledModel", "compile_model", "Flange", "RotFlange", "Frame", "Port",
     "Parameter", "Variable", "Discrete", "Event", "Assertion", "Start", "guess", "der",
     "time", "Eq", "Experiment", "Measure", "Stop", "AcausalError", "ModelError",
     "ParameterError", "StructuralError",

@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 import sympy as sp
 
-FORMAT = 2
+FORMAT = 3
 _OFF = {"off", "0", "none", "false", "no"}
 _COMPILER_MODULES = ("flatten", "aliases", "structure", "causalize", "codegen", "compile",
                      "fastdiff", "symbols", "cache", "declare")
@@ -50,6 +50,7 @@ class Entry:
     source: str
     sparsity: object
     root_via: dict = None   # root -> (alias name, sign, offset): start values set per run
+    propagated: dict = None  # guesses of frame positions/angles from the start values
     format: int = FORMAT
 
 

@@ -149,9 +149,12 @@ def _safe_coefficient(c, params):
     return not c.has(sp.Piecewise, sp.Heaviside, sp.sign, sp.Abs, sp.Max, sp.Min)
 
 
-def _solve_linear_block(exprs, us, params, values=None, max_size=12):
+def _solve_linear_block(exprs, us, params, values=None, max_size=12, max_varying=2):
     """Solve a block of equations linear in its unknowns, with constant
-    (parameter) coefficients, symbolically; None when it is not such a block."""
+    (parameter) coefficients, symbolically; None when it is not such a block.
+    A larger block (more than ``max_varying`` unknowns) whose coefficients
+    depend on variables is first eliminated on constant pivots, if it can be
+    (:func:`_constant_pivot_solve`)."""
     if len(us) > max_size:
         return None
     try:
@@ -162,7 +165,16 @@ def _solve_linear_block(exprs, us, params, values=None, max_size=12):
         return None
     if any(set(us) & bi.free_symbols for bi in b):
         return None
+    simplify = True
     if not all(a.free_symbols <= params for a in A):
+        if len(us) > max_varying:
+            # coefficients that move with the variables (a planar body's
+            # r x f): pivots fixed at the start values could vanish later in
+            # the motion, so first try to eliminate on constant pivots only
+            x = _constant_pivot_solve(A, b, params, values)
+            if x is not None:
+                return x
+            simplify = False    # cancel on trigonometric entries costs seconds
         # pivots chosen numerically at the start values (partial pivoting),
         # then imposed on the symbolic LU by reordering the rows: sympy would
         # otherwise take the first structurally non-zero pivot, which can be
@@ -178,7 +190,72 @@ def _solve_linear_block(exprs, us, params, values=None, max_size=12):
         x = A.LUsolve(b)
     except (ValueError, ZeroDivisionError):
         return None
-    return [sp.cancel(xi) if xi.count_ops() < 200 else xi for xi in x]
+    return [sp.cancel(xi) if simplify and xi.count_ops() < 200 else xi for xi in x]
+
+
+def _constant_pivot_solve(A, b, params, values):
+    """Gaussian elimination of ``A x = b`` whose every pivot is made of
+    numbers and parameters only (full pivoting, largest at the start values,
+    among such entries), so that no pivot can vanish as the variables move;
+    None when the elimination runs out of such pivots. No ``cancel`` (it
+    costs seconds on trigonometric entries and gains nothing at run time)."""
+    n = A.rows
+    M, rhs, cols = A.as_mutable(), b.as_mutable(), list(range(n))
+    for k in range(n):
+        best = None
+        for i in range(k, n):
+            for j in range(k, n):
+                a = M[i, j]
+                if a == 0 or not a.free_symbols <= params:
+                    continue
+                v = abs(_numeric(a, values))
+                if np.isfinite(v) and v > 1e-12 and (best is None or v > best[0]):
+                    best = (v, i, j)
+        if best is None:
+            best = _simplified_pivot(M, k, params, values)
+        if best is None:
+            return None
+        _, i, j = best
+        M.row_swap(k, i)
+        rhs.row_swap(k, i)
+        M.col_swap(k, j)
+        cols[k], cols[j] = cols[j], cols[k]
+        for i in range(k + 1, n):
+            if M[i, k] != 0:
+                fct = M[i, k] / M[k, k]
+                for j in range(k + 1, n):
+                    M[i, j] = M[i, j] - fct * M[k, j]
+                rhs[i] = rhs[i] - fct * rhs[k]
+                M[i, k] = 0
+    x = [None] * n
+    for k in reversed(range(n)):
+        acc = rhs[k] - sp.Add(*[M[k, j] * x[cols[j]] for j in range(k + 1, n)])
+        x[cols[k]] = acc / M[k, k]
+    return x
+
+
+def _simplified_pivot(M, k, params, values, max_ops=30, max_tries=6):
+    """A pivot from the remaining diagonal entries that ``trigsimp`` shows to
+    be made of parameters only (a body's ``I + m r^2 (sin^2 + cos^2)``); the
+    entry is replaced by its simplified form. None when there is none (at
+    most ``max_tries`` small entries are simplified: trigsimp is slow)."""
+    best, tries = None, 0
+    for i in range(k, M.rows):
+        for j in (i,):
+            a = M[i, j]
+            if a == 0 or a.count_ops() > max_ops or not a.has(sp.sin, sp.cos):
+                continue
+            tries += 1
+            if tries > max_tries:
+                return best
+            s = sp.trigsimp(a)
+            if s == 0 or not s.free_symbols <= params:
+                continue
+            M[i, j] = s
+            v = abs(_numeric(s, values))
+            if np.isfinite(v) and v > 1e-12 and (best is None or v > best[0]):
+                best = (v, i, j)
+    return best
 
 
 def _blt(eqs, unknowns):

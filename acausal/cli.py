@@ -1,4 +1,4 @@
-"""The ``acausal`` command: simulate, variables, calibrate, sweep, diagnose.
+"""The ``acausal`` command: simulate, animate, variables, calibrate, sweep, diagnose.
 
 Exit codes: 0 success, 2 a model or input error (an AcausalError: one
 readable line on stderr), 3 a solver failure (time and component named).
@@ -231,6 +231,33 @@ def _plot(mf, res, path, partial=False):
                 raise
         custom = None
     res.plot(custom or None, path, title=mf.path.rsplit("/", 1)[-1])
+
+
+@main.command()
+@click.argument("file", type=click.Path(dir_okay=False))
+@click.option("--out", required=True, type=click.Path(dir_okay=False),
+              help="animation file: .gif (Pillow) or .mp4 (needs ffmpeg)")
+@click.option("--t-end", type=float, help="stop time [s] (default: the model file's)")
+@click.option("--set", "sets", multiple=True, metavar="PATH=VALUE",
+              help="override a parameter, e.g. --set crank_pin.w=10")
+@click.option("--fps", type=int, default=25, show_default=True)
+@click.option("--frames", type=int, default=150, show_default=True,
+              help="largest number of frames (evenly spaced in time)")
+def animate(file, out, t_end, sets, fps, frames):
+    """Simulate a planar model file and animate its mechanism."""
+    from .animate import animate as write_animation
+    from .modelfile import compile_file
+    try:
+        mf, cm = compile_file(file)
+        opts = mf.experiment.run_options()
+        if t_end is not None:
+            opts["t_end"] = t_end
+        res = cm.simulate(params=_parse_sets(sets), **opts)
+        ks = write_animation(res, out, fps=fps, max_frames=frames,
+                             title=mf.path.rsplit("/", 1)[-1])
+    except (AcausalError, click.BadParameter) as exc:
+        _fail(exc)
+    click.echo(f"wrote {out}: {len(ks)} frames, t = {res.t[0]:g} .. {res.t[-1]:g} s")
 
 
 @main.command()

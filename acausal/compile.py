@@ -80,6 +80,7 @@ class CompiledModel:
             make, fixjac = load_generated(entry.source)
         self.reduced, self.graph, self.dae = entry.reduced, entry.graph, entry.dae
         self._root_starts, self._root_via = entry.root_starts, entry.root_via or {}
+        self._propagated = entry.propagated or {}
         self._subs = dict(self.reduced.param_subs)
         self._alias = self.reduced.subs
         self.source, self._make, self._fixjac = entry.source, make, fixjac
@@ -94,7 +95,10 @@ class CompiledModel:
         g = self.graph = Graph(red.equations, red.unknowns)
         pantelides(g)
         self._root_starts, self._root_via = _alias_starts(flat, red)
-        values = self._start_values()
+        open_across = _open_across(self.model, flat, red)
+        values = _propagate_starts(red.equations, self._start_values(), open_across)
+        # guesses of the frames' positions and angles (at the default parameters)
+        self._propagated = {s: values[s] for s in open_across if s in values}
         fixed = {v.symbol for v in flat.variables.values() if v.start.fixed}
         fixed |= {r for r, st in self._root_starts.items() if st.fixed}
         dummies = dummy_derivatives(g, values, lambda s: base_and_order(s)[0] in fixed)
@@ -110,7 +114,7 @@ class CompiledModel:
                       if flat.variables[n].start.fixed]
         gen = generate(self.dae, self.param_syms, self.disc_syms, roots, observed, fixed_rows)
         entry = _cache.Entry(key, red, g, self._root_starts, self.dae, gen.source,
-                             gen.sparsity, self._root_via)
+                             gen.sparsity, self._root_via, self._propagated)
         return entry, gen.make, gen.fixjac
 
     # -- symbol resolution -------------------------------------------------
@@ -313,6 +317,8 @@ class CompiledModel:
             else:
                 st = self._root_starts.get(base, info.start)
                 y[i] = self._eval_start(st.value, p)
+                if base in self._propagated:
+                    y[i] = self._propagated[base]
         return y
 
     def state_guess_order(self):
@@ -364,6 +370,55 @@ class CompiledModel:
         hold this compiled model: see :func:`acausal.batch.simulate_batch`."""
         from .batch import simulate_batch
         return simulate_batch(self, param_sets, **kw)
+
+
+def _open_across(model, flat, red):
+    """Connector across variables left as unknowns with no start of their own
+    (a zero guess): the positions and angles of the frames between planar
+    links, which only the equations can place."""
+    out = set()
+    unknowns = set(red.unknowns)
+    for comp in model.walk():
+        for name in comp.connectors():
+            for a, _ in comp.port(name).pairs():
+                st = flat.variables[a.name].start
+                if a in unknowns and not st.fixed and st.value == 0:
+                    out.add(a)
+    return out
+
+
+def _propagate_starts(equations, values, open_vars, max_rounds=50):
+    """Start values of ``open_vars`` propagated through the equations (each
+    equation with one of them left, linear in it, gives its value from the
+    others), so that the Jacobians of the state selection are evaluated at
+    a configuration the equations describe (a planar loop whose link angles
+    all start at 0 would look like a dead centre). The Modelica tools'
+    start-value propagation; only the values for the structural stages
+    change, not the initialisation's guesses."""
+    vals = dict(values)
+    todo = set(open_vars)
+    for _ in range(max_rounds):
+        progress = False
+        for eq in equations:
+            left = [s for s in eq.expr.free_symbols if s in todo]
+            if len(left) != 1:
+                continue
+            u = left[0]
+            coeff = sp.diff(eq.expr, u)
+            if coeff.has(u):
+                continue
+            try:
+                c = float(coeff.xreplace(vals))
+                rest = float(eq.expr.xreplace({u: 0}).xreplace(vals))
+            except (TypeError, ValueError):
+                continue
+            if abs(c) > 1e-12 and np.isfinite(rest):
+                vals[u] = -rest / c
+                todo.discard(u)
+                progress = True
+        if not progress or not todo:
+            break
+    return vals
 
 
 def _alias_starts(flat, red):

@@ -34,9 +34,8 @@ class Stop:
                 s = comp.symbol(dname)
                 names[s.name] = s
             for pname in comp.connectors():
-                port = comp.port(pname)
-                names[port.across.name] = port.across
-                names[port.through.name] = port.through
+                for pair in comp.port(pname).pairs():
+                    names.update((s.name, s) for s in pair)
 
         def conv(side):
             if isinstance(side, str):

@@ -99,9 +99,10 @@ def _declare(flat, comp):
             flat.discretes[sym.name] = VarInfo(sym, Start(d.start, True), d.unit, d.desc, path)
     for name, ctype in comp.connectors().items():
         port = comp.port(name)
-        for (vname, unit, desc), sym in ((ctype.across, port.across),
-                                         (ctype.through, port.through)):
-            flat.variables[sym.name] = VarInfo(sym, Start(0.0, False), unit, desc, path, True)
+        for decls, syms in zip(ctype.pairs(), port.pairs()):
+            for (vname, unit, desc), sym in zip(decls, syms):
+                flat.variables[sym.name] = VarInfo(sym, Start(0.0, False), unit, desc, path,
+                                                   True)
 
 
 def relocate(expr, comp, known, start=None):
@@ -220,13 +221,19 @@ def _connections(flat, model, comps):
     for port in parent:
         sets.setdefault(find(port), []).append(port)
     for members in sets.values():
+        if len(members) == 1 and members[0].ctype.optional:
+            for _, through in members[0].pairs():   # unconnected optional: no force
+                flat.equations.append(Equation(through, members[0].path,
+                                               "unconnected optional connector"))
+            continue
         if len(members) == 1:
             flat.unconnected.append(members[0].path)
             continue
         members.sort(key=lambda p: p.path)
         where = "connect(" + ", ".join(p.path for p in members) + ")"
-        a0 = members[0].across
-        for p in members[1:]:
-            flat.equations.append(Equation(p.across - a0, where, "connection (across equal)"))
-        flat.equations.append(Equation(sp.Add(*[p.through for p in members]), where,
-                                       "connection (through sum to zero)"))
+        for k, (a0, _) in enumerate(members[0].pairs()):
+            for p in members[1:]:
+                flat.equations.append(Equation(p.pairs()[k][0] - a0, where,
+                                               "connection (across equal)"))
+            flat.equations.append(Equation(sp.Add(*[p.pairs()[k][1] for p in members]),
+                                           where, "connection (through sum to zero)"))

@@ -259,18 +259,55 @@ def _check(cm, full, J, z, fixed, n):
     if not bad.any():
         return
     names = [name for a, (_, _, name) in enumerate(fixed) if bad[n + a]]
+    rows = [k for k in range(n) if bad[k]]
     if names:
         detail = ", ".join(f"{nm} = {v:g}" for (_, v, nm) in fixed if nm in names)
+        owners = [cm.flat.owner_of(sp.Symbol(nm)) for nm in names]
+        hint = _component_explanation(cm, rows, f" (fixed starts {detail})", owners)
+        if hint is not None:
+            raise hint
         raise InitializationError(
             "inconsistent fixed start values: " + detail + " cannot all hold together with "
             "the model's equations (largest violation "
             f"{np.max(np.abs(full[n:])):.3g}); make some of them guesses "
             "(Start(value, fixed=False)) or correct them")
-    rows = [k for k in range(n) if bad[k]]
     origin = cm.dae.origins[rows[0]]
     what = origin.describe() if hasattr(origin, "describe") else str(origin)
-    raise InitializationError(f"no consistent initial point found: {what} "
-                              f"is violated by {full[rows[0]]:.3g}")
+    detail = f"; {what} is violated by {full[rows[0]]:.3g}"
+    hint = _component_explanation(cm, rows, detail)
+    if hint is not None:
+        raise hint
+    raise InitializationError(f"no consistent initial point found{detail}")
+
+
+def _component_explanation(cm, rows, detail, paths=()):
+    """The error a component gives for an initialisation failure in its own
+    terms (see :func:`ask_components`), from the violated residual ``rows``
+    and the component ``paths`` involved; None when none explains it."""
+    paths = [p for p in paths if p]
+    for k in rows:
+        o = getattr(cm.dae.origins[k], "origin", None)
+        if o and o not in paths:
+            paths.append(o)
+    return ask_components(cm.model, "initialization_failure", paths, detail)
+
+
+def ask_components(model, method, paths, *args):
+    """A component class may explain a failure in its own terms (a planar
+    loop that cannot close, or that reached a dead centre, names the loop and
+    its joints): the first error returned by ``method(model, paths, *args)``
+    of a component class of the model (once per class), given the paths of
+    the components involved; None when none explains it."""
+    seen = set()
+    for comp in model.walk():
+        fn = getattr(type(comp), method, None)
+        if fn is None or fn in seen:
+            continue
+        seen.add(fn)
+        err = fn(comp, model, paths, *args)
+        if err is not None:
+            return err
+    return None
 
 
 def reinitialize(cm, cb, t, y, yp):

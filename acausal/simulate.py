@@ -17,7 +17,7 @@ import numpy as np
 
 from .backends import BACKENDS, BackendError, make_solver
 from .errors import ChatteringError, LimitError, ModelError, SolverError, UsageError
-from .initialize import initial_point, reinitialize
+from .initialize import ask_components, initial_point, reinitialize
 from .result import Result
 
 CHATTER_COUNT = 100     # this many events ...
@@ -587,8 +587,13 @@ def _failure(run, cm, sol, cb):
                   "them is a small difference of large terms, give them their own absolute "
                   "tolerance (Experiment(atol_algebraic=...) or simulate(atol_algebraic=...), "
                   "in their SI units)")
-    return SolverError(f"IDA failed at t = {t:.9g} s{where}: {r.message}{extra}", t=t,
-                       component=comp, result=run.result("failed", r.message))
+    message = f"IDA failed at t = {t:.9g} s{where}: {r.message}{extra}"
+    result = run.result("failed", r.message)
+    hint = ask_components(cm.model, "solver_failure", [comp] if comp else [], message, t,
+                          result)
+    if hint is not None:
+        return hint
+    return SolverError(message, t=t, component=comp, result=result)
 
 
 def _safe_obs(cb, t, r):

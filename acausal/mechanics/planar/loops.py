@@ -1,0 +1,157 @@
+"""Kinematic loops of a planar model and the message when one cannot close.
+
+The frames joined by ``connect`` form nodes; every fixed frame is the world
+node; every rigid link or joint (a :class:`~.partials.PartialRigidLink`) is
+an edge between the nodes of its two frames (line forces constrain nothing).
+A spanning tree of that graph leaves one independent (fundamental) loop per
+edge outside the tree (Wittenburg's graph-theoretic treatment of multibody
+systems): loop k is that edge plus the tree path between its ends.
+"""
+from dataclasses import dataclass
+
+from acausal.component import Model
+from acausal.connectors import Frame
+from acausal.errors import InitializationError, SolverError
+
+from .partials import PartialRigidLink
+
+
+class LoopClosureError(InitializationError):
+    """A kinematic loop cannot be assembled at the start (a link too short or
+    too long for the others): the message names the loop and its joints."""
+
+
+class LoopSingularityError(SolverError):
+    """The solver failed in a kinematic loop: most likely a singular
+    configuration (dead centre: links aligned, where the loop locks or
+    switches assembly mode). The message names the loop and its joints."""
+
+
+@dataclass(frozen=True)
+class Loop:
+    """One independent kinematic loop: its links and joints (paths, in
+    order around the loop) and the frame nodes it passes through."""
+
+    links: tuple
+    joints: tuple
+    nodes: frozenset
+
+    @property
+    def name(self):
+        return "loop " + " - ".join(self.links)
+
+
+def _nodes(model):
+    """Frame port path -> node id (fixed frames share the node 'world')."""
+    from .parts import Fixed
+    parent = {}
+
+    def find(p):
+        while parent[p] != p:
+            parent[p] = parent[parent[p]]
+            p = parent[p]
+        return p
+
+    for comp in model.walk():
+        for name, ctype in comp.connectors().items():
+            if isinstance(ctype, Frame):
+                path = comp.port(name).path
+                parent.setdefault(path, path)
+                if isinstance(comp, Fixed):
+                    parent.setdefault("world", "world")
+                    parent[find(path)] = find("world")
+    for m in model.walk():
+        if isinstance(m, Model):
+            for group in m._connections:
+                frames = [p.path for p in group if isinstance(p.ctype, Frame)]
+                for p in frames[1:]:
+                    parent[find(p)] = find(frames[0])
+    return {p: find(p) for p in parent}
+
+
+def kinematic_loops(model):
+    """The independent kinematic loops of ``model`` (a list of :class:`Loop`)."""
+    node = _nodes(model)
+    edges = [(c.path, node[c.frame_a.path], node[c.frame_b.path], c)
+             for c in model.walk() if isinstance(c, PartialRigidLink)]
+    adj, tree, loops = {}, {}, []
+    for path, a, b, c in edges:
+        if a == b:
+            loops.append(((path,), {a}))
+            continue
+        ra, rb = _root(tree, a), _root(tree, b)
+        if ra != rb:
+            tree[ra] = rb
+            adj.setdefault(a, []).append((b, path))
+            adj.setdefault(b, []).append((a, path))
+        else:
+            chain, nodes = _path(adj, a, b)
+            loops.append(((path,) + chain, nodes))
+    kinds = {p: c for p, _, _, c in edges}
+    from .joints import Prismatic, Revolute
+    return [Loop(links, tuple(p for p in links if isinstance(kinds[p], (Revolute, Prismatic))),
+                 frozenset(nodes)) for links, nodes in loops]
+
+
+def _root(tree, x):
+    while x in tree:
+        x = tree[x]
+    return x
+
+
+def _path(adj, a, b):
+    """Edge paths and nodes of the tree path from a to b (depth first)."""
+    stack, seen = [(a, (), (a,))], {a}
+    while stack:
+        n, chain, nodes = stack.pop()
+        if n == b:
+            return chain, set(nodes)
+        for m, e in adj.get(n, []):
+            if m not in seen:
+                seen.add(m)
+                stack.append((m, chain + (e,), nodes + (m,)))
+    return (), {a, b}
+
+
+def loop_of(model, paths):
+    """The first loop that contains a component among ``paths`` (a link or
+    joint of the loop, or a component attached at one of its frame nodes)."""
+    loops = kinematic_loops(model)
+    if not loops:
+        return None
+    node = _nodes(model)
+    for path in paths:
+        for loop in loops:
+            if path in loop.links:
+                return loop
+        comp_nodes = {n for p, n in node.items() if p.startswith(path + ".")}
+        for loop in loops:
+            if comp_nodes & loop.nodes - {"world"}:
+                return loop
+    return None
+
+
+def closure_error(model, paths, detail=""):
+    """A :class:`LoopClosureError` naming the loop through ``paths`` (the
+    components whose equations could not be met), or None."""
+    loop = loop_of(model, paths)
+    if loop is None:
+        return None
+    joints = ", ".join(loop.joints) or "none"
+    return LoopClosureError(
+        f"kinematic {loop.name} cannot close at the start (joints: {joints}): the links "
+        f"cannot reach each other with these lengths and start angles{detail}")
+
+
+def singularity_error(model, paths, message, t, result):
+    """A :class:`LoopSingularityError` when the solver failed in a component
+    of a kinematic loop (``paths``), or None."""
+    loop = loop_of(model, paths)
+    if loop is None:
+        return None
+    joints = ", ".join(loop.joints) or "none"
+    return LoopSingularityError(
+        f"kinematic {loop.name} (joints: {joints}) reached a singular configuration at "
+        f"t = {t:.9g} s, most likely a dead centre (links aligned: the loop locks or "
+        f"switches assembly mode there); {message}", t=t, component=paths[0] if paths else None,
+        result=result)

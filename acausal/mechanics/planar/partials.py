@@ -1,0 +1,75 @@
+"""Partial planar models that own the frame equations (Modelica
+PlanarMechanics' PartialTwoFrames idea), so that a leaf is its parameters and
+its law. Sign convention: :mod:`acausal.connectors` (:class:`Frame`)."""
+from sympy import Eq, cos, sin, sqrt
+
+from acausal import Component, Variable
+from acausal.connectors import Frame
+
+
+def rotate(phi, rx, ry):
+    """World components of the vector (rx, ry) given in a frame at angle phi."""
+    return cos(phi) * rx - sin(phi) * ry, sin(phi) * rx + cos(phi) * ry
+
+
+class PartialOneFrame(Component):
+    """One planar frame. Connectors: ``frame``."""
+
+    frame = Frame("the component's frame")
+
+
+class PartialTwoFrames(Component):
+    """Two planar frames. Connectors: ``frame_a``, ``frame_b``."""
+
+    frame_a = Frame("first frame")
+    frame_b = Frame("second frame")
+
+
+class PartialRigidLink(PartialTwoFrames):
+    """Two frames held by a massless part: whatever the leaf says about the
+    positions, the forces balance and the torques balance about frame_a::
+
+        frame_a.f + frame_b.f = 0
+        frame_a.tau + frame_b.tau + (r_b - r_a) x frame_b.f = 0
+
+    (``r`` the frame origins in the world). A leaf adds three position
+    equations (and its own variables' laws)."""
+
+    def equations(self):
+        a, b = self.frame_a, self.frame_b
+        return [Eq(a.fx + b.fx, 0), Eq(a.fy + b.fy, 0),
+                Eq(a.tau + b.tau + (b.x - a.x) * b.fy - (b.y - a.y) * b.fx, 0)]
+
+    def initialization_failure(self, model, paths, detail=""):
+        """A :class:`~.loops.LoopClosureError` naming the kinematic loop
+        through the components ``paths`` whose equations the start could not
+        meet, or None (see :func:`acausal.initialize.initial_point`)."""
+        from .loops import closure_error
+        return closure_error(model, paths, detail)
+
+    def solver_failure(self, model, paths, message, t, result):
+        """A :class:`~.loops.LoopSingularityError` when the solver failed in
+        a component of a kinematic loop (see :func:`acausal.simulate`)."""
+        from .loops import singularity_error
+        return singularity_error(model, paths, message, t, result)
+
+
+class PartialLineForce(PartialTwoFrames):
+    """A force ``f`` [N] along the line from frame_a to frame_b (tension
+    positive: it pulls the frames together), no torque::
+
+        frame_b.(fx, fy) = f * (dx, dy) / s,  frame_a.(fx, fy) = -frame_b.(fx, fy)
+
+    States: ``s`` [m] distance between the frame origins (> 0), ``f`` [N].
+    The leaf gives the law of ``f``."""
+
+    s = Variable(1.0, "m", "distance between the frame origins")
+    f = Variable(0.0, "N", "force along the line, tension positive")
+
+    def equations(self):
+        a, b = self.frame_a, self.frame_b
+        dx, dy = b.x - a.x, b.y - a.y
+        return [Eq(self.s, sqrt(dx**2 + dy**2)),
+                Eq(b.fx * self.s, self.f * dx), Eq(b.fy * self.s, self.f * dy),
+                Eq(a.fx, -b.fx), Eq(a.fy, -b.fy),
+                Eq(a.tau, 0), Eq(b.tau, 0)]

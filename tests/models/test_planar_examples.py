@@ -1,0 +1,165 @@
+"""Planar reference models (models/examples/*planar*, slider_crank) against
+closed forms and independent scipy solutions."""
+import math
+import os
+import sys
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+from scipy.special import ellipk
+
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "..", "models", "examples"))
+
+import pendulum_planar as pp  # noqa: E402
+import slider_crank as sc  # noqa: E402
+
+EXAMPLES = os.path.join(HERE, "..", "..", "models", "examples")
+
+
+def compiled(name):
+    """The model file's compiled model (shared with the other tests of this
+    process through the model-file cache)."""
+    from acausal.modelfile import compile_file
+    return compile_file(os.path.join(EXAMPLES, name))[1]
+
+
+# -- pendulum -------------------------------------------------------------------
+def exact_period(theta0):
+    J = pp.I + pp.M * pp.L**2
+    return 4 * math.sqrt(J / (pp.M * pp.G * pp.L)) * ellipk(math.sin(theta0 / 2) ** 2)
+
+
+def test_pendulum_small_angle_period():
+    cm = compiled("pendulum_planar.py")
+    th0 = 0.01
+    res = cm.simulate(t_end=4.0, rtol=1e-11, atol=1e-13, output_step=1e-4,
+                      params={"theta0": th0})
+    T, T0 = pp.period(res), pp.small_angle_period()
+    # T0 (1 + theta0^2/16): the first correction is 6e-6 here
+    assert abs(T / T0 - 1 - th0**2 / 16) < 1e-8
+    assert abs(T / exact_period(th0) - 1) < 1e-8
+
+
+def test_pendulum_large_angle_against_scipy_and_elliptic_period():
+    cm = compiled("pendulum_planar.py")
+    th0 = 2.5
+    ts = np.linspace(0, 4.0, 40001)
+    res = cm.simulate(t_end=4.0, rtol=1e-11, atol=1e-13, output_times=ts,
+                      params={"theta0": th0})
+    J = pp.I + pp.M * pp.L**2
+    k = pp.M * pp.G * pp.L / J
+    ref = solve_ivp(lambda t, z: [z[1], -k * math.sin(z[0])], [0, 4.0], [th0, 0.0],
+                    t_eval=ts, rtol=1e-12, atol=1e-14, method="DOP853")
+    th = res["pin.phi"] + math.pi / 2
+    assert np.max(np.abs(th - ref.y[0])) < 1e-7
+    assert abs(pp.period(res) / exact_period(th0) - 1) < 1e-7
+    assert pp.period(res) > 1.5 * pp.small_angle_period()       # truly nonlinear
+    # the bob on its circle
+    assert np.max(np.abs(np.hypot(res["bob.x"], res["bob.y"]) - pp.L)) < 1e-10
+
+
+# -- slider-crank -----------------------------------------------------------------
+def test_slider_crank_closed_form_kinematics_and_energy():
+    cm = compiled("slider_crank.py")
+    res = cm.simulate(t_end=1.0, rtol=1e-11, atol=1e-12, output_step=1e-3)
+    th, w = res["crank_pin.phi"], res["crank_pin.w"]
+    assert th[-1] - th[0] > 2 * 2 * math.pi                     # over two turns
+    r, l = sc.R, sc.L
+    root = np.sqrt(l**2 - (r * np.sin(th))**2)
+    x = r * np.cos(th) + root
+    v = -r * w * np.sin(th) * (1 + r * np.cos(th) / root)
+    assert np.max(np.abs(res["slider.x"] - x)) < 1e-9
+    assert np.max(np.abs(res["slider.vx"] - v)) < 1e-9
+    assert np.max(np.abs(res["slider.y"])) < 1e-12
+    # the rod's angle (closed form) and its centre half way between the pins
+    beta = np.arcsin(r * np.sin(th) / l)
+    assert np.max(np.abs(res["wrist.phi"] - beta)) < 1e-9
+    assert np.max(np.abs(res["rod_body.x"] - (r * np.cos(th) + x) / 2)) < 1e-9
+    # lossless: kinetic energy constant while the flywheel speed varies
+    E = sc.kinetic_energy(res)
+    assert np.max(np.abs(E / E[0] - 1)) < 1e-8
+    assert np.ptp(w) > 0.01 * sc.W0
+
+
+# -- the report's cam-and-roller four-bar from bodies and joints --------------------
+FOURBAR = os.path.join(HERE, "..", "..", "models", "examples", "fourbar_planar.py")
+GENERIC = dict(e=0.04, f=0.1, r1=0.08, r2=0.03, r3=0.06)    # crank-rocker, large swing
+
+
+def wrap(a):
+    return (a + np.pi) % (2 * np.pi) - np.pi
+
+
+def fourbar_errors(res, geometry):
+    import fourbar_planar as fp
+    from acausal.mechanics.fourbar import fourbar_angles
+    th1, th2, th3 = fp.report_angles(res)
+    ref = np.array([fourbar_angles(a, **geometry) for a in th1])
+    return th1, np.max(np.abs(wrap(th2 - ref[:, 0]))), np.max(np.abs(wrap(th3 - ref[:, 1])))
+
+
+def test_fourbar_planar_report_geometry_matches_closed_form():
+    import fourbar_planar as fp
+    from acausal.modelfile import run_file
+    res, meas = run_file(FOURBAR)
+    th1, e2, e3 = fourbar_errors(res, fp.TABLE1)
+    assert abs(th1[-1] - fp.RA) < 1e-9 and th1[0] == 0.0     # latched -> released
+    assert e2 < 1e-9 and e3 < 1e-9
+    assert 0.0 < meas["t_release_s"] < 0.1
+
+
+def test_fourbar_planar_generic_geometry_over_turns_and_energy():
+    import fourbar_planar as fp
+    from acausal.modelfile import compile_file
+    _, cm = compile_file(FOURBAR)
+    res = cm.simulate(t_end=3.0, rtol=1e-10, atol=1e-12, output_step=1e-3,
+                      params={**GENERIC, "theta1_0": 2.5, "w1_0": 5.0, "spring.c": 0.0})
+    th1, e2, e3 = fourbar_errors(res, GENERIC)
+    assert th1[-1] - th1[0] > 2 * np.pi                       # more than a turn
+    assert e2 < 1e-9 and e3 < 1e-9
+    assert np.ptp(fp.report_angles(res)[2]) > 1.0              # the rocker swings
+    E = 0.5 * fp.JH * res["hook.w"]**2 + 0.5 * fp.JS * res["shaft.w"]**2
+    assert np.max(np.abs(E / E[0] - 1)) < 1e-8
+
+
+def test_unclosable_loop_names_the_loop_and_its_joints():
+    from acausal.mechanics.planar.loops import LoopClosureError
+    from acausal.modelfile import compile_file
+    _, cm = compile_file(FOURBAR)
+    with pytest.raises(LoopClosureError) as err:   # r1 + r2 + r3 < |AD|: too short
+        cm.simulate(t_end=0.01, params={"r1": 0.02})
+    msg = str(err.value)
+    assert "\n" not in msg and "cannot close" in msg
+    for joint in ("hook_pin", "shaft_pin", "roller_pin", "cam_pin"):
+        assert joint in msg
+
+
+@pytest.mark.slow
+def test_fourbar_planar_release_time_equals_the_1d_fourbar():
+    from acausal.modelfile import run_file
+    _, planar = run_file(FOURBAR)
+    _, one_d = run_file(os.path.join(HERE, "..", "..", "models", "examples", "fourbar.py"))
+    assert abs(planar["t_release_s"] - one_d["t_release_s"]) < 1e-9
+    assert abs(planar["theta3_at_release_rad"] - one_d["theta3_at_release_rad"]) < 1e-9
+
+
+@pytest.mark.slow
+def test_dead_centre_names_the_loop():
+    """A crank-rocker whose |AD| reaches r1 + r2 + r3: the coupler and the
+    rocker align (a toggle), where the loop locks; the error names the loop
+    and the partial result ends there."""
+    from acausal.mechanics.planar.loops import LoopSingularityError
+    from acausal.modelfile import compile_file
+    _, cm = compile_file(FOURBAR)
+    locking = dict(e=0.05, f=0.1, r1=0.06, r2=0.03, r3=0.05)
+    with pytest.raises(LoopSingularityError) as err:
+        cm.simulate(t_end=2.0, rtol=1e-10, atol=1e-12,
+                    params={**locking, "spring.c": 0.0, "w1_0": 5.0, "theta1_0": 0.2})
+    msg = str(err.value)
+    assert "\n" not in msg and "dead centre" in msg and "roller_pin" in msg
+    res = err.value.result
+    assert abs(np.sin(res["roller_pin.phi"][-1])) < 0.05         # coupler along rocker
+    assert err.value.t == pytest.approx(res.t[-1])
