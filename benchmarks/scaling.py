@@ -37,7 +37,7 @@ sys.path.insert(0, ROOT)
 sys.path.insert(0, os.path.join(ROOT, "benchmarks"))
 sys.path.insert(0, os.path.join(ROOT, "models", "examples"))
 
-from acausal import compile_model  # noqa: E402
+from acausal import AcausalError, compile_model  # noqa: E402
 from chains import chain  # noqa: E402
 import newtons_cradle  # noqa: E402
 
@@ -89,7 +89,12 @@ def main():
             print(f"\n{name}: N, unknowns, compile, cached compile, first simulate, simulate"
                   + (", dense, band" if name == "chain" else "") + " [s]; linear solver; events")
             for n in args.sizes:
-                r = measure(name, n)
+                try:
+                    r = measure(name, n)
+                except AcausalError as exc:      # e.g. the chattering guard's event count
+                    print(f"  N={n:4d} failed: {type(exc).__name__}: "
+                          f"{str(exc).splitlines()[0][:160]}", flush=True)
+                    continue
                 rows.append(r)
                 extra = f" {r['dense']:7.2f} {r['band']:7.2f}" if name == "chain" else ""
                 print(f"  N={n:4d} {r['unknowns']:5d} {r['compile']:8.2f} {r['cached']:7.2f} "
