@@ -71,6 +71,8 @@ def _text(path: Path) -> str:
         data = path.read_bytes()
     except OSError as exc:
         raise DataError(f"cannot read: {exc.strerror or exc}", path) from None
+    if data[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        raise DataError("the file is UTF-16 (save it as UTF-8)", path, 1)
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
@@ -125,6 +127,7 @@ def read_table(path: Path) -> Table:
     for row_line, cells in rows:
         if len(cells) != len(names):
             column = names[len(cells)] if len(cells) < len(names) else None
-            raise DataError(f"row has {len(cells)} cells, header has {len(names)}",
+            raise DataError(f"row has {len(cells)} cell{'s' * (len(cells) != 1)}, header "
+                            f"has {len(names)}",
                             path, row_line, column)
     return Table(path, line, names, units, rows)
