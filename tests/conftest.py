@@ -8,7 +8,9 @@ Tests may add lines to the same terminal summary through the
 ``terminal_report`` fixture (e.g. the fuzz tier's counts), printed with or
 without ``-s``.
 """
+import os
 import platform
+import tempfile
 from importlib import metadata
 
 import pytest
@@ -16,6 +18,12 @@ import pytest
 VERSIONED = ("numpy", "scipy", "sympy", "scikit-sundae", "matplotlib", "pint", "click",
              "tqdm", "dask", "distributed", "hypothesis", "casadi", "pytest")
 SUMMARY = pytest.StashKey[list]()
+
+
+def pytest_configure(config):
+    """The tests' compiled models and libraries go to a cache of this run
+    (worker processes and CLI subprocesses inherit it), not the user's."""
+    os.environ.setdefault("ACAUSAL_CACHE", tempfile.mkdtemp(prefix="acausal-test-cache-"))
 
 
 def _versions():

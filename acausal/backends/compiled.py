@@ -84,9 +84,13 @@ def _sundials_libs():
 
 
 def _cache_dir():
-    d = os.environ.get("ACAUSAL_CACHE_DIR") or os.path.join(
+    """``compiled/`` in the compiled-model cache (:func:`acausal.cache.cache_dir`,
+    ``$ACAUSAL_CACHE``), or in ``$ACAUSAL_CACHE_DIR``; a library has to live
+    somewhere, so with the model cache off it is ``~/.cache/acausal``."""
+    from ..cache import cache_dir
+    d = os.environ.get("ACAUSAL_CACHE_DIR") or cache_dir() or os.path.join(
         os.path.expanduser("~"), ".cache", "acausal")
-    d = os.path.join(d, "compiled")
+    d = os.path.join(str(d), "compiled")
     os.makedirs(d, exist_ok=True)
     return d
 
