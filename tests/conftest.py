@@ -10,6 +10,7 @@ without ``-s``.
 """
 import os
 import platform
+import shutil
 import tempfile
 from importlib import metadata
 
@@ -23,7 +24,15 @@ SUMMARY = pytest.StashKey[list]()
 def pytest_configure(config):
     """The tests' compiled models and libraries go to a cache of this run
     (worker processes and CLI subprocesses inherit it), not the user's."""
-    os.environ.setdefault("ACAUSAL_CACHE", tempfile.mkdtemp(prefix="acausal-test-cache-"))
+    if "ACAUSAL_CACHE" not in os.environ:
+        config._acausal_cache = tempfile.mkdtemp(prefix="acausal-test-cache-")
+        os.environ["ACAUSAL_CACHE"] = config._acausal_cache
+
+
+def pytest_unconfigure(config):
+    path = getattr(config, "_acausal_cache", None)
+    if path:
+        shutil.rmtree(path, ignore_errors=True)
 
 
 def _versions():
