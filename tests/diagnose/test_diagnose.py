@@ -21,7 +21,7 @@ HERE = os.path.dirname(__file__)
 LATCH = os.path.abspath(os.path.join(HERE, "..", "..", "models", "latch_striker.py"))
 FAST = ["coulomb_friction", "quadratic_damping", "constant_load"]
 KEYS = {"discrepancy", "cause", "location", "equivalent_causes", "parameters", "ranking",
-        "gain", "extended_model"}
+        "gain", "extended_model", "causes", "unexplained", "next_experiment", "profile_ci95"}
 
 
 def _latch_data(folder, seed, **kw):
