@@ -270,6 +270,9 @@ def diagnose(file, data, json_path, report_dir, scheduler, workers, hypotheses, 
     g = out["gain"]
     if not out["discrepancy"]:
         click.echo("no significant discrepancy between the calibrated model and the data")
+    elif out["unexplained"]["value"]:
+        click.echo(f"discrepancy not explained by the library; located at the node of "
+                   f"{out['unexplained']['node']}")
     elif out["cause"] is None:
         click.echo("discrepancy, but the evidence is weak: no cause named"
                    + (f" (best candidate: {out['ranking'][0]['cause']} at "

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import optimize, stats
 
-from ..calibrate import FD_STEP, ForwardDifferences, resolve, residual_vector
+from ..calibrate import FD_STEP, ForwardDifferences, resolve
 from ..data import Dataset
 from ..errors import AcausalError
 
@@ -69,10 +69,33 @@ def subset(dataset: Dataset, names) -> Dataset:
 
 
 def weighted_residuals(model, dataset, params):
-    """(vector, groups, signals) of weighted residuals for ``params``."""
-    vec, labels, _ = residual_vector(resolve(model), dataset, params,
-                                     options={"max_steps": MAX_STEPS})
-    return vec, [g for g, _ in labels], [s for _, s in labels]
+    """(vector, groups, signals) of weighted residuals for ``params``, as
+    :func:`acausal.calibrate.residual_vector` (measures first, then trace
+    samples), except that an experiment without measures is simulated only
+    up to its last trace sample (a growing-window fit then pays only for
+    its window) and its measures are not evaluated."""
+    from ..calibrate import _sigma
+    from ..modelfile import evaluate_measures
+    mf, cm = resolve(model)
+    vec, groups, signals = [], [], []
+    for e in dataset.experiments:
+        opts = {**mf.experiment.run_options(), "max_steps": MAX_STEPS}
+        if not e.measures and e.trace is not None and e.trace.time.size:
+            opts["t_end"] = min(opts["t_end"], float(e.trace.time[-1]) * (1 + 1e-9) + 1e-12)
+        res = cm.simulate(params={**params, **e.conditions}, **opts)
+        if e.measures:
+            meas = evaluate_measures(mf, res)
+            for m, y in e.measures.items():
+                vec.append((meas[m] - y) / _sigma(dataset, m, y))
+                groups.append(e.name)
+                signals.append(m)
+        if e.trace is not None:
+            for var, ys in e.trace.signals.items():
+                sim = np.interp(e.trace.time, res.t, res[var])
+                vec.extend((sim - ys) / _sigma(dataset, var, ys))
+                groups.extend([e.name] * len(ys))
+                signals.extend([var] * len(ys))
+    return np.asarray(vec, float), groups, signals
 
 
 class _OutOfTime(Exception):
@@ -87,8 +110,10 @@ class Objective:
     :data:`PENALTY` residuals (after a first success, which sets the size).
     """
 
-    def __init__(self, model, dataset, names, fixed=None, budget_s=None, max_evals=None):
+    def __init__(self, model, dataset, names, fixed=None, budget_s=None, max_evals=None,
+                 penalty=None):
         self.pair = resolve(model)
+        self.penalty = penalty        # (rows P, scales) on the last P.shape[1] parameters
         self.dataset = dataset
         self.names = list(names)
         self.fixed = dict(fixed or {})
@@ -123,6 +148,9 @@ class Objective:
             if self.size is None:
                 raise
             vec = np.full(self.size, PENALTY)
+        if self.penalty is not None:
+            P, sc = self.penalty
+            vec = np.concatenate([vec, P @ (np.asarray(x, float)[-P.shape[1]:] / sc)])
         c = float(vec @ vec)
         if c < self.best_cost:
             self.best_cost, self.best_x = c, np.array(x, float)
@@ -150,10 +178,12 @@ def score_starts(obj, starts, lo, hi, absorb=None):
         except _OutOfTime:
             break
         c = float(r @ r)
-        if a_jac is not None and a_jac.shape[0] == r.size:
-            d = np.linalg.lstsq(a_jac, -r, rcond=None)[0]
+        m = a_jac.shape[0] if a_jac is not None else 0
+        if a_jac is not None and m <= r.size:
+            d = np.linalg.lstsq(a_jac, -r[:m], rcond=None)[0]
             moved = np.clip(x[a_idx] + d, lo[a_idx], hi[a_idx])
-            rr = r + a_jac @ (moved - x[a_idx])
+            rr = r[:m] + a_jac @ (moved - x[a_idx])
+            c = float(rr @ rr) + float(r[m:] @ r[m:])
             c = float(rr @ rr)
             x = x.copy()
             x[a_idx] = moved
@@ -229,7 +259,7 @@ def finish(obj, x, J, ok, message, lo):
     r, groups, signals = weighted_residuals(obj.pair, obj.dataset, obj.params(x))
     obj.n_sim += len(obj.dataset.experiments)
     names = obj.names
-    J = np.asarray(J).reshape(r.size, len(names)) if names else np.zeros((r.size, 0))
+    J = np.asarray(J)[:r.size].reshape(r.size, len(names)) if names else np.zeros((r.size, 0))
     out = Fit(names, dict(zip(names, np.asarray(x, float).tolist())), float(r @ r), r, J,
               groups, signals, n_sim=obj.n_sim, wall_s=time.perf_counter() - obj.t0,
               ok=bool(ok), message=str(message))

@@ -602,13 +602,14 @@ def _hypothesis(hyp_id):
     return h
 
 
-def file_defaults(mf, hyp_id, location, graph=None):
+def file_defaults(mf, hyp_id, location, graph=None, h=None):
     """Values of a hypothesis's fixed parameters taken from the model file's
     nominal run (coulomb_friction: v_eps, flexible_link: T0); the same for
     :func:`build_extended` and :func:`write_extended_model`. ``graph``: the
     file's graph with its nominal run (built when not given; ``mf.model``
-    must not be extended yet)."""
-    h = _hypothesis(hyp_id)
+    must not be extended yet). ``h``: the hypothesis object (default: the
+    library's ``hyp_id``)."""
+    h = h or _hypothesis(hyp_id)
     if type(h).defaults is Hypothesis.defaults:
         return {}
     if graph is None:
@@ -619,7 +620,7 @@ def file_defaults(mf, hyp_id, location, graph=None):
 _CACHE = {}
 
 
-def build_extended(path, hyp_id, location, values=None):
+def build_extended(path, hyp_id, location, values=None, h=None):
     """(ModelFile, CompiledModel) of the model file at ``path`` extended by
     hypothesis ``hyp_id`` at ``location``. The file is loaded fresh, the
     hypothesis applied, the experiment's stop event added (as
@@ -628,8 +629,9 @@ def build_extended(path, hyp_id, location, values=None):
     become the compiled model's parameter defaults (a copy sharing the
     generated code: no recompilation). The specs, with bounds and scales
     from the file's nominal run, are in ``mf.namespace["hypothesis_specs"]``;
-    ``mf.namespace["hypothesis"]`` is ``(hyp_id, location)``."""
-    h = _hypothesis(hyp_id)
+    ``mf.namespace["hypothesis"]`` is ``(hyp_id, location)``. ``h``: a
+    hypothesis object outside the library (e.g. :mod:`.generic`)."""
+    h = h or _hypothesis(hyp_id)
     apath = os.path.abspath(path)
     key = (apath, os.path.getmtime(apath) if os.path.exists(apath) else None, hyp_id, location)
     hit = _CACHE.get(key)
@@ -637,7 +639,7 @@ def build_extended(path, hyp_id, location, values=None):
         mf = load_model_file(apath)
         graph = ModelGraph(mf.model, result=nominal_result(apath))
         specs = h.params(graph, location)         # scaled by the nominal run
-        h.apply(mf.model, location, file_defaults(mf, hyp_id, location, graph))
+        h.apply(mf.model, location, file_defaults(mf, hyp_id, location, graph, h))
         if mf.experiment.stop is not None:
             mf.model.event(mf.experiment.stop.event(mf.model))
         cm = compile_model(mf.model)
@@ -648,6 +650,27 @@ def build_extended(path, hyp_id, location, values=None):
     if values:
         cm = with_defaults(cm, values)
     return mf, cm
+
+
+def build_pair(path, pair):
+    """(ModelFile, CompiledModel) of the model file extended by two
+    hypotheses at once, ``pair`` = ((hyp_id, location), (hyp_id, location))
+    of two different hypotheses (their sub-models must not clash); cached
+    per process as :func:`build_extended`. The fixed parameters' defaults
+    come from the unextended file's nominal run."""
+    apath = os.path.abspath(path)
+    key = (apath, os.path.getmtime(apath) if os.path.exists(apath) else None, tuple(pair))
+    hit = _CACHE.get(key)
+    if hit is None:
+        mf = load_model_file(apath)
+        graph = ModelGraph(mf.model, result=nominal_result(apath))
+        defaults = [file_defaults(mf, h, loc, graph) for h, loc in pair]
+        for (h, loc), d in zip(pair, defaults):
+            _hypothesis(h).apply(mf.model, loc, d)
+        if mf.experiment.stop is not None:
+            mf.model.event(mf.experiment.stop.event(mf.model))
+        hit = _CACHE[key] = (mf, compile_model(mf.model))
+    return hit
 
 
 def with_defaults(cm, values):

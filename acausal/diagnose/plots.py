@@ -16,7 +16,26 @@ def write_plots(out_dir, d) -> dict:
     if d.ranking.rows:
         figs["ranking"] = _save(plt, _ranking(plt, d), out_dir, "ranking.png")
     figs["traces"] = _save(plt, _fitted(plt, d), out_dir, "fitted.png")
+    if d.location is not None and d.location.terms:
+        figs["located"] = _save(plt, _located(plt, d), out_dir, "located.png")
     return figs
+
+
+def _located(plt, d):
+    """The generic term's shape against position and velocity (best 3 nodes)."""
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.4))
+    for i, t in enumerate(d.location.terms[:3]):
+        lw = 2.0 if i == 0 else 0.8
+        axes[0].plot(t.shape["x"], t.shape["f_x"], lw=lw, label=t.node)
+        axes[1].plot(t.shape["v"], t.shape["f_v"], lw=lw, label=t.node)
+    axes[0].set_xlabel("position of the node's body [SI]")
+    axes[1].set_xlabel("velocity of the node's body [SI]")
+    for ax in axes:
+        ax.axhline(0, color="k", lw=0.5)
+        ax.set_ylabel("generic force [SI]")
+        ax.legend(fontsize=7)
+    axes[0].set_title("located generic term (thick: the best node)", fontsize=9)
+    return fig
 
 
 def _save(plt, fig, out_dir, name):

@@ -43,6 +43,7 @@ class Candidate:
     hypothesis: str | None
     location: str | None
     params: tuple = ()            # Param of the extension, neutral start
+    penalty: object = field(default=None, compare=False)  # smoothing rows (generic terms)
 
     @property
     def key(self):
@@ -50,7 +51,20 @@ class Candidate:
 
     @property
     def label(self):
-        return "nominal" if self.hypothesis is None else f"{self.hypothesis} at {self.location}"
+        if self.hypothesis is None:
+            return "nominal"
+        return " + ".join(f"{h} at {loc}" for h, loc, _ in self.members())
+
+    def members(self):
+        """[(hypothesis, location, [parameter names])]: one entry, or two for
+        a pair ("h1+h2" at "l1+l2"; each parameter named by its
+        hypothesis's sub-model prefix, in the pair's order)."""
+        hs, ls = self.hypothesis.split("+"), self.location.split("+")
+        if len(hs) == 1:
+            return [(hs[0], ls[0], [p.name for p in self.params])]
+        groups = list(dict.fromkeys(p.name.split(".")[0] for p in self.params))
+        return [(h, loc, [p.name for p in self.params if p.name.split(".")[0] == g])
+                for h, loc, g in zip(hs, ls, groups)]
 
 
 NOMINAL = Candidate(None, None, ())
@@ -67,7 +81,7 @@ class FitSettings:
     max_nfev: int = 60
     tol: float = FIT_TOL
     evals_per_param: int = 25
-    lhs: int = 6
+    lhs: int = 4
     refine: int = 2
     windows: tuple = (0.3, 1.0)
     seed: int = 0

@@ -54,7 +54,8 @@ def markdown(d, figs=None) -> str:
     parts = [_header(d), "## Verdict\n", verdict(d, s) + "\n", _section_residuals(d, figs),
              _section_fingerprints(d), _section_hypotheses(d, figs),
              "## 4. Cause, evidence and equivalent causes\n", "\n".join(evidence(d)) + "\n",
-             _section_gain(d, s, figs), _section_extended(d, s), _section_cost(d)]
+             _section_located(d, figs), _section_gain(d, s, figs), _section_extended(d, s),
+             _section_cost(d)]
     return "\n".join(parts) + "\n"
 
 
@@ -176,6 +177,32 @@ def _section_hypotheses(d, figs):
     return "\n".join(L)
 
 
+def _section_located(d, figs):
+    loc = d.location
+    L = ["## 4b. Where the library falls short (located generic term)\n"]
+    if loc is None or not loc.terms:
+        L.append(f"Not run: {loc.skipped if loc is not None else 'not requested'}.\n")
+        return "\n".join(L)
+    L.append("A generic, smooth, regularised force (linear splines in the body's position and "
+             "velocity, `acausal/diagnose/generic.py`) fitted at each body's node with the "
+             "free parameters; the node whose term removes most of the misfit locates the "
+             "discrepancy in the mechanism.\n")
+    L += ["| node (body) | components on the node | S | AICc | held-out RMS |",
+          "|---|---|---|---|---|"]
+    L += [f"| {t.node} | {', '.join(t.members)} | {fmt(t.S)} | {fmt(t.aicc)} | "
+          f"{fmt(t.heldout_rmse, 3)} |" for t in loc.terms]
+    verdict_line = (f"**Not explained by the library**: {loc.reason}." if loc.unexplained
+                    else f"The library is not ruled out: {loc.reason}.")
+    L += ["", verdict_line]
+    if loc.nearest_why:
+        L.append(f"Nearest library hypothesis: {loc.nearest}; why it does not fit: "
+                 f"{loc.nearest_why}.")
+    L.append("")
+    if "located" in figs:
+        L.append(f"![the located term against position and velocity]({figs['located']})\n")
+    return "\n".join(L)
+
+
 def _section_gain(d, s, figs):
     rk, g = d.ranking, s["gain"]
     which = ("the named cause" if rk.named is not None else
@@ -233,6 +260,11 @@ def verdict(d, s) -> str:
                 "would pass.)")
     held = (f"held-out error {fmt(g['before']['heldout'], 3)} -> "
             f"{fmt(g['after']['heldout'], 3)} floor units")
+    if s["unexplained"]["value"]:
+        return (f"**Discrepancy not explained by the library.** A generic term at the node of "
+                f"`{s['unexplained']['node']}` removes most of the misfit (held-out "
+                f"{fmt(s['unexplained']['heldout_rmse'], 3)} floor units; section 4b shows its "
+                f"shape). No library cause is named: {'; '.join(d.ranking.weak)}.")
     if s["cause"] is None:
         best, weak = d.ranking.best, d.ranking.weak
         reasons = "; ".join(weak) if weak else "no candidate could be fitted"
@@ -267,11 +299,13 @@ def evidence(d) -> list:
 
 def _best_lines(d):
     dec, rk, best = d.decision, d.ranking, d.ranking.best
-    hyp = load_library(d.problem.library).HYPOTHESES[best.candidate.hypothesis]
+    lib = load_library(d.problem.library)
     head = "Named cause" if rk.named is not None else "Best candidate (not named: evidence weak)"
-    L = [f"**{head}: {best.candidate.hypothesis} at `{best.candidate.location}`** — "
-         f"{hyp.title}. {hyp.explanation}\n",
-         "Parameters (95 % intervals, covariance scaled by max(1, S/(n-k))):\n"]
+    L = [f"**{head}: {best.candidate.label}**\n"]
+    for h, loc, _ in best.candidate.members():
+        hyp = lib.HYPOTHESES[h]
+        L.append(f"- {h} at `{loc}` — {hyp.title}. {hyp.explanation}")
+    L += ["", "Parameters (95 % intervals, covariance scaled by max(1, S/(n-k))):\n"]
     for nm in best.fit.names:
         lo, hi = best.fit.ci95.get(nm, (float("nan"),) * 2)
         L.append(f"- `{nm}` = {fmt(best.fit.values[nm])}  [{fmt(lo)}, {fmt(hi)}]")
@@ -302,8 +336,7 @@ def _class_lines(d):
         L += [f"  - {r.candidate.label} (dAICc {r.aicc - best.aicc:.2f}, held-out "
               f"{fmt(r.heldout_rmse, 3)})" for r in others]
         L.append("- the experiments that would tell them apart:")
-        for hid in dict.fromkeys([best.candidate.hypothesis] +
-                                 [r.candidate.hypothesis for r in others]):
+        for hid in dict.fromkeys(h for r in [best] + others for h, _, _ in r.candidate.members()):
             L.append(f"  - {hid}: {lib.HYPOTHESES[hid].distinguishing_experiment}")
     if rk.weak:
         L.append("- **evidence is weak**:")

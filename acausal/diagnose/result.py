@@ -24,6 +24,7 @@ class Diagnosis:
     views: object = None          # views.Views (None: not computed)
     next_experiment: dict | None = None
     timing: dict = field(default_factory=dict)
+    location: object = None       # locate.Location (None: not run)
 
 
 def num(x):
@@ -71,13 +72,18 @@ def _equivalent(d: Diagnosis):
             for i in rk.classes[0] if rk.cause is None or i != rk.cause]
 
 
+def _causes(row):
+    """One entry per cause of a named single or pair: its own parameters."""
+    every = parameters(row)
+    return [dict(cause=h, location=loc, parameters={k: every[k] for k in names})
+            for h, loc, names in row.candidate.members()]
+
+
 def summary(d: Diagnosis) -> dict:
     """The JSON summary (docs/diagnosis.md lists the keys)."""
     rk = d.ranking
     named = rk.named
-    causes = [] if named is None else [dict(cause=named.candidate.hypothesis,
-                                            location=named.candidate.location,
-                                            parameters=parameters(named))]
+    causes = [] if named is None else _causes(named)
     return dict(
         discrepancy=d.decision.discrepancy,
         cause=None if named is None else named.candidate.hypothesis,
@@ -89,10 +95,24 @@ def summary(d: Diagnosis) -> dict:
         gain=gain(d),
         extended_model=d.extended_model,
         causes=causes,
-        unexplained=dict(value=False, node=None),
+        unexplained=unexplained(d),
         next_experiment=d.next_experiment,
         profile_ci95={},
     )
+
+
+def unexplained(d: Diagnosis) -> dict:
+    """``value``: the discrepancy is not explained by the library; ``node``:
+    the body whose node the located generic term sits at (None when not
+    located); ``heldout_rmse`` of that term; ``nearest``: the best library
+    candidate."""
+    loc = d.location
+    if loc is None or not loc.terms:
+        return dict(value=False, node=None, heldout_rmse=None, nearest=None)
+    t = loc.terms[0]
+    return dict(value=loc.unexplained, node=loc.node,
+                heldout_rmse=num(t.heldout_rmse) if loc.unexplained else None,
+                nearest=loc.nearest)
 
 
 def _one(label, f, extra):
@@ -121,6 +141,9 @@ def details(d: Diagnosis) -> dict:
         failed=[dict(cause=r.candidate.hypothesis, location=r.candidate.location,
                      error=r.error or (r.fit.message if r.fit is not None else ""))
                 for r in dec.failed],
+        located=[dict(node=t.node, members=list(t.members), S=num(t.S), aicc=num(t.aicc),
+                      heldout_rmse=num(t.heldout_rmse), values=t.values)
+                 for t in (d.location.terms if d.location is not None else ())],
         decision=dec.decision, overdispersion=dec.c_hat, weak_evidence=rk.weak,
         timing=d.timing)
     return clean(out)

@@ -20,6 +20,7 @@ from pathlib import Path
 from ..executor import open_executor
 from . import stages
 from . import stats as st
+from .locate import Location, locate
 from .problem import FitSettings
 from .result import Diagnosis, details, summary
 from .stages import DiagnosisError
@@ -30,10 +31,13 @@ __all__ = ["diagnose", "run_stages", "DiagnosisError"]
 def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
                progress=True, hypotheses=None, locations=None, alpha=st.ALPHA,
                exact_cv=True, library=None, views=True, settings=None,
-               collect=None) -> Diagnosis:
+               collect=None, generic=True, pairs=True) -> Diagnosis:
     """The stages in order; returns the :class:`Diagnosis` (writes only the
     extended model file into ``out_dir``). ``collect(task, result)`` is
-    called as each fit result arrives (a checkpoint store plugs in there)."""
+    called as each fit result arrives (a checkpoint store plugs in there).
+    ``generic``: locate a discrepancy the library does not explain
+    (:mod:`.locate`); ``pairs``: search pairs of causes when the best single
+    one leaves misfit (:func:`.stages.pair_candidates`)."""
     t0 = time.perf_counter()
     problem, ds = stages.load_problem(model_path, data_folder, library, settings)
     cands = stages.candidates(problem, hypotheses, locations)
@@ -42,8 +46,14 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
         fits = stages.fit(problem, cal, cands, ex, progress, collect)
         t_fit = time.perf_counter() - t0
         dec = stages.decide(ds, cal, fits, alpha)
+        if pairs and stages.pairs_needed(dec):
+            fits += stages.fit(problem, cal, stages.pair_candidates(problem, dec), ex,
+                               progress, collect)
+            dec = stages.decide(ds, cal, fits, alpha)
         cv = stages.cross_validate(problem, ds, cal, dec, ex, exact_cv, progress)
-    rk = stages.rank(ds, cal, dec, cv)
+        rk = stages.rank(ds, cal, dec, cv)
+        where = locate(problem, cal, dec, rk, ex, progress, collect) if generic else Location(
+            skipped="not run (generic=False)")
     Path(out_dir).mkdir(parents=True, exist_ok=True)
     extended = stages.extend(problem, rk, out_dir)
     t_cv = time.perf_counter() - t0 - t_fit
@@ -55,13 +65,13 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
     timing = dict(fit_s=t_fit, cv_s=t_cv, n_candidates=len(cands), n_sim=n_sim,
                   total_s=time.perf_counter() - t0)
     return Diagnosis(problem, ds, cal, len(cands), dec, cv, rk, extended, shown,
-                     None, timing)
+                     None, timing, where)
 
 
 def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
              progress=True, hypotheses=None, locations=None, alpha=st.ALPHA,
              exact_cv=True, library=None, plots=True, max_nfev=60, settings=None,
-             collect=None) -> dict:
+             collect=None, generic=True, pairs=True) -> dict:
     """Diagnose ``model_path`` against the dataset folder ``data_folder``.
 
     Writes ``report.md``, ``diagnosis.json``, ``candidates.json``, plots and
@@ -78,7 +88,7 @@ def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
     d = run_stages(model_path, data_folder, out_dir=out_dir, scheduler=scheduler,
                    workers=workers, progress=progress, hypotheses=hypotheses,
                    locations=locations, alpha=alpha, exact_cv=exact_cv, library=library,
-                   settings=settings, collect=collect)
+                   settings=settings, collect=collect, generic=generic, pairs=pairs)
     out_dir = Path(out_dir)
     from .report import write_report
     write_report(out_dir, d, plots=plots)

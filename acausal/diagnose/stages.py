@@ -178,6 +178,37 @@ def fit(problem: Problem, cal: Calibration, cands, ex, progress=True, collect=No
     return tuple(run_tasks(ex, fit_candidate, tasks, "fitting candidates", progress, collect))
 
 
+# -- stage 3b: pairs ------------------------------------------------------------------------
+PAIR_TOP = 4          # pairs among the best this many single candidates (tested, distinct)
+
+
+def pairs_needed(dec) -> bool:
+    """Search pairs when a discrepancy is found and the best single cause
+    still leaves misfit beyond the instrument (S/(n-k) above OVERDISPERSION)."""
+    return bool(dec.discrepancy and dec.rows and dec.c_hat > st.OVERDISPERSION)
+
+
+def pair_candidates(problem: Problem, dec, top=PAIR_TOP) -> tuple:
+    """Pairs of two different hypotheses among the ``top`` best tested
+    single candidates, each parameter seeded from its single fit (its
+    neutral value kept as the prior)."""
+    if load_library(problem.library).build_pair is None:
+        return ()
+    singles = [r for r in dec.rows if "+" not in r.candidate.hypothesis
+               and r.starts.tested][:top]
+    out = []
+    for i, a in enumerate(singles):
+        for b in singles[i + 1:]:
+            ca, cb = a.candidate, b.candidate
+            if ca.hypothesis == cb.hypothesis:
+                continue
+            params = tuple(p.moved(r.fit.values[p.name]) for r in (a, b)
+                           for p in r.candidate.params)
+            out.append(Candidate(f"{ca.hypothesis}+{cb.hypothesis}",
+                                 f"{ca.location}+{cb.location}", params))
+    return tuple(out)
+
+
 # -- stage 4: decide ------------------------------------------------------------------------
 @dataclass(frozen=True)
 class Row:
@@ -371,6 +402,24 @@ def _untested_reasons(untested, best):
             for r in untested if r is not best][:3]
 
 
+def _pair_reasons(best, rows):
+    """A pair is named only when it beats each of its single members by
+    STRONG AICc units and by held-out error."""
+    if "+" not in best.candidate.hypothesis:
+        return []
+    out = []
+    for h, loc, _ in best.candidate.members():
+        single = next((r for r in rows if r.candidate.key == (h, loc)), None)
+        if single is None:
+            continue
+        d = single.aicc - best.aicc
+        if d < st.STRONG or not best.heldout_rmse < single.heldout_rmse:
+            out.append(f"the pair does not earn its second cause against {h} at {loc} alone "
+                       f"(dAICc {d:.1f}, needs {st.STRONG:g}; held-out {best.heldout_rmse:.3g} "
+                       f"against {single.heldout_rmse:.3g})")
+    return out
+
+
 def rank(ds, cal: Calibration, dec: Decision, cv: CrossValidation) -> Ranking:
     """Stage 6: exact held-out errors in, classes, weak-evidence rules; a
     cause is never named while a rival candidate is untested."""
@@ -392,13 +441,26 @@ def rank(ds, cal: Calibration, dec: Decision, cv: CrossValidation) -> Ranking:
             d_runner=None if runner is None else rows[runner].aicc - b.aicc,
             heldout_nominal=held0, heldout_best=b.heldout_rmse, ci_rel=_ci_rel(b),
             c_hat=dec.c_hat, coarse=_coarse(ds, cal.fit))
-        weak += _untested_reasons(untested, b)
+        weak += _untested_reasons(untested, b) + _pair_reasons(b, rows)
     cause = best if (dec.discrepancy and rows and not weak) else None
     after = best if dec.discrepancy else None
     return Ranking(rows, classes, cause, after, runner, weak, untested, held0)
 
 
-# -- stage 7: extend ---------------------------------------------------------------------------
+# -- stage 7: extend ---------------------------------------------------------------------
+def _append_second(problem, lib, part, row, path):
+    """Append the second hypothesis of a pair to a written model file."""
+    from pathlib import Path
+    from .hypotheses import file_defaults
+    from ..modelfile import load_model_file
+    h, loc, names = part
+    vals = file_defaults(load_model_file(problem.model_path), h, loc)
+    vals.update({k: row.fit.values[k] for k in names})
+    code = lib.HYPOTHESES[h].code(loc, vals).replace("hypothesis_specs =",
+                                                      "hypothesis_specs_2 =")
+    Path(path).write_text(Path(path).read_text() + "\n" + code)
+
+
 def extend(problem: Problem, ranking: Ranking, out_dir) -> str | None:
     """Stage 7: the extended model file of the named cause (or None): the
     library writes the original plus the hypothesis with its fitted values;
@@ -410,11 +472,14 @@ def extend(problem: Problem, ranking: Ranking, out_dir) -> str | None:
     from pathlib import Path
     lib = load_library(problem.library)
     c = row.candidate
-    target = Path(out_dir) / f"{Path(problem.model_path).stem}_{c.hypothesis}.py"
+    parts = c.members()
+    target = Path(out_dir) / f"{Path(problem.model_path).stem}_{c.hypothesis.replace('+', '_')}.py"
     free = problem.free_names
-    own = {k: v for k, v in row.fit.values.items() if k not in free}
-    path = str(lib.write_extended_model(problem.model_path, c.hypothesis, c.location, own,
-                                        str(target)))
+    h0, l0, names0 = parts[0]
+    path = str(lib.write_extended_model(problem.model_path, h0, l0,
+                                        {k: row.fit.values[k] for k in names0}, str(target)))
+    if len(parts) > 1:
+        _append_second(problem, lib, parts[1], row, path)
     if not free:
         return path
     lines = ["# calibrated free parameters (acausal diagnose)"]

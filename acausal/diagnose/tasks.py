@@ -31,6 +31,8 @@ from ..executor import worker_cache
 from ..modelfile import compile_file
 from .fitting import Fit, Objective, failed_fit, finish, linear_loo, refine_or_keep, \
     score_starts, subset, weighted_residuals
+from .generic import GENERIC
+from .generic import build as build_generic
 from .library import load_library
 from .problem import LOO_TOL, Candidate, Problem
 
@@ -93,6 +95,14 @@ def dataset_of(problem: Problem):
 def model_of(problem: Problem, candidate: Candidate):
     if candidate.hypothesis is None:
         return compile_file(problem.model_path)
+    if candidate.hypothesis == GENERIC.id:
+        return worker_cache(("diagnose-generic", _stamp(problem.model_path), candidate.location),
+                            lambda: build_generic(problem.model_path, candidate.location))
+    if "+" in candidate.hypothesis:          # a pair: "h1+h2" at "l1+l2"
+        pair = tuple(zip(candidate.hypothesis.split("+"), candidate.location.split("+")))
+        return worker_cache(("diagnose-pair", _stamp(problem.model_path), problem.library,
+                             pair), lambda: load_library(problem.library).build_pair(
+                                 problem.model_path, pair))
     key = ("diagnose-model", _stamp(problem.model_path), problem.library,
            candidate.hypothesis, candidate.location)
     return worker_cache(key, lambda: load_library(problem.library).build_extended(
@@ -109,7 +119,7 @@ def window(ds: Dataset, frac: float) -> Dataset:
         trace = None
         if e.trace is not None:
             t = e.trace.time
-            keep = t <= t[0] + frac * (t[-1] - t[0])
+            keep = t <= t[0] + frac * (t[-1] - t[0]) * (1 + 1e-9)
             trace = Trace(t[keep], {k: v[keep] for k, v in e.trace.signals.items()})
         out.append(Experiment(e.name, e.conditions, {}, trace, e.line, e.use))
     return Dataset(ds.folder, out, ds.instrument)
@@ -129,7 +139,7 @@ def lhs_values(params, n, seed=0):
         for p, ui in zip(params, row):
             sides = [s for s, b in ((1.0, p.high), (-1.0, -p.low)) if b > 0]
             if not sides:
-                x.append(p.start)
+                x.append(p.prior)
                 continue
             s = sides[0] if len(sides) == 1 else (-1.0 if ui < 0.5 else 1.0)
             w = ui if len(sides) == 1 else (2 * ui) % 1.0
@@ -146,8 +156,11 @@ def start_points(task: FitTask):
     s = task.problem.settings
     cal = [p.start for p in free]
     prior = [p.prior for p in free]
-    neutral = [p.start for p in ext]
+    neutral = [p.prior for p in ext]
     pts = [(np.array(cal + neutral), False)]
+    seeded = [p.start for p in ext]
+    if seeded != neutral:                 # a seed (a pair from its single fits)
+        pts.append((np.array(cal + seeded), False))
     differs = any(abs(a - b) > 1e-9 * max(abs(b), 1e-300) for a, b in zip(cal, prior))
     if differs and ext:
         pts.append((np.array(prior + neutral), True))
@@ -189,7 +202,7 @@ def _tested(fits, ext, J_best):
     if not ext:
         return True
     k = len(ext)
-    neutral = np.array([p.start for p in ext])
+    neutral = np.array([p.prior for p in ext])
     sc = np.array([abs(p.scale) or 1.0 for p in ext])
     if any(np.any(np.abs(np.array([f.values[p.name] for p in ext]) - neutral) > 1e-3 * sc)
            for f in fits):
@@ -212,6 +225,21 @@ def fit_candidate(task: FitTask) -> CandidateFit:
                             time.perf_counter() - t0)
 
 
+def _windows(ds, settings):
+    """The growing windows of the homotopy (only the whole record when the
+    data have no trace)."""
+    has_trace = any(e.trace is not None for e in ds.experiments)
+    return tuple(settings.windows) if has_trace else (1.0,)
+
+
+def _summary(fits, scored, ext=(), tested=True):
+    best = min(fits, key=lambda f: f.cost)
+    tol = max(0.5, 1e-3 * best.cost)
+    if ext:
+        tested = _tested(fits, ext, best.jacobian)
+    return best, Starts(scored, len(fits), sum(f.cost <= best.cost + tol for f in fits), tested)
+
+
 def _multistart(task: FitTask):
     p, cand = task.problem, task.candidate
     s = p.settings
@@ -220,22 +248,19 @@ def _multistart(task: FitTask):
     lo, hi, sc = _bounds(params)
     ds = dataset_of(p)
     pair = model_of(p, cand)
-    max_evals = s.evals_per_param * (len(names) + 1)
-    obj = Objective(pair, ds, names, budget_s=task.budget_s, max_evals=max_evals)
+    obj = Objective(pair, ds, names, budget_s=task.budget_s, penalty=_penalty(cand))
     pts = start_points(task)
-    origin = {id(x): pr for x, pr in pts}
     scored = score_starts(obj, [x for x, _ in pts], lo, hi, task.absorb)
     if not scored:
         return failed_fit(names, pts[0][0], obj, "every starting point failed"), Starts()
-    fits = []
-    for c, x in _pick(scored, len(cand.params), sc, s.refine):
-        obj.n_eval = 0
-        fits.append(finish(obj, *refine_or_keep(obj, x, lo, hi, sc, s.max_nfev, s.tol), lo))
-    best = min(fits, key=lambda f: f.cost)
-    tol = max(0.5, 1e-3 * best.cost)
-    starts = Starts(len(scored), len(fits), sum(f.cost <= best.cost + tol for f in fits),
-                    _tested(fits, cand.params, best.jacobian))
-    best.n_sim = obj.n_sim
+    fits, n_sim = [], obj.n_sim
+    for _, x in _pick(scored, len(cand.params), sc, s.refine):
+        f = _homotopy(pair, ds, names, x, lo, hi, sc, _windows(ds, s), s, task.budget_s,
+                      _penalty(cand))
+        n_sim += f.n_sim
+        fits.append(f)
+    best, starts = _summary(fits, len(scored), cand.params)
+    best.n_sim = n_sim
     return best, starts
 
 
@@ -251,32 +276,42 @@ def calibrate_nominal(task: FitTask) -> CandidateFit:
     lo, hi, sc = _bounds(params)
     ds = dataset_of(p)
     pair = model_of(p, task.candidate)
-    has_trace = any(e.trace is not None for e in ds.experiments)
-    windows = s.windows if has_trace else (1.0,)
+    windows = _windows(ds, s)
+    n_lhs = s.lhs if len(windows) > 1 else 0
     pts = [np.array([q.start for q in params])] + [np.array(x) for x in lhs_values(
-        [q.moved(q.start) for q in params], s.lhs if has_trace else 0, s.seed)]
+        params, n_lhs, s.seed)]
     obj = Objective(pair, window(ds, windows[0]), names)
     scored = score_starts(obj, pts, lo, hi)
     if not scored:
         return CandidateFit(task.candidate, None, {}, "every starting point failed",
                             time.perf_counter() - t0)
     fits = [_homotopy(pair, ds, names, x, lo, hi, sc, windows, s)
-            for _, x in scored[:max(1, s.refine if has_trace else 1)]]
-    best = min(fits, key=lambda f: f.cost)
-    tol = max(0.5, 1e-3 * best.cost)
-    starts = Starts(len(scored), len(fits), sum(f.cost <= best.cost + tol for f in fits))
+            for _, x in scored[:max(1, s.refine if n_lhs else 1)]]
+    best, starts = _summary(fits, len(scored))
+    best.n_sim = obj.n_sim + sum(f.n_sim for f in fits)
     loo = linear_loo(best) if best.ok else {}
     return CandidateFit(task.candidate, best, loo, None, time.perf_counter() - t0, starts)
 
 
-def _homotopy(pair, ds, names, x, lo, hi, sc, windows, s):
-    """Refine ``x`` on each window in turn, the last being the whole record."""
-    fit = None
+def _penalty(cand):
+    if cand.penalty is None:
+        return None
+    return np.asarray(cand.penalty, float), np.array([abs(p.scale) or 1.0 for p in cand.params])
+
+
+def _homotopy(pair, ds, names, x, lo, hi, sc, windows, s, budget_s=None, penalty=None):
+    """Refine ``x`` on each window in turn, the last being the whole record
+    (the windows before it get a third of the evaluations). ``n_sim`` of
+    the returned fit counts every window."""
+    fit, n_sim = None, 0
+    full = s.evals_per_param * (len(names) + 1)
     for w in windows:
-        obj = Objective(pair, window(ds, w), names,
-                        max_evals=s.evals_per_param * (len(names) + 1))
+        obj = Objective(pair, window(ds, w), names, budget_s=budget_s, penalty=penalty,
+                        max_evals=full if w >= 1.0 else max(3, full // 3))
         fit = finish(obj, *refine_or_keep(obj, x, lo, hi, sc, s.max_nfev, s.tol), lo)
+        n_sim += obj.n_sim
         x = np.array([fit.values[n] for n in names])
+    fit.n_sim = n_sim
     return fit
 
 

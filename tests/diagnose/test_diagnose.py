@@ -9,12 +9,16 @@ counts false positives over noise-only datasets.
 """
 import json
 import os
+import pickle
 
 import pytest
 from click.testing import CliRunner
 
 from acausal.cli import main
-from acausal.diagnose.run import diagnose
+from acausal.compile import CompiledModel
+from acausal.diagnose.report import write_report
+from acausal.diagnose.result import summary
+from acausal.diagnose.run import diagnose, run_stages
 from acausal.diagnose.synth import synthesize
 
 HERE = os.path.dirname(__file__)
@@ -36,8 +40,19 @@ def blind(tmp_path_factory):
     d = tmp_path_factory.mktemp("blind")
     truth = _latch_data(d / "data", 11, hypothesis="coulomb_friction", location="latch",
                         effect=(6.0, 6.0))
-    out = diagnose(LATCH, d / "data", out_dir=d / "out", workers=2, progress=False,
-                   hypotheses=FAST)
+    # the stages, then the report from a pickled copy of the result with the
+    # simulator disabled: the result is picklable and the report a pure view
+    res = run_stages(LATCH, d / "data", out_dir=d / "out", workers=2, progress=False,
+                     hypotheses=FAST)
+    res = pickle.loads(pickle.dumps(res))
+
+    def no_simulation(*a, **k):
+        raise AssertionError("the report simulated")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(CompiledModel, "simulate", no_simulation)
+        write_report(d / "out", res)
+    out = summary(res)
+    (d / "out" / "diagnosis.json").write_text(json.dumps(out, indent=1))
     return truth, out, d / "out"
 
 
@@ -58,6 +73,10 @@ def test_blind_case_names_the_hidden_cause(blind):
                                  "aicc": out["ranking"][0]["aicc"],
                                  "heldout_rmse": out["ranking"][0]["heldout_rmse"]}
     assert out["extended_model"] and os.path.exists(out["extended_model"])
+    assert out["causes"] == [{"cause": "coulomb_friction", "location": "latch",
+                              "parameters": {name: out["parameters"][name]}}]
+    assert out["unexplained"]["value"] is False and out["next_experiment"] is None
+    assert out["profile_ci95"] == {}
 
 
 def test_blind_case_report(blind):
