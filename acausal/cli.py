@@ -247,13 +247,18 @@ def _csv_list(text):
               help="only these locations (a path or a prefix of paths)")
 @click.option("--alpha", type=float, default=0.01, show_default=True,
               help="family significance level of the discrepancy decision")
+@click.option("--starts", type=click.IntRange(0, 64), default=4, show_default=True,
+              help="Latin-hypercube starts per fit (besides the neutral and calibrated ones)")
+@click.option("--refine", type=click.IntRange(1, 8), default=2, show_default=True,
+              help="best starts refined per fit (their agreement is reported)")
 @click.option("--no-progress", is_flag=True)
 @click.option("--library", hidden=True, help="module standing in for the hypothesis library")
 def diagnose(file, data, json_path, report_dir, scheduler, workers, hypotheses, locations,
-             alpha, no_progress, library):
+             alpha, starts, refine, no_progress, library):
     """Show what a model gets wrong against measured data, name the cause,
     extend the model and measure the gain."""
     from .data import DataError
+    from .diagnose.problem import FitSettings
     from .diagnose.run import diagnose as run_diagnosis
     try:
         if not 0 < alpha < 1:
@@ -261,7 +266,8 @@ def diagnose(file, data, json_path, report_dir, scheduler, workers, hypotheses, 
         out = run_diagnosis(file, data, out_dir=report_dir, scheduler=scheduler,
                             workers=workers, progress=not no_progress,
                             hypotheses=_csv_list(hypotheses), locations=_csv_list(locations),
-                            alpha=alpha, library=library)
+                            alpha=alpha, library=library,
+                            settings=FitSettings(lhs=starts, refine=refine))
     except (AcausalError, DataError, click.BadParameter, ValueError, ImportError) as exc:
         _fail(exc)
     if json_path:

@@ -16,6 +16,7 @@ from click.testing import CliRunner
 
 from acausal.cli import main
 from acausal.compile import CompiledModel
+from acausal.diagnose.problem import FitSettings
 from acausal.diagnose.report import write_report
 from acausal.diagnose.result import summary
 from acausal.diagnose.run import diagnose, run_stages
@@ -24,6 +25,10 @@ from acausal.diagnose.synth import synthesize
 HERE = os.path.dirname(__file__)
 LATCH = os.path.abspath(os.path.join(HERE, "..", "..", "models", "latch_striker.py"))
 FAST = ["coulomb_friction", "quadratic_damping", "constant_load"]
+# the fast tier's fits: two Latin-hypercube starts, the best refined (the
+# full method's defaults are 4 and 2: slow tier and command-line default)
+LIGHT = FitSettings(lhs=2, refine=1)
+LIGHT_CLI = ["--starts", "2", "--refine", "1"]
 KEYS = {"discrepancy", "cause", "location", "equivalent_causes", "parameters", "ranking",
         "gain", "extended_model", "causes", "unexplained", "next_experiment", "profile_ci95"}
 
@@ -43,7 +48,7 @@ def blind(tmp_path_factory):
     # the stages, then the report from a pickled copy of the result with the
     # simulator disabled: the result is picklable and the report a pure view
     res = run_stages(LATCH, d / "data", out_dir=d / "out", workers=2, progress=False,
-                     hypotheses=FAST)
+                     hypotheses=FAST, settings=LIGHT)
     res = pickle.loads(pickle.dumps(res))
 
     def no_simulation(*a, **k):
@@ -93,7 +98,7 @@ def test_null_case_and_command_line(tmp_path):
     r = CliRunner().invoke(main, ["diagnose", LATCH, str(tmp_path / "data"), "--json",
                                   str(tmp_path / "out.json"), "--report",
                                   str(tmp_path / "rep"), "--workers", "2", "--no-progress",
-                                  "--hypotheses", ",".join(FAST)])
+                                  "--hypotheses", ",".join(FAST), *LIGHT_CLI])
     assert r.exit_code == 0, r.output
     out = json.loads((tmp_path / "out.json").read_text())
     assert set(out) == KEYS
@@ -275,7 +280,7 @@ def test_candidate_fits_on_a_dask_cluster_match_local_processes(tmp_path):
     _latch_data(tmp_path / "data", 14, hypothesis="constant_load", location="plunger",
                 effect=(6.0, 6.0))
     kw = dict(progress=False, hypotheses=["constant_load", "quadratic_damping"],
-              locations=["plunger"], plots=False)
+              locations=["plunger"], plots=False, settings=LIGHT)
     local = diagnose(LATCH, tmp_path / "data", out_dir=tmp_path / "local", workers=2, **kw)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster:
@@ -284,7 +289,7 @@ def test_candidate_fits_on_a_dask_cluster_match_local_processes(tmp_path):
                                       str(tmp_path / "dask"), "--scheduler",
                                       cluster.scheduler_address, "--no-progress",
                                       "--hypotheses", "constant_load,quadratic_damping",
-                                      "--locations", "plunger"])
+                                      "--locations", "plunger", *LIGHT_CLI])
     assert r.exit_code == 0, r.output
     remote = json.loads((tmp_path / "dask.json").read_text())
     assert remote["cause"] == local["cause"] == "constant_load"
