@@ -195,17 +195,19 @@ def _pick(scored, n_ext, sc, n):
     return out
 
 
-def _tested(fits, ext, J_best):
-    """False when every refined fit left the extension at its neutral
-    values and a move by one typical magnitude changes S by less than 1
-    at the best point (the data never saw the extension act)."""
+def _tested(fits, ext, J_best, starts=()):
+    """False when every refined fit started and ended with the extension at
+    its neutral values and a move by one typical magnitude changes S by
+    less than 1 at the best point: the data never saw the extension act.
+    (A fit started away from neutral that comes back to it is a test: the
+    data rejected the effect.)"""
     if not ext:
         return True
     k = len(ext)
     neutral = np.array([p.prior for p in ext])
     sc = np.array([abs(p.scale) or 1.0 for p in ext])
-    if any(np.any(np.abs(np.array([f.values[p.name] for p in ext]) - neutral) > 1e-3 * sc)
-           for f in fits):
+    ends = [np.array([f.values[p.name] for p in ext]) for f in fits]
+    if any(np.any(np.abs(x[-k:] - neutral) > 1e-3 * sc) for x in list(starts) + ends):
         return True
     if J_best.size == 0:
         return False
@@ -232,11 +234,11 @@ def _windows(ds, settings):
     return tuple(settings.windows) if has_trace else (1.0,)
 
 
-def _summary(fits, scored, ext=(), tested=True):
+def _summary(fits, scored, ext=(), tested=True, starts=()):
     best = min(fits, key=lambda f: f.cost)
     tol = max(0.5, 1e-3 * best.cost)
     if ext:
-        tested = _tested(fits, ext, best.jacobian)
+        tested = _tested(fits, ext, best.jacobian, starts)
     return best, Starts(scored, len(fits), sum(f.cost <= best.cost + tol for f in fits), tested)
 
 
@@ -254,12 +256,13 @@ def _multistart(task: FitTask):
     if not scored:
         return failed_fit(names, pts[0][0], obj, "every starting point failed"), Starts()
     fits, n_sim = [], obj.n_sim
-    for _, x in _pick(scored, len(cand.params), sc, s.refine):
+    picked = _pick(scored, len(cand.params), sc, s.refine)
+    for _, x in picked:
         f = _homotopy(pair, ds, names, x, lo, hi, sc, _windows(ds, s), s, task.budget_s,
                       _penalty(cand))
         n_sim += f.n_sim
         fits.append(f)
-    best, starts = _summary(fits, len(scored), cand.params)
+    best, starts = _summary(fits, len(scored), cand.params, True, [x for _, x in picked])
     best.n_sim = n_sim
     return best, starts
 

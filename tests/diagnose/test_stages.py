@@ -100,6 +100,9 @@ def test_not_tested_when_neutral_from_every_start_and_without_local_effect():
     assert _tested([at_zero, at_zero], ext, flat) is False
     moved = _fit({"k": 1.0, "hyp.T": 0.05}, flat)
     assert _tested([at_zero, moved], ext, flat) is True
+    # started away from neutral and pulled back: the data rejected it (a test)
+    assert _tested([at_zero], ext, flat, [np.array([1.0, 0.3])]) is True
+    assert _tested([at_zero], ext, flat, [np.array([1.0, 0.0])]) is False
     steep = flat.copy()
     steep[:, 1] = 10.0                      # at its neutral value but with an effect:
     assert _tested([at_zero], ext, steep) is True   # the data pushed it there
