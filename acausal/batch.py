@@ -18,7 +18,7 @@ import itertools
 import multiprocessing as mp
 import os
 
-from .errors import AcausalError
+from .errors import AcausalError, UsageError
 
 _JOBS = {}              # token -> (compiled model, reduce, simulate keywords)
 _token = itertools.count()
@@ -76,7 +76,7 @@ def simulate_batch(cm, param_sets, *, workers=None, chunksize=None, reduce=None,
     (default: about four tasks per worker). Other keywords go to
     :meth:`CompiledModel.simulate`."""
     if errors not in ("raise", "return"):
-        raise ValueError(f"errors must be 'raise' or 'return', got {errors!r}")
+        raise UsageError(f"errors must be 'raise' or 'return', got {errors!r}")
     sets = [dict(p or {}) for p in param_sets]
     for p in sets:
         cm.param_vector(p)                   # bad names / out-of-bounds values: fail now

@@ -456,12 +456,17 @@ def _csv_list(text):
               help="only these locations (a path or a prefix of paths)")
 @click.option("--alpha", type=float, default=0.01, show_default=True,
               help="family significance level of the discrepancy decision")
+@click.option("--starts", type=click.IntRange(0, 64), default=4, show_default=True,
+              help="Latin-hypercube starts per fit (besides the neutral and calibrated ones)")
+@click.option("--refine", type=click.IntRange(1, 8), default=2, show_default=True,
+              help="best starts refined per fit (their agreement is reported)")
 @click.option("--no-progress", is_flag=True)
 @click.option("--library", hidden=True, help="module standing in for the hypothesis library")
 def diagnose(file, data, json_path, report_dir, scheduler, workers, hypotheses, locations,
-             alpha, no_progress, library):
+             alpha, starts, refine, no_progress, library):
     """Show what a model gets wrong against measured data, name the cause,
     extend the model and measure the gain."""
+    from .diagnose.problem import FitSettings
     from .diagnose.run import diagnose as run_diagnosis
     from .executor import terminate_on_sigterm
     try:
@@ -471,7 +476,8 @@ def diagnose(file, data, json_path, report_dir, scheduler, workers, hypotheses, 
             out = run_diagnosis(file, data, out_dir=report_dir, scheduler=scheduler,
                                 workers=workers, progress=not no_progress,
                                 hypotheses=_csv_list(hypotheses),
-                                locations=_csv_list(locations), alpha=alpha, library=library)
+                                locations=_csv_list(locations), alpha=alpha, library=library,
+                                settings=FitSettings(lhs=starts, refine=refine))
     except (AcausalError, click.BadParameter) as exc:
         _fail(exc)
     if json_path:
@@ -480,6 +486,9 @@ def diagnose(file, data, json_path, report_dir, scheduler, workers, hypotheses, 
     g = out["gain"]
     if not out["discrepancy"]:
         click.echo("no significant discrepancy between the calibrated model and the data")
+    elif out["unexplained"]["value"]:
+        click.echo(f"discrepancy not explained by the library; located at the node of "
+                   f"{out['unexplained']['node']}")
     elif out["cause"] is None:
         click.echo("discrepancy, but the evidence is weak: no cause named"
                    + (f" (best candidate: {out['ranking'][0]['cause']} at "

@@ -100,7 +100,8 @@ class Names:
             e = sp.sympify(e)
             bad = [s for s in e.free_symbols if s not in self.map]
             if bad:
-                raise ValueError(f"internal: {what} refers to {bad[0]} which is not "
+                raise ValueError(  # internal: CompiledModel.resolve checked user expressions
+                    f"internal: {what} refers to {bad[0]} which is not "
                                  "a state, algebraic unknown, parameter or discrete value")
             out.append(e)
         return out

@@ -126,9 +126,12 @@ def _raise_if_parameter_breaks(cm, t0, p, d, exc):
     kg*m^2 inertia makes them numerically singular, which shows as
     "inconsistent fixed start values"). Only the generic failures are
     diagnosed; a named cause (a linkage that cannot close) is kept."""
-    if not str(exc).startswith(("inconsistent fixed start values",
-                                "no consistent initial point")):
-        return  # a named cause (an assertion such as a linkage that cannot close)
+    text = str(exc)
+    if not any(m in text for m in ("inconsistent fixed start values",
+                                   "no consistent initial point")):
+        return  # a named cause alone (a linkage that cannot close)
+    # (an absurd stiffness can also push a linkage past its assertion: then
+    # both are reported, and only parameters SUSPECT_DECADES away are tried)
     for k, entry in enumerate(cm.params):
         if not _far_from(p[k], entry.default):
             continue

@@ -2,13 +2,19 @@
 physical cause explains it.
 
 :mod:`.graph` finds the sites of a model where a cause can act (bodies,
-joints, springs, contacts, sources); :mod:`.hypotheses` is the library of
-causes, each a model extension that inserts a component at a site, with
-the parameters to fit. :mod:`.run` is the driver (``acausal diagnose``,
-:func:`~acausal.diagnose.run.diagnose`), with :mod:`.stats` (the tests and
-criteria), :mod:`.fitting` (output-error fits and leave-one-out),
-:mod:`.fingerprints`, :mod:`.report` and :mod:`.synth` (synthetic data for
-blind tests). Importing this package has no side effects.
+joints, springs, contacts, sources: each component class declares its
+``diagnosis_site``); :mod:`.domain` describes the mechanical domains once;
+:mod:`.hypotheses` is the library of causes, each a model extension that
+inserts a component at a site, with the parameters to fit.
+
+The diagnosis is a chain of typed stages (:mod:`.stages`: calibrate ->
+candidates -> fit -> decide -> cross-validate -> rank -> extend -> views)
+over picklable dataclasses (:mod:`.problem`, :mod:`.tasks`), chained by
+:mod:`.run` (``acausal diagnose``, :func:`~acausal.diagnose.run.diagnose`)
+into a :class:`~.result.Diagnosis`, of which :mod:`.report` is a pure view.
+:mod:`.stats` holds the tests and criteria, :mod:`.fitting` the output-error
+fits, :mod:`.synth` synthetic data for blind tests. Importing this package
+has no side effects.
 """
 from .graph import KINDS, ModelGraph, Site
 from .hypotheses import HYPOTHESES, Hypothesis, ParamSpec, build_extended, write_extended_model

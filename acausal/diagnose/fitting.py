@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import optimize, stats
 
-from ..calibrate import FD_STEP, ForwardDifferences, resolve, residual_vector
+from ..calibrate import FD_STEP, ForwardDifferences, resolve
 from ..data import Dataset
 from ..errors import AcausalError
 
@@ -69,140 +69,202 @@ def subset(dataset: Dataset, names) -> Dataset:
 
 
 def weighted_residuals(model, dataset, params):
-    """(vector, groups, signals) of weighted residuals for ``params``."""
-    vec, labels, _ = residual_vector(resolve(model), dataset, params,
-                                     options={"max_steps": MAX_STEPS})
-    return vec, [g for g, _ in labels], [s for _, s in labels]
+    """(vector, groups, signals) of weighted residuals for ``params``, as
+    :func:`acausal.calibrate.residual_vector` (measures first, then trace
+    samples), except that an experiment without measures is simulated only
+    up to its last trace sample (a growing-window fit then pays only for
+    its window) and its measures are not evaluated."""
+    from ..calibrate import _sigma
+    from ..modelfile import evaluate_measures
+    mf, cm = resolve(model)
+    vec, groups, signals = [], [], []
+    for e in dataset.experiments:
+        # samples compared with a trace: the model file's dense grid
+        opts = {**mf.experiment.run_options(dense=e.trace is not None), "max_steps": MAX_STEPS}
+        if not e.measures and e.trace is not None and e.trace.time.size:
+            opts["t_end"] = min(opts["t_end"], float(e.trace.time[-1]) * (1 + 1e-9) + 1e-12)
+        res = cm.simulate(params={**params, **e.conditions}, **opts)
+        if e.measures:
+            meas = evaluate_measures(mf, res)
+            for m, y in e.measures.items():
+                vec.append((meas[m] - y) / _sigma(dataset, m, y))
+                groups.append(e.name)
+                signals.append(m)
+        if e.trace is not None:
+            for var, ys in e.trace.signals.items():
+                sim = np.interp(e.trace.time, res.t, res[var])
+                vec.extend((sim - ys) / _sigma(dataset, var, ys))
+                groups.extend([e.name] * len(ys))
+                signals.extend([var] * len(ys))
+    return np.asarray(vec, float), groups, signals
 
 
 class _OutOfTime(Exception):
     """The fit's time budget is spent (raised inside the optimiser)."""
 
 
-def fit(model, dataset, names, x0, low, high, scale, *, fixed=None, starts=None,
-        max_nfev=60, tol=1e-8, budget_s=None, absorb=None, max_evals=None) -> Fit:
-    """Weighted output-error least squares over ``names``.
-
-    ``x0``, ``low``, ``high``, ``scale``: per-name start, bounds and typical
-    magnitude (the optimiser works on value/scale). ``fixed``: other
-    parameter overrides. ``starts``: extra starting points (dicts name ->
-    value, merged into ``x0``); the one with the smallest cost is refined
-    (a cheap guard against a local minimum when a hypothesis's parameter
-    starts where it has no effect). ``budget_s``: wall-time budget; when it
-    is spent the best point seen so far is kept (``message`` says so) and
-    the Jacobian is taken there by one more finite-difference pass.
-    ``max_evals``: the same after this many evaluations of the residuals
-    (counting finite-difference ones; deterministic, unlike the budget).
-    ``absorb``: (names, jacobian) of parameters calibrated beforehand (the
-    nominal fit's free parameters and its Jacobian, rows as this dataset's
-    residuals): each starting point is then scored after a linearised
-    re-calibration of those parameters, and moved there. Without it a start
-    is scored with the free parameters as they are, which favours "no
-    effect" whenever they already absorb part of the effect (a viscous
-    coefficient absorbing quadratic drag).
+class Objective:
+    """The weighted residuals of one model on one dataset as a function of
+    the fitted parameters, counting simulations, keeping the best point
+    seen, and stopping (:class:`_OutOfTime`) after ``max_evals``
+    evaluations or ``budget_s`` seconds. A failed simulation gives
+    :data:`PENALTY` residuals (after a first success, which sets the size).
     """
-    t0 = time.perf_counter()
-    pair = resolve(model)
-    fixed = dict(fixed or {})
-    names = list(names)
-    x0 = np.array([float(x0[n]) for n in names])
-    lo = np.array([float(low[n]) for n in names])
-    hi = np.array([float(high[n]) for n in names])
-    sc = np.array([abs(float(scale[n])) or 1.0 for n in names])
-    n_sim = [0]
-    n_exp = len(dataset.experiments)
-    size = [None]
 
-    seen = {"cost": np.inf, "x": None}
-    timed = [True]
+    def __init__(self, model, dataset, names, fixed=None, budget_s=None, max_evals=None,
+                 penalty=None):
+        self.pair = resolve(model)
+        self.penalty = penalty        # (rows P, scales) on the last P.shape[1] parameters
+        self.dataset = dataset
+        self.names = list(names)
+        self.fixed = dict(fixed or {})
+        self.budget_s, self.max_evals = budget_s, max_evals
+        self.t0 = time.perf_counter()
+        self.n_eval = self.n_sim = 0
+        self.size = None
+        self.best_cost, self.best_x = np.inf, None
+        self.timed = True
 
-    n_eval = [0]
+    def params(self, x):
+        return {**self.fixed, **dict(zip(self.names, np.asarray(x, float).tolist()))}
 
-    def evaluate(x):
-        if timed[0] and budget_s is not None and time.perf_counter() - t0 > budget_s:
-            raise _OutOfTime(f"stopped at the time budget ({budget_s:.0f} s)")
-        if timed[0] and max_evals is not None and n_eval[0] >= max_evals:
-            raise _OutOfTime(f"stopped after {max_evals} evaluations")
-        n_eval[0] += 1
-        n_sim[0] += n_exp
-        params = {**fixed, **dict(zip(names, x))}
+    def _check(self):
+        if not self.timed:
+            return
+        if self.budget_s is not None and time.perf_counter() - self.t0 > self.budget_s:
+            raise _OutOfTime(f"stopped at the time budget ({self.budget_s:.0f} s)")
+        if self.max_evals is not None and self.n_eval >= self.max_evals:
+            raise _OutOfTime(f"stopped after {self.max_evals} evaluations")
+
+    def __call__(self, x):
+        self._check()
+        self.n_eval += 1
+        self.n_sim += len(self.dataset.experiments)
         try:
-            vec = weighted_residuals(pair, dataset, params)[0]
-            size[0] = vec.size
+            vec = weighted_residuals(self.pair, self.dataset, self.params(x))[0]
+            self.size = vec.size
             if not np.all(np.isfinite(vec)):
                 vec = np.nan_to_num(vec, nan=PENALTY, posinf=PENALTY, neginf=-PENALTY)
         except AcausalError:
-            if size[0] is None:
+            if self.size is None:
                 raise
-            vec = np.full(size[0], PENALTY)
+            vec = np.full(self.size, PENALTY)
+        if self.penalty is not None:
+            P, sc = self.penalty
+            vec = np.concatenate([vec, P @ (np.asarray(x, float)[-P.shape[1]:] / sc)])
         c = float(vec @ vec)
-        if c < seen["cost"]:
-            seen.update(cost=c, x=np.array(x, float))
+        if c < self.best_cost:
+            self.best_cost, self.best_x = c, np.array(x, float)
         return vec
 
-    candidates = [np.clip(x0, lo, hi)]
-    for st in starts or []:
-        x = x0.copy()
-        for i, n in enumerate(names):
-            if n in st:
-                x[i] = st[n]
-        candidates.append(np.clip(x, lo, hi))
-    best, best_cost = None, np.inf
-    a_idx, a_jac = None, None
+
+def score_starts(obj, starts, lo, hi, absorb=None):
+    """Evaluate each start (an array over ``obj.names``) once; with
+    ``absorb`` = (names, jacobian) of parameters calibrated beforehand, each
+    start is scored after a linearised re-calibration of those parameters
+    and moved there (so that a start is not rejected because a free
+    parameter currently absorbs the effect). Returns [(cost, x)] sorted by
+    cost (starts that fail to simulate are left out)."""
+    a_idx = a_jac = None
     if absorb is not None and absorb[0]:
-        a_idx = np.array([names.index(n) for n in absorb[0]])
+        a_idx = np.array([obj.names.index(n) for n in absorb[0]])
         a_jac = np.asarray(absorb[1], float)
-    for x in candidates:
+    out = []
+    for x in starts:
+        x = np.clip(np.asarray(x, float), lo, hi)
         try:
-            r = evaluate(x)
+            r = obj(x)
         except AcausalError:
             continue
         except _OutOfTime:
             break
         c = float(r @ r)
-        if a_jac is not None and a_jac.shape[0] == r.size:
-            d = np.linalg.lstsq(a_jac, -r, rcond=None)[0]
+        m = a_jac.shape[0] if a_jac is not None else 0
+        if a_jac is not None and m <= r.size:
+            d = np.linalg.lstsq(a_jac, -r[:m], rcond=None)[0]
             moved = np.clip(x[a_idx] + d, lo[a_idx], hi[a_idx])
-            rr = r + a_jac @ (moved - x[a_idx])
+            rr = r[:m] + a_jac @ (moved - x[a_idx])
+            c = float(rr @ rr) + float(r[m:] @ r[m:])
             c = float(rr @ rr)
             x = x.copy()
             x[a_idx] = moved
-        if c < best_cost:
-            best, best_cost = x, c
-    if best is None:
-        return Fit(names, dict(zip(names, x0.tolist())), float("inf"), np.zeros(0),
-                   np.zeros((0, len(names))), [], [], n_sim=n_sim[0],
-                   wall_s=time.perf_counter() - t0, ok=False,
-                   message="every starting point failed to simulate")
-    ok, message = True, ""
-    if names:
-        try:
-            fd = ForwardDifferences(lambda z: evaluate(z * sc), FD_STEP, hi / sc)
-            sol = optimize.least_squares(fd, best / sc, jac=fd.jac,
-                                         bounds=(lo / sc, hi / sc), x_scale=1.0,
-                                         xtol=tol, ftol=tol, gtol=tol, max_nfev=max_nfev)
-            x = sol.x * sc
-            message = sol.message
-            ok = sol.status >= 0     # 0: max_nfev reached (still usable)
-            J = sol.jac / sc
-        except _OutOfTime as stop:
-            timed[0] = False
-            x = seen["x"] if seen["x"] is not None else best
-            message = f"{stop}; best point kept"
-            J = fd.jac(x / sc) / sc      # the same differences, at the kept point
-    else:
-        x = best
-        J = np.zeros((0, 0))
-    r, groups, signals = weighted_residuals(pair, dataset, {**fixed, **dict(zip(names, x))})
-    n_sim[0] += n_exp
-    if names:
-        J = J.reshape(r.size, len(names))
-    else:
-        J = np.zeros((r.size, 0))
-    values = dict(zip(names, x.tolist()))
-    out = Fit(names, values, float(r @ r), r, J, groups, signals, n_sim=n_sim[0],
-              wall_s=time.perf_counter() - t0, ok=bool(ok), message=str(message))
-    out.ci95 = confidence(out, positive=[n for n, l in zip(names, lo) if l > 0])
+        out.append((c, x))
+    return sorted(out, key=lambda cx: cx[0])
+
+
+def refine(obj, x_start, lo, hi, sc, max_nfev, tol):
+    """Trust-region least squares (scipy, bounded, on value/scale) from
+    ``x_start`` with forward differences of a step FD_STEP of each scale.
+    Returns (x, jacobian in parameter units, ok, message); when the budget
+    runs out the best point seen is kept and the Jacobian taken there."""
+    fd = ForwardDifferences(lambda z: obj(z * sc), FD_STEP, hi / sc)
+    obj.best_cost, obj.best_x = np.inf, None
+    try:
+        sol = optimize.least_squares(fd, x_start / sc, jac=fd.jac, bounds=(lo / sc, hi / sc),
+                                     x_scale=1.0, xtol=tol, ftol=tol, gtol=tol,
+                                     max_nfev=max_nfev)
+        return sol.x * sc, sol.jac / sc, sol.status >= 0, str(sol.message)
+    except _OutOfTime as stop:
+        obj.timed = False
+        x = obj.best_x if obj.best_x is not None else x_start
+        J = fd.jac(x / sc) / sc
+        obj.timed = True
+        return x, J, True, f"{stop}; best point kept"
+
+
+def _arrays(names, *dicts):
+    return [np.array([float(d[n]) for n in names]) for d in dicts]
+
+
+def fit(model, dataset, names, x0, low, high, scale, *, fixed=None, starts=None,
+        max_nfev=60, tol=1e-8, budget_s=None, absorb=None, max_evals=None) -> Fit:
+    """Weighted output-error least squares over ``names`` from the best of
+    the starting points.
+
+    ``x0``, ``low``, ``high``, ``scale``: per-name start, bounds and typical
+    magnitude (the optimiser works on value/scale). ``fixed``: other
+    parameter overrides. ``starts``: extra starting points (dicts name ->
+    value, merged into ``x0``), scored by :func:`score_starts` (with
+    ``absorb``); the best is refined by :func:`refine`. ``budget_s`` /
+    ``max_evals``: a wall-time / evaluation budget (the best point is kept).
+    """
+    names = list(names)
+    x0, lo, hi = _arrays(names, x0, low, high)
+    sc = np.array([abs(float(scale[n])) or 1.0 for n in names])
+    obj = Objective(model, dataset, names, fixed, budget_s, max_evals)
+    cands = [x0]
+    for st in starts or []:
+        cands.append(np.array([float(st.get(n, v)) for n, v in zip(names, x0)]))
+    scored = score_starts(obj, cands, lo, hi, absorb)
+    if not scored:
+        return failed_fit(names, x0, obj, "every starting point failed to simulate")
+    return finish(obj, *refine_or_keep(obj, scored[0][1], lo, hi, sc, max_nfev, tol), lo)
+
+
+def refine_or_keep(obj, x, lo, hi, sc, max_nfev, tol):
+    """:func:`refine` when there is something to fit, else the start."""
+    if not obj.names:
+        return x, np.zeros((0, 0)), True, ""
+    return refine(obj, x, lo, hi, sc, max_nfev, tol)
+
+
+def failed_fit(names, x0, obj, message):
+    return Fit(list(names), dict(zip(names, np.asarray(x0, float).tolist())), float("inf"),
+               np.zeros(0), np.zeros((0, len(names))), [], [], n_sim=obj.n_sim,
+               wall_s=time.perf_counter() - obj.t0, ok=False, message=message)
+
+
+def finish(obj, x, J, ok, message, lo):
+    """The :class:`Fit` at ``x``: residuals re-simulated there, the
+    Jacobian reshaped, intervals (log intervals for positive parameters)."""
+    r, groups, signals = weighted_residuals(obj.pair, obj.dataset, obj.params(x))
+    obj.n_sim += len(obj.dataset.experiments)
+    names = obj.names
+    J = np.asarray(J)[:r.size].reshape(r.size, len(names)) if names else np.zeros((r.size, 0))
+    out = Fit(names, dict(zip(names, np.asarray(x, float).tolist())), float(r @ r), r, J,
+              groups, signals, n_sim=obj.n_sim, wall_s=time.perf_counter() - obj.t0,
+              ok=bool(ok), message=str(message))
+    out.ci95 = confidence(out, positive=[n for n, low in zip(names, lo) if low > 0])
     return out
 
 

@@ -17,6 +17,12 @@ a component:
 * ``source``: a force or torque source acting against the frame
   (:class:`PartialSource` with one flange: ``Force``, ``Torque``).
 
+Each component class of the library declares what it is to the diagnosis
+(its ``diagnosis_site`` class attribute: body, compliant, contact,
+clearance, source, ground, driver, sensor; :func:`role`), so the graph
+needs no list of library classes: a user's component takes part by
+declaring the same attribute.
+
 Typical magnitudes (speeds, travels, forces) used to scale hypothesis
 parameters come from a nominal simulation result when one is given
 (``ModelGraph(model, result=res)`` or :meth:`ModelGraph.from_file`), else
@@ -32,6 +38,7 @@ from ..component import Model
 from ..declare import Parameter
 from ..errors import ModelError
 from ..flatten import relocate
+from .domain import domain_name
 
 KINDS = ("body", "joint", "spring", "contact", "source")
 _PLURAL = {"bodies": "body", "joints": "joint", "springs": "spring", "contacts": "contact",
@@ -50,29 +57,22 @@ class Site:
     note: str = ""
 
 
-def _lib():
-    """The component classes the graph recognises (imported lazily: the
-    component library is a separate package)."""
-    from acausal.mechanics import contact, partials, rotational, translational
-    return dict(
-        rigid=(partials.PartialRigid, partials.PartialRotRigid),
-        compliant=(partials.PartialCompliant, partials.PartialRotCompliant),
-        contact=contact.PartialContact,
-        clearance=contact.Clearance,
-        source=partials.PartialSource,
-        ground=(translational.Fixed, rotational.Fixed),
-        driver=(translational.Position, rotational.Angle),
-        sensor=(partials.PartialAbsoluteSensor, partials.PartialRelativeSensor,
-                partials.PartialRotAbsoluteSensor, partials.PartialRotRelativeSensor),
-    )
+def role(comp):
+    """The diagnosis role a component declares (``diagnosis_site`` class
+    attribute of the component library: body, compliant, contact,
+    clearance, source, ground, driver, sensor), or None (a link: a lever, a
+    four-bar, a user's component)."""
+    return getattr(type(comp), "diagnosis_site", None)
+
+
+def has_role(comp, *roles):
+    return role(comp) in roles
 
 
 def domain_of(comp):
     """'translational' or 'rotational' from the component's connectors
     (the first one for a mixed component such as a lever)."""
-    for c in comp.connectors().values():
-        return type(c).domain
-    return "generic"
+    return domain_name(comp)
 
 
 class ModelGraph:
@@ -88,7 +88,6 @@ class ModelGraph:
             raise ModelError(f"ModelGraph needs a Model, got {type(model).__name__}")
         self.model = model
         self.result = result
-        self._lib = _lib()
         self._index()
         self._classify()
 
@@ -97,7 +96,7 @@ class ModelGraph:
         """The graph of a model file with its nominal run attached (the file's
         experiment, default parameters): sensible typical magnitudes."""
         from ..modelfile import load_model_file
-        from .hypotheses import nominal_result
+        from .nominal import nominal_result
         return cls(load_model_file(path).model, result=nominal_result(path))
 
     # -- structure --------------------------------------------------------------
@@ -145,28 +144,26 @@ class ModelGraph:
         self._values = None
 
     def _classify(self):
-        L = self._lib
         self.bodies, self.joints, self.springs, self.contacts, self.sources = [], [], [], [], []
         for path, c in self.components.items():
             dom = domain_of(c)
-            if isinstance(c, L["rigid"]):
+            if has_role(c, "body"):
                 self.bodies.append(Site("body", path, dom, c, self._body_note(c)))
                 fixed = [o.path for o in self.at_node(c.flange)
-                         if isinstance(o, L["ground"] + L["driver"])]
+                         if has_role(o, "ground", "driver")]
                 if not fixed:
                     self.joints.append(Site("joint", path, dom, c, self._joint_note(c)))
-            elif isinstance(c, L["contact"]):
+            elif has_role(c, "contact"):
                 parent = c._parent
-                note = (f"side of the clearance {parent.path}" if isinstance(parent, L["clearance"])
+                note = (f"side of the clearance {parent.path}" if has_role(parent, "clearance")
                         else f"{type(c).__name__} between "
                         + ", ".join(self.describe_ports(c)))
                 self.contacts.append(Site("contact", path, dom, c, note))
-            elif isinstance(c, L["compliant"]) and isinstance(c.declarations().get("c"),
-                                                                Parameter):
+            elif has_role(c, "compliant") and isinstance(c.declarations().get("c"), Parameter):
                 self.springs.append(Site("spring", path, dom, c, f"{type(c).__name__} c = "
                                          f"{self._fmt(c, 'c')} between "
                                          + ", ".join(self.describe_ports(c))))
-            elif isinstance(c, L["source"]) and len(c.connectors()) == 1:
+            elif has_role(c, "source") and len(c.connectors()) == 1:
                 body = self.body_at(next(iter(self.ports(c))))
                 self.sources.append(Site("source", path, dom, c, f"{type(c).__name__} on "
                                          + (body.path if body else "a massless node")))
@@ -192,14 +189,13 @@ class ModelGraph:
     def _to_frame(self, comp, port):
         """A one-flange element (ground friction, end stop) or a two-flange
         compliant one whose other flange is on a fixed node."""
-        L = self._lib
-        if isinstance(comp, L["rigid"] + L["sensor"] + (L["source"],)):
+        if has_role(comp, "body", "sensor", "source"):
             return False
         others = [p for p in self.ports(comp) if self.node(p) != self.node(port)]
         if not others:
             return True
-        return isinstance(comp, L["compliant"]) and all(
-            any(isinstance(o, L["ground"]) for o in self.at_node(p)) for p in others)
+        return has_role(comp, "compliant") and all(
+            any(has_role(o, "ground") for o in self.at_node(p)) for p in others)
 
     # -- queries ------------------------------------------------------------------
     def sites(self, kind):
@@ -236,7 +232,7 @@ class ModelGraph:
     def body_at(self, port):
         """The body in ``port``'s node, or None."""
         for o in self.at_node(port):
-            if isinstance(o, self._lib["rigid"]):
+            if has_role(o, "body"):
                 return o
         return None
 
@@ -268,7 +264,6 @@ class ModelGraph:
         """Whether ``comp``, starting from its connectors off ``body``'s
         node, leads through other components to another body or a
         prescribed motion (a link that transmits motion)."""
-        L = self._lib
         start = self.node(body.flange)
         seen_nodes, seen = {start}, {comp, body}
         todo = [self.node(p) for p in self.ports(comp) if self.node(p) != start]
@@ -282,7 +277,7 @@ class ModelGraph:
                 if o in seen:
                     continue
                 seen.add(o)
-                if isinstance(o, L["rigid"] + L["driver"]):
+                if has_role(o, "body", "driver"):
                     return True
                 todo += [self.node(q) for q in self.ports(o)]
         return False

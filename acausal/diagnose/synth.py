@@ -28,8 +28,8 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 from scipy import optimize
 
-from ..data import Dataset, Experiment, Instrument, Trace, write_dataset
 from ..errors import UsageError
+from ..data import Dataset, Experiment, Instrument, Trace, write_dataset
 from ..modelfile import compile_file, evaluate_measures
 from .library import load_library
 
@@ -117,60 +117,80 @@ def synthesize(model_path, folder, *, conditions, hypothesis=None, location=None
     for m in measures:
         if m not in mf.measures:
             raise UsageError(f"the model file has no measure {m!r}")
-    truth_free = {}
-    for name, (lo, hi) in mf.free.items():
-        v = (free or {}).get(name)
-        if v is None:
-            v = cm.params[cm.param_index(name)].default * math.exp(free_jitter * rng.normal())
-            v = float(np.clip(v, lo, hi))
-        truth_free[name] = float(v)
-    floors = _floors(measures + traces, noise, resolution)
-    ext_values = {}
-    achieved = 0.0
-    pair = (mf, cm)
+    truth_free = _truth_free(mf, cm, free, free_jitter, rng)
+    read = dict(measures=measures, traces=traces, floors=_floors(measures + traces, noise,
+                                                                  resolution),
+                rate=sample_rate)
+    pair, ext_values, location = (mf, cm), {}, location
     if hypothesis is not None:
-        lib = load_library(library)
-        hyp = lib.HYPOTHESES[hypothesis]
-        graph = lib.graph_of(model_path)
-        if location is None:
-            location = hyp.candidates(graph)[0]
-        specs = hyp.params(graph, location)
-        ext_values = {s.name: float(s.initial) for s in specs}
-        ext_values.update(values or {})
-        pair = lib.build_extended(model_path, hypothesis, location)
-        first = specs[0]
-        if not values or first.name not in values:
-            if magnitude is not None:
-                lo, hi = sorted(abs(float(x)) for x in magnitude)
-                ext_values[first.name] = sign * math.exp(rng.uniform(math.log(lo),
-                                                                     math.log(hi)))
-            elif effect is not None:
-                lo, hi = sorted(float(x) for x in effect)
-                target = math.exp(rng.uniform(math.log(lo), math.log(hi)))
-                ref = _simulate((mf, cm), truth_free, conds)
-                ext_values[first.name] = _solve_effect(
-                    pair, truth_free, ext_values, first, sign, target, conds, ref,
-                    measures, traces, floors, sample_rate)
-            else:
-                raise UsageError("give values, magnitude or effect for the hidden extension")
+        pair, ext_values, location = _hidden(model_path, (mf, cm), hypothesis, location,
+                                             values, magnitude, effect, sign, truth_free,
+                                             conds, read, library, rng)
     runs = _simulate(pair, {**truth_free, **ext_values}, conds)
+    achieved = 0.0
     if hypothesis is not None:
         ref = _simulate((mf, cm), truth_free, conds)
-        achieved = _effect(runs, ref, measures, traces, floors, sample_rate)
+        achieved = _effect(runs, ref, measures, traces, read["floors"], sample_rate)
     names = list(names or [f"E{i + 1:02d}" for i in range(len(conds))])
-    experiments = []
-    for name, c, (res, meas) in zip(names, conds, runs):
-        mvals = {m: _read(meas[m], m, noise, resolution, rng) for m in measures}
-        trace = None
-        if traces:
-            t = np.arange(0.0, res.t[-1] + 1e-15, 1.0 / sample_rate)
-            trace = Trace(t, {v: _read(np.interp(t, res.t, res[v]), v, noise, resolution, rng)
-                              for v in traces})
-        experiments.append(Experiment(name, dict(c), mvals, trace))
+    experiments = [_experiment(name, c, res, meas, read, noise, resolution, rng)
+                   for name, c, (res, meas) in zip(names, conds, runs)]
     instrument = {s: Instrument(s, (resolution or {}).get(s, 0.0), (noise or {}).get(s, 0.0))
                   for s in measures + traces}
     write_dataset(folder, Dataset(None, experiments, instrument), units)
     return Truth(hypothesis, location, ext_values, truth_free, achieved, seed, names)
+
+
+def _truth_free(mf, cm, free, jitter, rng):
+    """The free parameters of the truth: given, or the model's values each
+    times exp(jitter N(0, 1)), kept in their bounds."""
+    out = {}
+    for name, (lo, hi) in mf.free.items():
+        v = (free or {}).get(name)
+        if v is None:
+            v = cm.params[cm.param_index(name)].default * math.exp(jitter * rng.normal())
+            v = float(np.clip(v, lo, hi))
+        out[name] = float(v)
+    return out
+
+
+def _hidden(model_path, nominal, hypothesis, location, values, magnitude, effect, sign,
+            truth_free, conds, read, library, rng):
+    """(extended pair, extension values, location) of the hidden effect."""
+    lib = load_library(library)
+    hyp = lib.HYPOTHESES[hypothesis]
+    graph = lib.graph_of(model_path)
+    if location is None:
+        location = hyp.candidates(graph)[0]
+    specs = hyp.params(graph, location)
+    ext = {s.name: float(s.initial) for s in specs}
+    ext.update(values or {})
+    pair = lib.build_extended(model_path, hypothesis, location)
+    first = specs[0]
+    if values and first.name in values:
+        return pair, ext, location
+    if magnitude is not None:
+        lo, hi = sorted(abs(float(x)) for x in magnitude)
+        ext[first.name] = sign * math.exp(rng.uniform(math.log(lo), math.log(hi)))
+    elif effect is not None:
+        lo, hi = sorted(float(x) for x in effect)
+        target = math.exp(rng.uniform(math.log(lo), math.log(hi)))
+        ref = _simulate(nominal, truth_free, conds)
+        ext[first.name] = _solve_effect(pair, truth_free, ext, first, sign, target, conds,
+                                        ref, read["measures"], read["traces"],
+                                        read["floors"], read["rate"])
+    else:
+        raise UsageError("give values, magnitude or effect for the hidden extension")
+    return pair, ext, location
+
+
+def _experiment(name, c, res, meas, read, noise, resolution, rng):
+    mvals = {m: _read(meas[m], m, noise, resolution, rng) for m in read["measures"]}
+    trace = None
+    if read["traces"]:
+        t = np.arange(0.0, res.t[-1] + 1e-15, 1.0 / read["rate"])
+        trace = Trace(t, {v: _read(np.interp(t, res.t, res[v]), v, noise, resolution, rng)
+                          for v in read["traces"]})
+    return Experiment(name, dict(c), mvals, trace)
 
 
 def _read(x, signal, noise, resolution, rng):

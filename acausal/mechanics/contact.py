@@ -190,6 +190,8 @@ class PartialContact(Component):
     negative), ``f_peak`` [N].
     """
 
+    diagnosis_site = "contact"   # what acausal.diagnose may extend here
+
     K = Parameter(1e9, "N/m^gamma", "contact stiffness", min=0.0, min_open=True)
     gamma = Parameter(1.5, "1", "force exponent (1.5 = Hertz)", min=1.0)
     e = Parameter(1.0, "1", "coefficient of restitution", min=0.0, min_open=True, max=1.0)
@@ -359,6 +361,8 @@ class Clearance(Model):
     ``law``, ``peak_event``.
     Connectors: ``flange_a``, ``flange_b``.
     """
+
+    diagnosis_site = "clearance"   # what acausal.diagnose may extend here
 
     SHARED = ("K", "gamma", "e", "beta", "v_min", "delta_tol")
 

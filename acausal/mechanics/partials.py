@@ -18,6 +18,8 @@ class PartialCompliant(Component):
     Connectors: ``flange_a``, ``flange_b``.
     """
 
+    diagnosis_site = "compliant"   # what acausal.diagnose may extend here
+
     flange_a = Flange("left flange")
     flange_b = Flange("right flange")
     s_rel = Variable(0.0, "m", "relative displacement flange_b.s - flange_a.s")
@@ -36,6 +38,8 @@ class PartialRotCompliant(Component):
     torque at flange_b. Connectors: ``flange_a``, ``flange_b``.
     """
 
+    diagnosis_site = "compliant"   # what acausal.diagnose may extend here
+
     flange_a = RotFlange("left flange")
     flange_b = RotFlange("right flange")
     phi_rel = Variable(0.0, "rad", "relative angle flange_b.phi - flange_a.phi")
@@ -51,6 +55,8 @@ class PartialRigid(Component):
     """A translational body with one flange: position ``s`` [m] and velocity
     ``v`` [m/s]; ``flange.f`` is the sum of the forces applied on it."""
 
+    diagnosis_site = "body"   # what acausal.diagnose may extend here
+
     flange = Flange("the body's flange (all forces act here)")
     s = Variable(0.0, "m", "absolute position")
     v = Variable(0.0, "m/s", "absolute velocity")
@@ -63,6 +69,8 @@ class PartialRigid(Component):
 class PartialRotRigid(Component):
     """A rotating body with one flange: angle ``phi`` [rad] and angular
     velocity ``w`` [rad/s]; ``flange.tau`` is the sum of applied torques."""
+
+    diagnosis_site = "body"   # what acausal.diagnose may extend here
 
     flange = RotFlange("the body's flange (all torques act here)")
     phi = Variable(0.0, "rad", "absolute angle")
@@ -78,6 +86,8 @@ class PartialAbsoluteSensor(Component):
     """One translational flange that takes no force (``flange.f = 0``): the
     sensor measures without acting. Connectors: ``flange``."""
 
+    diagnosis_site = "sensor"   # what acausal.diagnose may extend here
+
     flange = Flange("measured flange (no force taken)")
 
     def equations(self):
@@ -87,6 +97,8 @@ class PartialAbsoluteSensor(Component):
 class PartialRelativeSensor(Component):
     """Two translational flanges that take no force. Connectors:
     ``flange_a``, ``flange_b``."""
+
+    diagnosis_site = "sensor"   # what acausal.diagnose may extend here
 
     flange_a = Flange("reference flange (no force taken)")
     flange_b = Flange("measured flange (no force taken)")
@@ -98,6 +110,8 @@ class PartialRelativeSensor(Component):
 class PartialRotAbsoluteSensor(Component):
     """One rotational flange that takes no torque. Connectors: ``flange``."""
 
+    diagnosis_site = "sensor"   # what acausal.diagnose may extend here
+
     flange = RotFlange("measured flange (no torque taken)")
 
     def equations(self):
@@ -107,6 +121,8 @@ class PartialRotAbsoluteSensor(Component):
 class PartialRotRelativeSensor(Component):
     """Two rotational flanges that take no torque. Connectors: ``flange_a``,
     ``flange_b``."""
+
+    diagnosis_site = "sensor"   # what acausal.diagnose may extend here
 
     flange_a = RotFlange("reference flange (no torque taken)")
     flange_b = RotFlange("measured flange (no torque taken)")
@@ -150,6 +166,8 @@ class PartialSource(Component):
     ``across_name``, declares the Variable of that name and writes its
     connector equation with :meth:`law`.
     """
+
+    diagnosis_site = "source"   # what acausal.diagnose may extend here
 
     quantity = ("u", "1", "source value")
     across_name = "across variable"   # how the law's argument is called in messages

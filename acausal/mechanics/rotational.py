@@ -28,6 +28,8 @@ class Fixed(Component):
     Parameters: ``phi0`` [rad] angle. Connectors: ``flange``.
     """
 
+    diagnosis_site = "ground"   # what acausal.diagnose may extend here
+
     flange = RotFlange("fixed flange")
     phi0 = Parameter(0.0, "rad", "fixed angle")
 
@@ -169,6 +171,8 @@ class Angle(Component):
 
     States: ``phi`` [rad]. Connectors: ``flange``.
     """
+
+    diagnosis_site = "driver"   # what acausal.diagnose may extend here
 
     flange = RotFlange("driven flange")
     phi = Variable(0.0, "rad", "prescribed angle")

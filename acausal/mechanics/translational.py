@@ -28,6 +28,8 @@ class Fixed(Component):
     Parameters: ``s0`` [m] position. Connectors: ``flange``.
     """
 
+    diagnosis_site = "ground"   # what acausal.diagnose may extend here
+
     flange = Flange("fixed flange")
     s0 = Parameter(0.0, "m", "fixed position")
 
@@ -176,6 +178,8 @@ class Position(Component):
     Parameters: none (``s`` is fixed at construction). States: ``s`` [m].
     Connectors: ``flange``.
     """
+
+    diagnosis_site = "driver"   # what acausal.diagnose may extend here
 
     flange = Flange("driven flange")
     s = Variable(0.0, "m", "prescribed position")

@@ -9,19 +9,28 @@ counts false positives over noise-only datasets.
 """
 import json
 import os
+import pickle
 
 import pytest
 from click.testing import CliRunner
 
 from acausal.cli import main
-from acausal.diagnose.run import diagnose
+from acausal.compile import CompiledModel
+from acausal.diagnose.problem import FitSettings
+from acausal.diagnose.report import write_report
+from acausal.diagnose.result import summary
+from acausal.diagnose.run import diagnose, run_stages
 from acausal.diagnose.synth import synthesize
 
 HERE = os.path.dirname(__file__)
 LATCH = os.path.abspath(os.path.join(HERE, "..", "..", "models", "latch_striker.py"))
 FAST = ["coulomb_friction", "quadratic_damping", "constant_load"]
+# the fast tier's fits: two Latin-hypercube starts, the best refined (the
+# full method's defaults are 4 and 2: slow tier and command-line default)
+LIGHT = FitSettings(lhs=2, refine=1)
+LIGHT_CLI = ["--starts", "2", "--refine", "1"]
 KEYS = {"discrepancy", "cause", "location", "equivalent_causes", "parameters", "ranking",
-        "gain", "extended_model"}
+        "gain", "extended_model", "causes", "unexplained", "next_experiment", "profile_ci95"}
 
 
 def _latch_data(folder, seed, **kw):
@@ -36,8 +45,19 @@ def blind(tmp_path_factory):
     d = tmp_path_factory.mktemp("blind")
     truth = _latch_data(d / "data", 11, hypothesis="coulomb_friction", location="latch",
                         effect=(6.0, 6.0))
-    out = diagnose(LATCH, d / "data", out_dir=d / "out", workers=2, progress=False,
-                   hypotheses=FAST)
+    # the stages, then the report from a pickled copy of the result with the
+    # simulator disabled: the result is picklable and the report a pure view
+    res = run_stages(LATCH, d / "data", out_dir=d / "out", workers=2, progress=False,
+                     hypotheses=FAST, settings=LIGHT)
+    res = pickle.loads(pickle.dumps(res))
+
+    def no_simulation(*a, **k):
+        raise AssertionError("the report simulated")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(CompiledModel, "simulate", no_simulation)
+        write_report(d / "out", res)
+    out = summary(res)
+    (d / "out" / "diagnosis.json").write_text(json.dumps(out, indent=1))
     return truth, out, d / "out"
 
 
@@ -58,6 +78,10 @@ def test_blind_case_names_the_hidden_cause(blind):
                                  "aicc": out["ranking"][0]["aicc"],
                                  "heldout_rmse": out["ranking"][0]["heldout_rmse"]}
     assert out["extended_model"] and os.path.exists(out["extended_model"])
+    assert out["causes"] == [{"cause": "coulomb_friction", "location": "latch",
+                              "parameters": {name: out["parameters"][name]}}]
+    assert out["unexplained"]["value"] is False and out["next_experiment"] is None
+    assert out["profile_ci95"] == {}
 
 
 def test_blind_case_report(blind):
@@ -74,7 +98,7 @@ def test_null_case_and_command_line(tmp_path):
     r = CliRunner().invoke(main, ["diagnose", LATCH, str(tmp_path / "data"), "--json",
                                   str(tmp_path / "out.json"), "--report",
                                   str(tmp_path / "rep"), "--workers", "2", "--no-progress",
-                                  "--hypotheses", ",".join(FAST)])
+                                  "--hypotheses", ",".join(FAST), *LIGHT_CLI])
     assert r.exit_code == 0, r.output
     out = json.loads((tmp_path / "out.json").read_text())
     assert set(out) == KEYS
@@ -256,7 +280,7 @@ def test_candidate_fits_on_a_dask_cluster_match_local_processes(tmp_path):
     _latch_data(tmp_path / "data", 14, hypothesis="constant_load", location="plunger",
                 effect=(6.0, 6.0))
     kw = dict(progress=False, hypotheses=["constant_load", "quadratic_damping"],
-              locations=["plunger"], plots=False)
+              locations=["plunger"], plots=False, settings=LIGHT)
     local = diagnose(LATCH, tmp_path / "data", out_dir=tmp_path / "local", workers=2, **kw)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster:
@@ -265,7 +289,7 @@ def test_candidate_fits_on_a_dask_cluster_match_local_processes(tmp_path):
                                       str(tmp_path / "dask"), "--scheduler",
                                       cluster.scheduler_address, "--no-progress",
                                       "--hypotheses", "constant_load,quadratic_damping",
-                                      "--locations", "plunger"])
+                                      "--locations", "plunger", *LIGHT_CLI])
     assert r.exit_code == 0, r.output
     remote = json.loads((tmp_path / "dask.json").read_text())
     assert remote["cause"] == local["cause"] == "constant_load"

@@ -1,0 +1,126 @@
+"""Stage: where the library falls short. When a discrepancy is found and
+no library cause explains it (no cause named, or the named one still
+leaves misfit beyond the instrument), the generic term of :mod:`.generic`
+is fitted at every node of a body; the node whose term removes most of the
+misfit (by AICc, with its held-out error) locates the discrepancy.
+
+The verdict "not explained by the library" needs: the best generic term
+beats the best library candidate by more than ``MARGIN`` AICc units and by
+held-out error, and it reaches closer to the instrument floor.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import stats as st
+from .fitting import heldout_rms
+from .generic import GENERIC, N_V, N_X, penalty, shape
+from .problem import Candidate, Param
+from .stages import fit_tasks, run_tasks
+from .tasks import fit_candidate
+
+MARGIN = 10.0    # AICc units by which the generic term must beat the library
+
+
+@dataclass
+class Term:
+    """The generic term fitted at one node."""
+
+    node: str                     # the body's path (its node)
+    members: tuple                # components with a connector on that node
+    S: float
+    aicc: float
+    heldout_rmse: float
+    ranges: tuple                 # (x_lo, x_hi, v_lo, v_hi) of the knots
+    shape: dict                   # generic.shape of the fitted weights
+    values: dict
+
+
+@dataclass
+class Location:
+    """The located discrepancy: terms best first, and the verdict."""
+
+    terms: tuple = ()
+    unexplained: bool = False
+    node: str | None = None
+    reason: str = ""
+    nearest: str | None = None    # the best library candidate, for comparison
+    nearest_why: str = ""
+    skipped: str = ""             # why the stage did not run, if it did not
+    wall_s: float = 0.0
+    details: dict = field(default_factory=dict)
+
+
+def needed(dec, rk) -> bool:
+    """Run the stage when a discrepancy is found and no cause is named or
+    the best fit still leaves misfit beyond the instrument."""
+    return dec.discrepancy and (rk.named is None or dec.c_hat > st.OVERDISPERSION)
+
+
+def generic_candidates(problem):
+    from .graph import ModelGraph
+    from .nominal import nominal_result
+    from ..modelfile import load_model_file
+    graph = ModelGraph(load_model_file(problem.model_path).model,
+                       result=nominal_result(problem.model_path))
+    out = []
+    for loc in GENERIC.candidates(graph):
+        params = tuple(Param(s.name, s.initial, s.low, s.high, s.scale, s.initial)
+                       for s in GENERIC.params(graph, loc))
+        out.append((Candidate(GENERIC.id, loc, params, penalty(N_X, N_V)),
+                    tuple(GENERIC.ranges(graph, loc)),
+                    tuple(sorted({p.owner.path for p in
+                                  graph.nodes[graph.node(graph.components[loc].flange)]}))))
+    return out
+
+
+def _term(r, n, c_hat, ranges, members):
+    f = r.fit
+    return Term(r.candidate.location, members, f.cost, st.aicc(f.cost, n, f.k, c_hat),
+                heldout_rms(r.loo), ranges, shape(f.values, GENERIC.prefix, ranges),
+                dict(f.values))
+
+
+def locate(problem, cal, dec, rk, ex, progress=True, collect=None) -> Location:
+    """Fit the generic term at every body node (module doc)."""
+    import time
+    if not needed(dec, rk):
+        return Location(skipped="not needed: no discrepancy, or a cause explains it")
+    t0 = time.perf_counter()
+    gens = generic_candidates(problem)
+    if not gens:
+        return Location(skipped="the model has no body node")
+    tasks = fit_tasks(problem, cal, [g[0] for g in gens])
+    results = run_tasks(ex, fit_candidate, tasks, "locating", progress, collect)
+    n = cal.fit.n
+    terms = sorted((_term(r, n, dec.c_hat, g[1], g[2]) for r, g in zip(results, gens) if r.ok),
+                   key=lambda t: t.aicc)
+    out = _verdict(terms, dec, rk, n)
+    out.wall_s = time.perf_counter() - t0
+    return out
+
+
+def _verdict(terms, dec, rk, n) -> Location:
+    if not terms:
+        return Location(skipped="no generic term could be fitted")
+    best_t = terms[0]
+    lib = rk.best
+    lib_aicc = lib.aicc if lib is not None else dec.a0
+    lib_held = lib.heldout_rmse if lib is not None else rk.heldout0
+    nearest = lib.candidate.label if lib is not None else None
+    k = lib.k if lib is not None else 0
+    left = np.sqrt(lib.S / max(n - k, 1)) if lib is not None else float("nan")
+    why = (f"the best library candidate ({nearest}) leaves {left:.3g}x the noise floor (RMS) "
+           f"and a held-out error of {lib_held:.3g}; the generic term at {best_t.node} "
+           f"leaves {np.sqrt(best_t.S / n):.3g}x and {best_t.heldout_rmse:.3g}"
+           if lib is not None else "")
+    beats = (lib_aicc - best_t.aicc > MARGIN and best_t.heldout_rmse < lib_held
+             and best_t.S < (lib.S if lib is not None else np.inf))
+    unexplained = bool(beats and rk.named is None)
+    reason = (f"the generic term at {best_t.node} is {lib_aicc - best_t.aicc:.1f} AICc units "
+              f"better than the best library candidate" if beats else
+              "the generic terms do not beat the library's best candidate")
+    return Location(tuple(terms), unexplained, best_t.node if unexplained else None, reason,
+                    nearest, why)

@@ -1,0 +1,102 @@
+"""The picklable inputs of the diagnosis stages: what is fitted, where, and
+how hard (no state: every stage takes these and returns a new dataclass)."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+FIT_TOL = 1e-6   # ftol/xtol of the candidate fits (S to about 1e-6 relative)
+LOO_TOL = 1e-4   # of the warm-started leave-one-out refits (predictions only)
+
+
+@dataclass(frozen=True)
+class Param:
+    """A fitted parameter: model-level name, start (the calibrated value for
+    a free parameter, the neutral value for an extension's), bounds, a
+    typical magnitude, and ``prior`` (the model file's value for a free
+    parameter; the neutral value for an extension's)."""
+
+    name: str
+    start: float
+    low: float
+    high: float
+    scale: float
+    prior: float
+
+    def moved(self, start: float) -> "Param":
+        return Param(self.name, float(min(max(start, self.low), self.high)), self.low,
+                     self.high, self.scale, self.prior)
+
+
+def free_param(name, default, low, high) -> Param:
+    """A model file's free parameter (its default clipped into its bounds)."""
+    start = float(min(max(default, low), high))
+    scale = abs(default) or (high - low if math.isfinite(high - low) else 1.0)
+    return Param(name, start, float(low), float(high), float(scale), start)
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """A hypothesis at a location with its parameters (``hypothesis`` None:
+    the nominal model)."""
+
+    hypothesis: str | None
+    location: str | None
+    params: tuple = ()            # Param of the extension, neutral start
+    penalty: object = field(default=None, compare=False)  # smoothing rows (generic terms)
+
+    @property
+    def key(self):
+        return (self.hypothesis, self.location)
+
+    @property
+    def label(self):
+        if self.hypothesis is None:
+            return "nominal"
+        return " + ".join(f"{h} at {loc}" for h, loc, _ in self.members())
+
+    def members(self):
+        """[(hypothesis, location, [parameter names])]: one entry, or two for
+        a pair ("h1+h2" at "l1+l2"; each parameter named by its
+        hypothesis's sub-model prefix, in the pair's order)."""
+        hs, ls = self.hypothesis.split("+"), self.location.split("+")
+        if len(hs) == 1:
+            return [(hs[0], ls[0], [p.name for p in self.params])]
+        groups = list(dict.fromkeys(p.name.split(".")[0] for p in self.params))
+        return [(h, loc, [p.name for p in self.params if p.name.split(".")[0] == g])
+                for h, loc, g in zip(hs, ls, groups)]
+
+
+NOMINAL = Candidate(None, None, ())
+
+
+@dataclass(frozen=True)
+class FitSettings:
+    """How hard each fit tries. ``lhs``: Latin-hypercube starts over the
+    extension's bounds (scipy.stats.qmc); ``refine``: how many of the best
+    scored starts are refined by least squares (their agreement is
+    reported); ``windows``: fractions of the trace for the growing-window
+    homotopy of the nominal calibration (1.0 last)."""
+
+    max_nfev: int = 60
+    tol: float = FIT_TOL
+    evals_per_param: int = 25
+    lhs: int = 4
+    refine: int = 2
+    windows: tuple = (0.3, 1.0)
+    seed: int = 0
+
+
+@dataclass(frozen=True)
+class Problem:
+    """A model file against a dataset folder, with its free parameters."""
+
+    model_path: str
+    data_folder: str
+    library: str
+    free: tuple                   # Param of the free parameters (start = prior)
+    settings: FitSettings = field(default_factory=FitSettings)
+
+    @property
+    def free_names(self):
+        return [p.name for p in self.free]
