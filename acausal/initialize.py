@@ -148,6 +148,14 @@ def _raise_if_parameter_breaks(cm, t0, p, d, exc):
             variable=entry.name) from None
 
 
+def suspect_parameters(cm, p):
+    """(name, value, default, unit) of each parameter SUSPECT_DECADES or more
+    from its default: named when a run fails (a 1e-30 kg*m^2 inertia makes
+    the equations too stiff to integrate)."""
+    return [(e.name, float(p[k]), e.default, e.unit) for k, e in enumerate(cm.params)
+            if _far_from(p[k], e.default)]
+
+
 # A value this many decades from the parameter's default is suspect when
 # the initialisation fails (a 1e30 N/m spring for 2.4e5, a 1e-30 kg*m^2
 # inertia for 4.4e-4); values nearer their defaults are design changes.

@@ -17,7 +17,7 @@ import numpy as np
 
 from .backends import BACKENDS, BackendError, make_solver
 from .errors import ChatteringError, LimitError, ModelError, SolverError, UsageError
-from .initialize import ask_components, initial_point, reinitialize
+from .initialize import ask_components, initial_point, reinitialize, suspect_parameters
 from .result import Result
 
 CHATTER_COUNT = 100     # this many events ...
@@ -587,13 +587,19 @@ def _failure(run, cm, sol, cb):
                   "them is a small difference of large terms, give them their own absolute "
                   "tolerance (Experiment(atol_algebraic=...) or simulate(atol_algebraic=...), "
                   "in their SI units)")
+    suspect = suspect_parameters(cm, run.p)
+    if suspect:
+        extra += ("; " + ", ".join(f"parameter {nm} = {v:g} [{u}] is far from its default "
+                                   f"{dv:g}" for nm, v, dv, u in suspect)
+                  + ": check its value and unit")
     message = f"IDA failed at t = {t:.9g} s{where}: {r.message}{extra}"
     result = run.result("failed", r.message)
     hint = ask_components(cm.model, "solver_failure", [comp] if comp else [], message, t,
                           result)
     if hint is not None:
         return hint
-    return SolverError(message, t=t, component=comp, result=result)
+    return SolverError(message, t=t, component=comp, result=result,
+                       variable=suspect[0][0] if suspect else None)
 
 
 def _safe_obs(cb, t, r):
