@@ -273,6 +273,7 @@ def test_report_data_diagnosis_full_library(tmp_path):
     assert len(out["ranking"]) == 20
 
 
+@pytest.mark.slow   # 25-30 s on 2 cores (a LocalCluster beside the fits); the sweep's Dask test stays in the default tier
 def test_candidate_fits_on_a_dask_cluster_match_local_processes(tmp_path):
     """``--scheduler ADDRESS``: the same fits through Dask give the same
     diagnosis as the local process pool (the fits are deterministic)."""
