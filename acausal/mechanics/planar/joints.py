@@ -31,6 +31,8 @@ class Revolute(PartialRigidLink):
     Connectors: ``frame_a``, ``frame_b``, ``axis`` (optional, RotFlange).
     """
 
+    loop_role = "joint"   # named when its loop cannot close
+
     axis = RotFlange("joint angle and the torque across the joint", optional=True)
     phi = Variable(0.0, "rad", "joint angle frame_b.phi - frame_a.phi")
     w = Variable(0.0, "rad/s", "joint angular velocity")
@@ -59,6 +61,8 @@ class Prismatic(PartialRigidLink):
     unit length). States: ``s`` [m] stroke, ``v`` [m/s] its rate.
     Connectors: ``frame_a``, ``frame_b``, ``axis`` (optional, Flange).
     """
+
+    loop_role = "joint"   # named when its loop cannot close
 
     axis = Flange("stroke and the force along the axis", optional=True)
     ex = Parameter(1.0, "1", "axis direction, x in frame_a's axes")

@@ -1,7 +1,8 @@
 """Kinematic loops of a planar model and the message when one cannot close.
 
 The frames joined by ``connect`` form nodes; every fixed frame is the world
-node; every rigid link or joint (a :class:`~.partials.PartialRigidLink`) is
+node; every rigid link or joint (a part whose class says ``loop_role = "link"`` or
+``"joint"``, as :class:`~.partials.PartialRigidLink` does) is
 an edge between the nodes of its two frames (line forces constrain nothing).
 A spanning tree of that graph leaves one independent (fundamental) loop per
 edge outside the tree (Wittenburg's graph-theoretic treatment of multibody
@@ -13,7 +14,6 @@ from acausal.component import Model
 from acausal.connectors import Frame
 from acausal.errors import InitializationError, SolverError
 
-from .partials import PartialRigidLink
 
 
 class LoopClosureError(InitializationError):
@@ -43,7 +43,6 @@ class Loop:
 
 def _nodes(model):
     """Frame port path -> node id (fixed frames share the node 'world')."""
-    from .parts import Fixed
     parent = {}
 
     def find(p):
@@ -57,7 +56,7 @@ def _nodes(model):
             if isinstance(ctype, Frame):
                 path = comp.port(name).path
                 parent.setdefault(path, path)
-                if isinstance(comp, Fixed):
+                if getattr(comp, "loop_role", None) == "ground":
                     parent.setdefault("world", "world")
                     parent[find(path)] = find("world")
     for m in model.walk():
@@ -73,7 +72,7 @@ def kinematic_loops(model):
     """The independent kinematic loops of ``model`` (a list of :class:`Loop`)."""
     node = _nodes(model)
     edges = [(c.path, node[c.frame_a.path], node[c.frame_b.path], c)
-             for c in model.walk() if isinstance(c, PartialRigidLink)]
+             for c in model.walk() if getattr(c, "loop_role", None) in ("link", "joint")]
     adj, tree, loops = {}, {}, []
     for path, a, b, c in edges:
         if a == b:
@@ -88,8 +87,7 @@ def kinematic_loops(model):
             chain, nodes = _path(adj, a, b)
             loops.append(((path,) + chain, nodes))
     kinds = {p: c for p, _, _, c in edges}
-    from .joints import Prismatic, Revolute
-    return [Loop(links, tuple(p for p in links if isinstance(kinds[p], (Revolute, Prismatic))),
+    return [Loop(links, tuple(p for p in links if kinds[p].loop_role == "joint"),
                  frozenset(nodes)) for links, nodes in loops]
 
 

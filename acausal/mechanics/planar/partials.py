@@ -35,6 +35,8 @@ class PartialRigidLink(PartialTwoFrames):
     (``r`` the frame origins in the world). A leaf adds three position
     equations (and its own variables' laws)."""
 
+    loop_role = "link"   # an edge of the kinematic graph (acausal.mechanics.planar.loops)
+
     def equations(self):
         a, b = self.frame_a, self.frame_b
         return [Eq(a.fx + b.fx, 0), Eq(a.fy + b.fy, 0),

@@ -16,6 +16,7 @@ class Fixed(PartialOneFrame):
     Connectors: ``frame``.
     """
 
+    loop_role = "ground"  # its frame is the world node of the kinematic graph
     x0 = Parameter(0.0, "m", "world x of the frame")
     y0 = Parameter(0.0, "m", "world y of the frame")
     phi0 = Parameter(0.0, "rad", "angle of the frame")
