@@ -405,8 +405,9 @@ def sweep(file, params, measures, out, plot, scheduler, workers, no_progress):
     try:
         mf, cm = compile_file(file)
         specs = [parse_param(p) for p in params]
-        for name, _ in specs:
-            cm.param_index(name)
+        for name, _ in specs:   # a parameter, or a fixed start value (mass.v)
+            if name in cm.split_overrides({name: 0.0})[0]:
+                cm.param_index(name)
         for m in measures:
             if m not in mf.measures:
                 raise click.BadParameter(f"--measure {m!r}: the model file defines "
