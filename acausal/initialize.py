@@ -132,20 +132,19 @@ def _raise_if_parameter_breaks(cm, t0, p, d, exc):
         return  # a named cause alone (a linkage that cannot close)
     # (an absurd stiffness can also push a linkage past its assertion: then
     # both are reported, and only parameters SUSPECT_DECADES away are tried)
-    for k, entry in enumerate(cm.params):
-        if not _far_from(p[k], entry.default):
-            continue
+    for name, value, default, unit in suspect_parameters(cm, p):
+        k = cm.param_index(name)
         q = np.array(p, dtype=float)
-        q[k] = entry.default
+        q[k] = default
         try:
             _solve_initial(cm, q, d, cm.callbacks(q, d), t0)
         except (InitializationError, ArithmeticError, ValueError, np.linalg.LinAlgError):
             continue
         raise InitializationError(
-            f"parameter {entry.name} = {p[k]:g} [{entry.unit}] makes the initial equations "
-            f"unsolvable (with its default {entry.default:g} they solve): check its value "
+            f"parameter {name} = {value:g} [{unit}] makes the initial equations "
+            f"unsolvable (with its default {default:g} they solve): check its value "
             f"and unit; the initialisation said: {exc}",
-            variable=entry.name) from None
+            variable=name) from None
 
 
 def suspect_parameters(cm, p):

@@ -182,13 +182,19 @@ class CasadiIDAS:
             events.append((te, cm.events[i].name if i < len(cm.events) else "assert"))
             if self.terminal[i] and i < len(cm.events) and cm.events[i].terminal:
                 break
-            yy = np.concatenate([x, z[:len(z) - ns]])
-            yyp = np.zeros(len(yy))
-            yyp[:ns] = z[len(z) - ns:]
-            st = EventState(cm, p, d, te, cm.callbacks(p, d)[4](te, yy, yyp))
-            cm.events[i].action(st)
-            d = st.d
+            d = self._act(p, d, te, x, z, i)
         return events
+
+    def _act(self, p, d, te, x, z, i):
+        """Event ``i``'s action at the point (x, z) of the CasADi state: the
+        discrete values after it."""
+        cm, ns = self.cm, self.ns
+        yy = np.concatenate([x, z[:len(z) - ns]])
+        yyp = np.zeros(len(yy))
+        yyp[:ns] = z[len(z) - ns:]
+        st = EventState(cm, p, d, te, cm.callbacks(p, d)[4](te, yy, yyp))
+        cm.events[i].action(st)
+        return st.d
 
     def replay(self, p, d, t, y, yp, events):
         """The lower bound of the CasADi side: integrate from event to event
@@ -204,12 +210,7 @@ class CasadiIDAS:
             i = [e.name for e in cm.events].index(name)
             if cm.events[i].terminal:
                 break
-            yy = np.concatenate([x, z[:len(z) - ns]])
-            yyp = np.zeros(len(yy))
-            yyp[:ns] = z[len(z) - ns:]
-            st = EventState(cm, p, d, te, cm.callbacks(p, d)[4](te, yy, yyp))
-            cm.events[i].action(st)
-            d = st.d
+            d = self._act(p, d, te, x, z, i)
         return x
 
     def _first_crossing(self, G):
