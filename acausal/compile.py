@@ -331,6 +331,16 @@ class CompiledModel:
     def discrete_start(self):
         return [float(d.start.value) for d in self.discretes]
 
+    def y_column(self, name):
+        """The column of the DAE's unknowns y that variable ``name`` is
+        (directly, as itself or an alias), else None: a result then reads it
+        without evaluating every observed variable at every output."""
+        cols = self.__dict__.setdefault("_y_columns", {})
+        if name not in cols:
+            e = self.resolve(self.flat.variables[name].symbol)
+            cols[name] = self.dae.y.index(e) if e in self.dae.y else None
+        return cols[name]
+
     def callbacks(self, p, d):
         """(res, jac, roots, jacs, observe, count, jac_csc) for parameter vector
         ``p`` and discrete values ``d``: ``jac`` fills a 2-D (dense or band)

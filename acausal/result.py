@@ -54,9 +54,11 @@ class Result:
             return self.t
         try:
             k = cm.var_names.index(name)
-            return self._observed()[:, k]
         except ValueError:
-            pass
+            k = None
+        if k is not None:
+            j = cm.y_column(name) if self._obs is None and self.y.ndim == 2 else None
+            return self.y[:, j] if j is not None else self._observed()[:, k]
         for j, dsc in enumerate(cm.discretes):
             if dsc.symbol.name == name:
                 return self.d[:, j]

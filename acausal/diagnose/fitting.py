@@ -68,12 +68,13 @@ def subset(dataset: Dataset, names) -> Dataset:
                    dataset.instrument)
 
 
-def weighted_residuals(model, dataset, params):
+def weighted_residuals(model, dataset, params, backend=None):
     """(vector, groups, signals) of weighted residuals for ``params``, as
     :func:`acausal.calibrate.residual_vector` (measures first, then trace
     samples), except that an experiment without measures is simulated only
     up to its last trace sample (a growing-window fit then pays only for
-    its window) and its measures are not evaluated."""
+    its window) and its measures are not evaluated. ``backend``: the
+    integrator (:func:`acausal.simulate.simulate`; None: the library's)."""
     from ..calibrate import _sigma
     from ..modelfile import evaluate_measures
     mf, cm = resolve(model)
@@ -83,7 +84,7 @@ def weighted_residuals(model, dataset, params):
         opts = {**mf.experiment.run_options(dense=e.trace is not None), "max_steps": MAX_STEPS}
         if not e.measures and e.trace is not None and e.trace.time.size:
             opts["t_end"] = min(opts["t_end"], float(e.trace.time[-1]) * (1 + 1e-9) + 1e-12)
-        res = cm.simulate(params={**params, **e.conditions}, **opts)
+        res = cm.simulate(params={**params, **e.conditions}, backend=backend, **opts)
         if e.measures:
             meas = evaluate_measures(mf, res)
             for m, y in e.measures.items():
@@ -112,8 +113,9 @@ class Objective:
     """
 
     def __init__(self, model, dataset, names, fixed=None, budget_s=None, max_evals=None,
-                 penalty=None):
+                 penalty=None, backend=None):
         self.pair = resolve(model)
+        self.backend = backend
         self.penalty = penalty        # (rows P, scales) on the last P.shape[1] parameters
         self.dataset = dataset
         self.names = list(names)
@@ -141,7 +143,8 @@ class Objective:
         self.n_eval += 1
         self.n_sim += len(self.dataset.experiments)
         try:
-            vec = weighted_residuals(self.pair, self.dataset, self.params(x))[0]
+            vec = weighted_residuals(self.pair, self.dataset, self.params(x),
+                                     self.backend)[0]
             self.size = vec.size
             if not np.all(np.isfinite(vec)):
                 vec = np.nan_to_num(vec, nan=PENALTY, posinf=PENALTY, neginf=-PENALTY)
@@ -257,7 +260,8 @@ def failed_fit(names, x0, obj, message):
 def finish(obj, x, J, ok, message, lo):
     """The :class:`Fit` at ``x``: residuals re-simulated there, the
     Jacobian reshaped, intervals (log intervals for positive parameters)."""
-    r, groups, signals = weighted_residuals(obj.pair, obj.dataset, obj.params(x))
+    r, groups, signals = weighted_residuals(obj.pair, obj.dataset, obj.params(x),
+                                                obj.backend)
     obj.n_sim += len(obj.dataset.experiments)
     names = obj.names
     J = np.asarray(J)[:r.size].reshape(r.size, len(names)) if names else np.zeros((r.size, 0))

@@ -3,10 +3,16 @@ how hard (no state: every stage takes these and returns a new dataclass)."""
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, field
 
 FIT_TOL = 1e-6   # ftol/xtol of the candidate fits (S to about 1e-6 relative)
 LOO_TOL = 1e-4   # of the warm-started leave-one-out refits (predictions only)
+# The diagnosis's fits run thousands of simulations of a few models: IDA
+# calling generated C (acausal.backends.compiled; falls back to "sundae"
+# without a C compiler) is 9x (breaker) to 18x (torsion rig) faster per
+# simulation and agrees to the integrator's tolerance (docs/diagnosis.md).
+FIT_BACKEND = "compiled"
 
 
 @dataclass(frozen=True)
@@ -76,7 +82,9 @@ class FitSettings:
     extension's bounds (scipy.stats.qmc); ``refine``: how many of the best
     scored starts are refined by least squares (their agreement is
     reported); ``windows``: fractions of the trace for the growing-window
-    homotopy of the nominal calibration (1.0 last)."""
+    homotopy of the nominal calibration (1.0 last); ``backend``: the
+    integrator of every fit's simulations (None: ``ACAUSAL_BACKEND``, else
+    :data:`FIT_BACKEND`)."""
 
     max_nfev: int = 60
     tol: float = FIT_TOL
@@ -85,6 +93,11 @@ class FitSettings:
     refine: int = 2
     windows: tuple = (0.3, 1.0)
     seed: int = 0
+    backend: str | None = None
+
+    @property
+    def integrator(self) -> str:
+        return self.backend or os.environ.get("ACAUSAL_BACKEND") or FIT_BACKEND
 
 
 @dataclass(frozen=True)

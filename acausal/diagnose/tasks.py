@@ -250,7 +250,8 @@ def _multistart(task: FitTask):
     lo, hi, sc = _bounds(params)
     ds = dataset_of(p)
     pair = model_of(p, cand)
-    obj = Objective(pair, ds, names, budget_s=task.budget_s, penalty=_penalty(cand))
+    obj = Objective(pair, ds, names, budget_s=task.budget_s, penalty=_penalty(cand),
+                    backend=s.integrator)
     pts = start_points(task)
     scored = score_starts(obj, [x for x, _ in pts], lo, hi, task.absorb)
     if not scored:
@@ -283,7 +284,7 @@ def calibrate_nominal(task: FitTask) -> CandidateFit:
     n_lhs = s.lhs if len(windows) > 1 else 0
     pts = [np.array([q.start for q in params])] + [np.array(x) for x in lhs_values(
         params, n_lhs, s.seed)]
-    obj = Objective(pair, window(ds, windows[0]), names)
+    obj = Objective(pair, window(ds, windows[0]), names, backend=s.integrator)
     scored = score_starts(obj, pts, lo, hi)
     if not scored:
         return CandidateFit(task.candidate, None, {}, "every starting point failed",
@@ -310,7 +311,7 @@ def _homotopy(pair, ds, names, x, lo, hi, sc, windows, s, budget_s=None, penalty
     full = s.evals_per_param * (len(names) + 1)
     for w in windows:
         obj = Objective(pair, window(ds, w), names, budget_s=budget_s, penalty=penalty,
-                        max_evals=full if w >= 1.0 else max(3, full // 3))
+                        max_evals=full if w >= 1.0 else max(3, full // 3), backend=s.integrator)
         fit = finish(obj, *refine_or_keep(obj, x, lo, hi, sc, s.max_nfev, s.tol), lo)
         n_sim += obj.n_sim
         x = np.array([fit.values[n] for n in names])
@@ -347,8 +348,8 @@ def refit_without(task: LooTask) -> LooResult:
     lo, hi, sc = _bounds(task.params)
     s = task.problem.settings
     obj = Objective(pair, train, names, budget_s=task.budget_s,
-                    max_evals=s.evals_per_param * (len(names) + 1) // 3)
+                    max_evals=s.evals_per_param * (len(names) + 1) // 3, backend=s.integrator)
     x0 = np.array([q.start for q in task.params])
     f = finish(obj, *refine_or_keep(obj, x0, lo, hi, sc, task.max_nfev, LOO_TOL), lo)
-    r = weighted_residuals(pair, subset(ds, [task.held]), f.values)[0]
+    r = weighted_residuals(pair, subset(ds, [task.held]), f.values, s.integrator)[0]
     return LooResult(task.candidate, task.held, r, f.values, f.n_sim)
