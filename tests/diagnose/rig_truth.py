@@ -10,6 +10,9 @@ effects the diagnosis must find:
   c * sign(phi) * max(|phi| - b, 0) (no library hypothesis acts there);
 * ``coulomb``: tau_extra = F sign(phi') (dry friction at the bearing,
   regularised over 1e-4 rad/s);
+* ``drag``: tau_extra = c2 phi'|phi'| (quadratic drag);
+* ``threshold``: tau_extra = F_t sign(phi') min(max(|phi'| - W_T, 0) / W_T, 1)
+  (a torque that sets in above the speed W_T: no library law);
 
 several at once as a dict {effect: value}.
 
@@ -24,6 +27,7 @@ from acausal.data import Dataset, Experiment, Instrument, Trace, write_dataset
 J, C, D = 1e-3, 4.0, 1.5e-3     # the rig's nominal inertia, stiffness and damping
 T_END, RATE = 1.6, 2000.0
 NOISE, RESOLUTION = 5e-4, 2e-4  # rad
+W_T = 10.0                      # speed at which the threshold torque sets in [rad/s]
 
 
 def _effects(effect, value):
@@ -42,7 +46,10 @@ def spring_torque(phi, c, eff):
 
 
 def extra_torque(w, eff):
-    return eff.get("coulomb", 0.0) * np.tanh(w / 1e-4)
+    tau = eff.get("coulomb", 0.0) * np.tanh(w / 1e-4) + eff.get("drag", 0.0) * w * abs(w)
+    if "threshold" in eff:
+        tau += eff["threshold"] * np.sign(w) * min(max(abs(w) - W_T, 0.0) / W_T, 1.0)
+    return tau
 
 
 def simulate(phi0, effect=None, value=0.0, c=C, d=D, t=None):
