@@ -22,7 +22,9 @@ def run_case(model, truth, tmp_path, effect, value=None, seed=3, name=None, **kw
     row = dict(case=name or str(effect), model=os.path.basename(model), effect=effect,
                value=value, seed=seed, floors=floors, discrepancy=out["discrepancy"],
                causes=out["causes"], unexplained=out["unexplained"], gain=out["gain"],
-               weak=det.get("weak_evidence"), ranking=out["ranking"][:4], wall_s=wall)
+               weak=det.get("weak_evidence"), ranking=out["ranking"][:4], wall_s=wall,
+               located=[{k: t.get(k) for k in ("node", "S", "aicc", "heldout_rmse")}
+                        for t in det.get("located") or []][:3])
     print(f"BLIND {row['case']} ({row['model']}, seed {seed}): effect {floors:.0f} floors; "
           f"discrepancy {out['discrepancy']}; named {[(c['cause'], c['location']) for c in out['causes']]}; "
           f"unexplained {out['unexplained']}; held-out {out['gain']['before']['heldout']:.3f}"
