@@ -24,8 +24,9 @@ import sympy as sp
 from .domain import domain_of
 from .hypotheses import Hypothesis, build_extended
 
-N_X = 7          # knots in position
-N_V = 5          # knots in velocity
+N_X = 9          # knots in position (a feature of 1/8 of the range is resolved)
+N_V = 9          # knots in velocity (with 5, a torque that sets in above a speed
+                 # was no better fitted than quadratic drag: docs/diagnosis.md)
 SMOOTH = 1.0     # penalty weight on second differences (per typical force, squared)
 PAD = 0.1        # knot range padding (fraction of the nominal range)
 

@@ -76,6 +76,15 @@ def generic_candidates(problem):
     return out
 
 
+def _one_start(problem):
+    """The term is linear in its weights: it is refined from zero weights
+    (with the calibrated free parameters) only; Latin-hypercube splines are
+    random wiggles that cost a refinement each and start nowhere useful."""
+    import dataclasses
+    s = dataclasses.replace(problem.settings, lhs=0, refine=1)
+    return dataclasses.replace(problem, settings=s)
+
+
 def _term(r, n, c_hat, ranges, members):
     f = r.fit
     return Term(r.candidate.location, members, f.cost, st.aicc(f.cost, n, f.k, c_hat),
@@ -92,7 +101,7 @@ def locate(problem, cal, dec, rk, ex, progress=True, collect=None) -> Location:
     gens = generic_candidates(problem)
     if not gens:
         return Location(skipped="the model has no body node")
-    tasks = fit_tasks(problem, cal, [g[0] for g in gens])
+    tasks = fit_tasks(_one_start(problem), cal, [g[0] for g in gens])
     results = run_tasks(ex, fit_candidate, tasks, "locating", progress, collect)
     n = cal.fit.n
     terms = sorted((_term(r, n, dec.c_hat, g[1], g[2]) for r, g in zip(results, gens) if r.ok),
