@@ -317,25 +317,42 @@ def confidence(f: Fit, level=0.95, positive=()) -> dict:
     return out
 
 
-def linear_loo(f: Fit) -> dict:
+def linear_loo(f: Fit, penalty=None) -> dict:
     """Leave-one-experiment-out residuals predicted from the full fit.
 
     For experiment G, one Gauss-Newton step from the optimum without G's
     rows: delta = -lstsq(J[-G], r[-G]); predicted held-out residuals
     r[G] + J[G] delta. Exact for a model linear in its parameters (the
     classical PRESS residuals); a first-order estimate otherwise, and free
-    (no simulation). Returns experiment -> residual vector.
+    (no simulation). ``penalty`` = (rows P, scales) of a penalised fit
+    (:class:`Objective`) on its last P.shape[1] parameters: the step keeps
+    the penalty rows, as the refit would (the PRESS residuals of a
+    penalised fit). Returns experiment -> residual vector.
     """
     groups = np.asarray(f.groups)
+    Jp, rp = _penalty_rows(f, penalty)
     out = {}
     for g in dict.fromkeys(f.groups):
         m = groups == g
         if f.k == 0 or not np.any(~m):
             out[g] = f.residuals[m]
             continue
-        delta = np.linalg.lstsq(f.jacobian[~m], -f.residuals[~m], rcond=None)[0]
+        A = np.vstack([f.jacobian[~m], Jp])
+        delta = np.linalg.lstsq(A, -np.concatenate([f.residuals[~m], rp]), rcond=None)[0]
         out[g] = f.residuals[m] + f.jacobian[m] @ delta
     return out
+
+
+def _penalty_rows(f: Fit, penalty):
+    """(Jacobian rows, residuals) of the penalty at the fit, in parameter units."""
+    if penalty is None or f.k == 0:
+        return np.zeros((0, f.k)), np.zeros(0)
+    P, sc = penalty
+    q = P.shape[1]
+    x = np.array([f.values[n] for n in f.names[-q:]], float)
+    J = np.zeros((P.shape[0], f.k))
+    J[:, -q:] = P / sc
+    return J, P @ (x / sc)
 
 
 def heldout_rms(loo: dict) -> float:

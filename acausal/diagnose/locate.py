@@ -16,7 +16,7 @@ import numpy as np
 
 from . import stats as st
 from .fitting import heldout_rms
-from .generic import GENERIC, N_V, N_X, penalty, shape
+from .generic import GENERIC, N_V, N_X, SMOOTH, penalty, shape
 from .problem import Candidate, Param
 from .stages import fit_tasks, run_tasks
 from .tasks import fit_candidate
@@ -59,7 +59,9 @@ def needed(dec, rk) -> bool:
     return dec.discrepancy and (rk.named is None or dec.c_hat > st.OVERDISPERSION)
 
 
-def generic_candidates(problem):
+def generic_candidates(problem, n=1):
+    """(Candidate, knot ranges, members) of the generic term at every body
+    node; ``n`` data values set the penalty's weight (generic.SMOOTH per value)."""
     from .graph import ModelGraph
     from .nominal import nominal_result
     from ..modelfile import load_model_file
@@ -69,7 +71,7 @@ def generic_candidates(problem):
     for loc in GENERIC.candidates(graph):
         params = tuple(Param(s.name, s.initial, s.low, s.high, s.scale, s.initial)
                        for s in GENERIC.params(graph, loc))
-        out.append((Candidate(GENERIC.id, loc, params, penalty(N_X, N_V)),
+        out.append((Candidate(GENERIC.id, loc, params, penalty(N_X, N_V, SMOOTH * n)),
                     tuple(GENERIC.ranges(graph, loc)),
                     tuple(sorted({p.owner.path for p in
                                   graph.nodes[graph.node(graph.components[loc].flange)]}))))
@@ -98,7 +100,7 @@ def locate(problem, cal, dec, rk, ex, progress=True, collect=None) -> Location:
     if not needed(dec, rk):
         return Location(skipped="not needed: no discrepancy, or a cause explains it")
     t0 = time.perf_counter()
-    gens = generic_candidates(problem)
+    gens = generic_candidates(problem, cal.fit.n)
     if not gens:
         return Location(skipped="the model has no body node")
     tasks = fit_tasks(_one_start(problem), cal, [g[0] for g in gens])

@@ -220,7 +220,7 @@ def fit_candidate(task: FitTask) -> CandidateFit:
     t0 = time.perf_counter()
     try:
         fit, starts = _multistart(task)
-        loo = linear_loo(fit) if fit.ok else {}
+        loo = linear_loo(fit, _penalty(task.candidate)) if fit.ok else {}
         return CandidateFit(task.candidate, fit, loo, None, time.perf_counter() - t0, starts)
     except Exception as exc:  # noqa: BLE001 - a candidate that cannot be built is reported
         return CandidateFit(task.candidate, None, {}, f"{type(exc).__name__}: {exc}",
