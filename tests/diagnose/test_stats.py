@@ -137,6 +137,32 @@ def test_linear_loo_is_exact_for_linear_models():
     assert heldout_rms(loo) == pytest.approx(np.sqrt(np.mean(allr ** 2)))
 
 
+def test_linear_loo_of_a_penalised_fit_is_the_penalised_refit():
+    """With smoothing rows on the last parameters (value/scale), the
+    linearised leave-one-out is exactly the penalised refit without the
+    group (the PRESS residuals of a penalised linear model)."""
+    rng = np.random.default_rng(5)
+    groups = np.repeat(["a", "b", "c"], 12)
+    X = rng.normal(size=(36, 5))
+    y = X @ [1.0, 0.5, -1.0, 2.0, 0.3] + rng.normal(size=36)
+    P = 3.0 * np.diff(np.eye(4), 2, axis=0)          # on the last 4 parameters
+    sc = np.array([2.0, 2.0, 2.0, 2.0])
+    Pf = np.c_[np.zeros((2, 1)), P / sc]
+
+    def solve(m):
+        return np.linalg.lstsq(np.vstack([X[m], Pf]), np.r_[y[m], np.zeros(2)], rcond=None)[0]
+
+    b = solve(np.ones(36, bool))
+    names = [f"p{i}" for i in range(5)]
+    f = Fit(names, dict(zip(names, b)), float(np.sum((X @ b - y) ** 2)), X @ b - y, X,
+            list(groups), ["y"] * 36)
+    loo = linear_loo(f, (P, sc))
+    for g in "abc":
+        m = groups == g
+        np.testing.assert_allclose(loo[g], X[m] @ solve(~m) - y[m], atol=1e-10)
+    assert not np.allclose(linear_loo(f)["a"], loo["a"])
+
+
 def test_confidence_matches_ols_with_known_sigma():
     rng = np.random.default_rng(3)
     X = np.c_[np.ones(50), np.linspace(0, 1, 50)]
