@@ -57,8 +57,9 @@ def main(ctx, global_backend):
 # commands that run many simulations of one model: the compiled backend's
 # one-off C build (about 2-3 s, cached on disk) pays for itself there; it
 # falls back to sundae without a C compiler (benchmarks/anchors.py,
-# tests/backends/test_agreement.py). diagnose compiles dozens of hypothesis
-# models: not measured yet, so it keeps the reference.
+# tests/backends/test_agreement.py). diagnose's fits take the compiled
+# backend themselves (acausal/diagnose/problem.py FIT_BACKEND, measured in
+# docs/diagnosis.md); --backend / ACAUSAL_BACKEND still overrides it.
 MANY_RUNS = {"calibrate", "sweep"}
 
 
