@@ -136,6 +136,7 @@ class _Run:
         self.T, self.Y, self.YP, self.D = [], [], [], []
         self.events, self.event_log = [], []
         self.nfev = self.njev = self.steps = self.rows = 0
+        self.sens = None   # acausal.sensitivity.SensRun when sensitivities are asked for
 
     def record(self, t, y, yp, d):
         self.T.append(np.atleast_1d(np.asarray(t, float)))
@@ -161,15 +162,22 @@ class _Run:
             stats["backend_fallback"] = solver.fallback
         n = len(self.cm.dae.y)
         cat = (lambda blocks, w: np.concatenate(blocks) if blocks else np.zeros((0, w)))
-        return Result(self.cm, self.p, cat(self.T, 0) if self.T else np.zeros(0),
-                      cat(self.Y, n), cat(self.YP, n), cat(self.D, len(self.cm.discretes)),
-                      list(self.events), stats, status, message)
+        T, Y, YP = cat(self.T, 0) if self.T else np.zeros(0), cat(self.Y, n), cat(self.YP, n)
+        D = cat(self.D, len(self.cm.disc_syms))
+        if self.sens is None:
+            return Result(self.cm, self.p, T, Y, YP, D, list(self.events), stats, status,
+                          message)
+        sm = self.cm   # the augmented model (acausal.sensitivity)
+        res = Result(sm.base, self.p, T, sm.unpack(Y)[0], sm.unpack(YP)[0],
+                     D[:, :len(sm.base.disc_syms)], list(self.events), stats, status, message)
+        res.sensitivities = self.sens.result_data(T, Y, YP, D, len(self.events))
+        return res
 
 
 def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_step=None,
              output_times=None, max_step=None, max_steps=100000, atol_algebraic=None,
              backend=None, max_rows=MAX_ROWS, max_wall=None, max_total_steps=None,
-             progress=False, linsolver="auto"):
+             progress=False, linsolver="auto", sensitivities=None):
     """Simulate a :class:`CompiledModel` from ``t0`` to ``t_end`` (or until a
     terminal event). ``params`` overrides parameter values, and the start
     values of variables whose start is fixed, by dotted path (both are
@@ -205,17 +213,33 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
 
     ``linsolver``: IDA's linear solver, see
     :meth:`acausal.compile.CompiledModel.linear_solver` (``"auto"`` chooses
-    band for large models with a narrow band, else dense)."""
+    band for large models with a narrow band, else dense).
+
+    ``sensitivities``: names of free parameters; the run then also integrates
+    the forward sensitivities of every unknown with respect to them, with
+    their jumps at events (:mod:`acausal.sensitivity`), on either backend:
+    ``res.sensitivity("body.x", "spring.c")`` is d(body.x)/d(spring.c) at
+    every ``res.t``, ``res.event_sensitivity("spring.c")`` the derivatives of
+    the event times."""
     wall0 = _time.perf_counter()
     backend = _backend(backend)
     params, starts = cm.split_overrides(params)
     p = cm.param_vector(params)
     d = cm.discrete_start()
-    run = _Run(cm, p, t0, t_end, rtol, _atol_vector(cm, atol, atol_algebraic), max_step,
-               max_steps, backend, linsolver)
+    atol = _atol_vector(cm, atol, atol_algebraic)
+    model = cm
+    if sensitivities:
+        from .sensitivity import SensRun, sensitivity_model
+        model = sensitivity_model(cm, sensitivities)
+        atol = model.atol(atol, p)
+    run = _Run(model, p, t0, t_end, rtol, atol, max_step, max_steps, backend, linsolver)
     cb = cm.callbacks(p, d)
     run.cb_d = list(d)
     y, yp = initial_point(cm, p, d, cb, t0, starts)
+    if sensitivities:
+        run.sens = SensRun(model, p, t_end - t0)
+        y, yp, d, cb = run.sens.start(p, d, t0, y, yp, starts)
+        run.cb_d = list(d)
     y, yp, d, cb, stop = _event_iteration(run, cb, t0, y, yp, d, initial=True)
     _check_output_size(cm, t0, t_end, output_step, output_times, max_rows)
     tout = _output_times(t0, t_end, output_step, output_times)
@@ -233,12 +257,12 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
             if len(seg.t) > 1:
                 run.record(seg.t[1:], seg.y[1:], seg.yp[1:], d)
             if seg.status < 0:
-                raise _failure(run, cm, seg, cb)
+                raise _failure(run, run.cm, seg, cb)
             t, y, yp = float(seg.t[-1]), np.array(seg.y[-1]), np.array(seg.yp[-1])
             watch.check(t)
             d, fired = _observers(run, cb, seg, d)
             if d != run.cb_d:
-                cb = cm.callbacks(run.p, d)
+                cb = run.cm.callbacks(run.p, d)
             run.cb_d = list(d)
             if seg.status != 2:
                 if tspan[-1] < t_end:   # the end of a window of the watch
@@ -478,7 +502,10 @@ def _observers(run, cb, seg, d):
         te = root.t
         state = EventState(cm, run.p, d, te, cb[4](te, root.y, root.yp))
         before = list(d)
+        taus = run.sens.event_times(te, root.y, root.yp, d, obs) if run.sens else None
         for i in obs:
+            if taus is not None:
+                run.sens.note(len(run.events), taus[i])
             _log_event(run, te, cm.events[i])
             cm.events[i].action(state)
         for j, (a, b) in enumerate(zip(before, d)):
@@ -497,26 +524,42 @@ def _handle(run, cb, t, y, yp, d, fired):
     cm = run.cm
     n_ev = len(cm.events)
     d = list(d)
+    d_before = list(d)
     obs = cb[4](t, y, yp)
     state = EventState(cm, run.p, d, t, obs)
     stop = False
+    taus = run.sens.event_times(t, y, yp, d, fired, current=True) if run.sens else None
     for i in fired:
         if i >= n_ev:
             a = cm.assertions[i - n_ev]
             raise SolverError(f"{a.owner}: {a.message} (at t = {t:.6g} s)", t=t,
                               component=a.owner, result=run.result("failed", a.message))
         ev = cm.events[i]
+        if taus is not None:
+            run.sens.note(len(run.events), taus[i])
         _log_event(run, t, ev)
         if ev.action is not None:
             ev.action(state)
         if ev.terminal:
             stop = True
     if state.changed:
-        cb = cm.callbacks(run.p, d)
-        y, yp = reinitialize(cm, cb, t, y, yp)
+        d, cb, y, yp = _new_mode(run, [cm.events[i] for i in fired], t, y, yp, d_before, d,
+                                 obs)
         y, yp, d, cb, stop2 = _event_iteration(run, cb, t, y, yp, d)
         stop = stop or stop2
+    if run.sens is not None:
+        run.sens.dtau[:] = 0.0   # the instant is over
     return y, yp, d, cb, stop
+
+
+def _new_mode(run, events, t, y, yp, d_before, d, obs):
+    """(d, callbacks, y, y') of the mode ``d`` that ``events`` set, re-initialised
+    at ``t``; with sensitivities, their jumps (:meth:`acausal.sensitivity.SensRun.mode_change`)."""
+    if run.sens is not None:
+        return run.sens.mode_change(events, t, y, yp, d_before, d, obs)
+    cb = run.cm.callbacks(run.p, d)
+    y, yp = reinitialize(run.cm, cb, t, y, yp)
+    return d, cb, y, yp
 
 
 def _event_iteration(run, cb, t, y, yp, d, initial=False):
@@ -530,17 +573,19 @@ def _event_iteration(run, cb, t, y, yp, d, initial=False):
         cb[2](t, y, yp, g)
         obs = cb[4](t, y, yp)
         state = EventState(cm, run.p, list(d), t, obs)
+        fired = []
         for i in checks:
             ev = cm.events[i]
             if (ev.direction < 0 and g[i] < 0) or (ev.direction > 0 and g[i] > 0):
+                if run.sens is not None:
+                    run.sens.note(len(run.events), run.sens.dtau)
                 _log_event(run, t, ev)
+                fired.append(ev)
                 if ev.action is not None:
                     ev.action(state)
         if not state.changed:
             return y, yp, d, cb, False
-        d = state.d
-        cb = cm.callbacks(run.p, d)
-        y, yp = reinitialize(cm, cb, t, y, yp)
+        d, cb, y, yp = _new_mode(run, fired, t, y, yp, d, state.d, obs)
     raise ChatteringError(f"event iteration did not settle at t = {t:.6g} s "
                           f"({MAX_ITER} mode changes at one instant) in "
                           + ", ".join(sorted({cm.events[i].owner for i in checks})), t=t)
