@@ -332,7 +332,7 @@ class SensRun:
                 for a, qd in enumerate(sm.dyn):
                     dd[qd] += sgn * h * sd[j, a]
                 st = EventState(cm, q, dd, t + sgn * h * self.dtau[j],
-                                list(np.asarray(obs) + sgn * h * (dobs[j] + odot * self.dtau[j])))
+                                list(np.asarray(obs)[:nobs] + sgn * h * (dobs[j] + odot * self.dtau[j])))
                 for ev in events:
                     if ev.action is not None:
                         ev.action(st)
@@ -393,8 +393,7 @@ def _initial_state_sensitivities(sm, cm, cb, p, d, t0, y, yp, starts):
         qp, qm = np.array(p, float), np.array(p, float)
         qp[k] += h
         qm[k] -= h
-        dv = (np.array([v for _, v, _ in cm.fixed_starts(qp, starts)])
-              - np.array([v for _, v, _ in cm.fixed_starts(qm, starts)])) / (2 * h)
+        dv = np.array([_start_derivative(cm, name, k, p, starts) for _, _, name in fixed])
         dg = (cm.guess_vector(qp, starts) - cm.guess_vector(qm, starts)) / (2 * h)
         rhs = [-Fp[j]]
         if fixed:
@@ -403,6 +402,18 @@ def _initial_state_sensitivities(sm, cm, cb, p, d, t0, y, yp, starts):
         dz = _lstsq_scaled(A, np.concatenate(rhs))
         out[j] = dz[:ns]
     return out
+
+
+def _start_derivative(cm, name, k, p, starts):
+    """d(fixed start value of variable ``name``)/d(parameter ``k``): the start
+    value is a number (0), an override for this run (0) or an expression of
+    parameters (differentiated symbolically)."""
+    value = cm.flat.variables[name].start.value
+    if (starts and name in starts) or not isinstance(value, sp.Basic) or value.is_number:
+        return 0.0
+    e = value.xreplace(cm._subs)
+    de = diff(e, cm.param_syms[k])
+    return float(de.xreplace(dict(zip(cm.param_syms, map(float, p)))))
 
 
 class Sensitivities:
