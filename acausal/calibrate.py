@@ -143,9 +143,10 @@ class Calibration:
     n_sim: int = 0
     validation: dict = field(default_factory=dict)  # held-back experiment -> residuals
     profile_ci95: dict = field(default_factory=dict)  # name -> acausal.profile.Profile
+    jacobian: str = "finite differences"   # or "sensitivities" (see least_squares)
 
     def to_dict(self):
-        return dict(method=self.method, values=self.values,
+        return dict(method=self.method, values=self.values, jacobian=self.jacobian,
                     ci95={k: list(v) for k, v in self.ci95.items()},
                     profile_ci95={k: p.to_dict() for k, p in self.profile_ci95.items()},
                     correlation=None if self.correlation is None else self.correlation.tolist(),
@@ -269,6 +270,63 @@ def residual_vector(path, dataset, params, signals=None, options=None):
     return np.asarray(vec), labels, raw
 
 
+def exact_jacobian_applies(dataset, signals=None):
+    """True when every residual of ``dataset`` (restricted to ``signals``) is a
+    trace sample, whose derivative :func:`residual_jacobian` takes from the
+    forward sensitivities; a measure is any function of a result, which only
+    finite differences can differentiate."""
+    return all(not [m for m in exp.measures if not signals or m in signals]
+               for exp in dataset.experiments) and \
+        any(exp.trace is not None for exp in dataset.experiments)
+
+
+def residual_jacobian(path, dataset, params, names, signals=None, options=None):
+    """(weighted residuals, their Jacobian d r / d x over the parameters
+    ``names``) from one simulation per experiment with forward sensitivities
+    (:mod:`acausal.sensitivity`): the derivative of a trace sample
+    ``interp(t_k, res.t, res[var])`` is the same interpolation of
+    ``res.sensitivity(var, p)``. Only for datasets of traces
+    (:func:`exact_jacobian_applies`)."""
+    path = resolve(path)
+    if not exact_jacobian_applies(dataset, signals):
+        raise CalibrationError("the exact Jacobian needs a dataset of traces only")
+    vec, jac = [], []
+    for exp in dataset.experiments:
+        opts = {**path[0].experiment.run_options(dense=True), **(options or {}),
+                "sensitivities": list(names)}
+        res, _ = simulate_experiment(path, params, exp.conditions, opts)
+        for var, ys in exp.trace.signals.items():
+            if signals and var not in signals:
+                continue
+            sigma = _sigma(dataset, var, ys)
+            sim = np.interp(exp.trace.time, res.t, res[var])
+            vec.extend((sim - ys) / sigma)
+            jac.append(np.column_stack([np.interp(exp.trace.time, res.t,
+                                                  res.sensitivity(var, n)) / sigma
+                                        for n in names]))
+    return np.asarray(vec), np.vstack(jac)
+
+
+class SensitivityJacobian:
+    """``jac`` for ``scipy.optimize.least_squares`` in the fit's variables
+    ``z`` (``x = to_x(z)``, ``dxdz(z)`` = dx/dz) from
+    :func:`residual_jacobian`; where a sensitivity run fails, the finite
+    differences ``fallback`` (a :class:`ForwardDifferences`) answer that
+    call instead, counted in ``fallbacks``."""
+
+    def __init__(self, jac_x, to_x, dxdz, fallback):
+        self.jac_x, self.to_x, self.dxdz, self.fallback = jac_x, to_x, dxdz, fallback
+        self.fallbacks = self.calls = 0
+
+    def jac(self, z):
+        self.calls += 1
+        try:
+            return self.jac_x(self.to_x(z)) * self.dxdz(z)[None, :]
+        except AcausalError:
+            self.fallbacks += 1
+            return self.fallback.jac(z)
+
+
 def _sigma(dataset, signal, values):
     inst = dataset.instrument.get(signal)
     s = inst.floor() if inst is not None else 0.0
@@ -277,7 +335,8 @@ def _sigma(dataset, signal, values):
     return s
 
 
-def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, profile="none"):
+def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, profile="none",
+                  jacobian="auto"):
     """Output-error least squares over parameters ``names``.
 
     Bounds come from ``bounds``, else the model file's ``free_parameters``,
@@ -290,7 +349,14 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, prof
     ``profile``: "auto" adds profile-likelihood intervals
     (:mod:`acausal.profile`, ``Calibration.profile_ci95``) for the parameters
     whose linearised interval fails :func:`acausal.profile.linear_check`;
-    "all" for every fitted parameter; "none" (default) for none."""
+    "all" for every fitted parameter; "none" (default) for none.
+
+    ``jacobian``: "auto" (default) takes the Jacobian from forward
+    sensitivities (:func:`residual_jacobian`, one simulation per experiment
+    and exact up to the solver tolerance) when every residual is a trace
+    sample, else finite differences (absolute step :data:`FD_STEP`);
+    "sensitivities" or "differences" force one. ``Calibration.jacobian``
+    says which ran."""
     path = resolve(path)
     mf, cm = path
     entries = [cm.params[cm.param_index(n)] for n in names]
@@ -333,8 +399,22 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, prof
     zhi = np.where(np.isfinite(hi), zhi, np.inf)
     z0 = np.clip(to_z(inside), zlo, zhi)
     fd = ForwardDifferences(fun, FD_STEP, zhi)
-    sol = optimize.least_squares(fd, z0, jac=fd.jac, bounds=(zlo, zhi),
+    jac, kind = fd.jac, "finite differences"
+    if jacobian == "sensitivities" or (jacobian == "auto"
+                                       and exact_jacobian_applies(dataset, signals)):
+        def jac_x(x):
+            n_sim[0] += len(dataset.experiments)
+            return residual_jacobian(path, dataset, dict(zip(names, x.tolist())), names,
+                                     signals)[1]
+        exact = SensitivityJacobian(jac_x, to_x, lambda z: np.where(logp, to_x(z), scale), fd)
+        jac, kind = exact.jac, "sensitivities"
+    elif jacobian not in ("auto", "differences"):
+        raise CalibrationError(f"jacobian={jacobian!r}: choose 'auto', 'sensitivities' or "
+                               "'differences'")
+    sol = optimize.least_squares(fd, z0, jac=jac, bounds=(zlo, zhi),
                                  xtol=1e-12, ftol=1e-12, gtol=1e-12)
+    if kind == "sensitivities" and exact.fallbacks:
+        kind += f" ({exact.fallbacks} of {exact.calls} by finite differences)"
     xs = to_x(sol.x)
     values = dict(zip(names, xs.tolist()))
     dof = max(n_res - len(names), 0)
@@ -354,7 +434,7 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, prof
         ci = {n: (float("nan"), float("nan")) for n in names}
     raw = residual_vector(path, dataset, values, signals)[2]
     out = Calibration("least_squares", values, ci, corr, raw, float(2 * sol.cost), dof,
-                      n_sim[0])
+                      n_sim[0], jacobian=kind)
     if profile != "none" and names:
         # in the fit's own variables (log for a positive range, value/scale
         # otherwise), so that the profiles' Wald intervals are the ones above
