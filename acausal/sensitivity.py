@@ -262,15 +262,23 @@ class SensRun:
         return Y, YP, d_aug, cb
 
     # -- events ------------------------------------------------------------------
-    def event_time(self, t, Y, YP, d_aug, i):
-        """dtau/dp (m) of root ``i`` located at ``(t, Y, Y')``."""
+    def polish(self, t, Y, YP, d_aug):
+        """The point IDA located a root at, with its algebraic unknowns and
+        derivatives re-solved from the (augmented) equations: IDA's
+        interpolated values there meet them only to the tolerance."""
+        from .initialize import reinitialize
+        return reinitialize(self.sm, self.sm.callbacks(self.p, d_aug), t, Y, YP)
+
+    def event_time(self, t, Y, YP, d_aug, i, rates):
+        """dtau/dp (m) of root ``i`` at the (polished) point ``(t, Y, Y')``;
+        ``rates`` = (y', y'') of the base model there."""
         sm = self.sm
         nd = len(sm.base.disc_syms)
         (y, S), (yp, Sp) = sm.unpack(Y), sm.unpack(YP)
         Gy, Gyp, Gt, Gp, Gd = sm.rootgrad(t, y, yp, self.p, d_aug[:nd])
         sd = sm.sd_of(d_aug)
         num = S @ Gy[i] + Sp @ Gyp[i] + Gp[i] + sd @ Gd[i]
-        rate = Gy[i] @ yp + Gt[i]
+        rate = Gy[i] @ rates[0] + Gyp[i] @ rates[1] + Gt[i]
         if rate == 0 or not np.isfinite(rate):
             return np.full(sm.m, np.nan)   # a grazing root: tau is not differentiable
         return -num / rate
@@ -279,7 +287,12 @@ class SensRun:
         """index -> dtau/dp of each fired event; with ``current`` the first
         one is the instant's (the one its mode changes jump by)."""
         n_ev = len(self.sm.base.events)
-        taus = {i: self.event_time(t, Y, YP, d_aug, i) for i in fired if i < n_ev}
+        fired = [i for i in fired if i < n_ev]
+        if not fired:
+            return {}
+        Y, YP = self.polish(t, Y, YP, d_aug)
+        rates = _rates(self.sm, self.p, t, Y, YP, d_aug)
+        taus = {i: self.event_time(t, Y, YP, d_aug, i, rates) for i in fired}
         if current and taus:
             first = taus[min(taus)]
             self.dtau[:] = np.where(np.isfinite(first), first, 0.0)
@@ -297,6 +310,7 @@ class SensRun:
         from .initialize import reinitialize
         sm = self.sm
         nd = len(sm.base.disc_syms)
+        Y, YP = self.polish(t, Y, YP, d_before)
         sd = self._action_sensitivities(events, t, Y, YP, d_before, d_after, obs)
         d_new = list(d_after[:nd]) + sd.ravel().tolist()
         cb = sm.callbacks(self.p, d_new)
@@ -359,6 +373,36 @@ class SensRun:
             if k < n_events:
                 E[k] = v
         return Sensitivities(self.sm, self.p, T, Y, YP, D, E)
+
+
+def _rates(sm, p, t, Y, YP, d_aug):
+    """(y', y'') of the base model at a consistent point: y' of the states
+    from ``YP``, y' of the algebraic unknowns and y'' of the states from the
+    equations differentiated once along the solution,
+    ``[F_y(alg) F_y'(states)] [y'_alg; y''_states] = -(F_t + F_y(states) y'_states)``
+    (as :func:`acausal.initialize._algebraic_rates`; F_t by a central
+    difference)."""
+    from .initialize import _jacobians
+    cm, n, ns = sm.base, sm.n, sm.ns
+    y, yp = sm.unpack(Y)[0], sm.unpack(YP)[0]
+    ydot, ydd = np.array(yp, float), np.zeros(n)
+    if n == ns and not any(s is not None for s in cm.dae.yp):
+        return ydot, ydd
+    cb = cm.callbacks(p, list(d_aug[:len(cm.disc_syms)]))
+    Jy, Jyp = _jacobians(cb, t, y, yp, n)
+    dt = 1e-7 * max(1.0, abs(t))
+    rp, rm = np.zeros(n), np.zeros(n)
+    cb[0](t + dt, y, yp, rp)
+    cb[0](t - dt, y, yp, rm)
+    rhs = -((rp - rm) / (2 * dt) + Jy[:, :ns] @ yp[:ns])
+    J = np.hstack([Jy[:, ns:], Jyp[:, :ns]])
+    try:
+        sol = np.linalg.solve(J, rhs)
+    except np.linalg.LinAlgError:
+        sol = np.linalg.lstsq(J, rhs, rcond=None)[0]
+    ydot[ns:] = sol[:n - ns]
+    ydd[:ns] = sol[n - ns:]
+    return ydot, ydd
 
 
 def _initial_state_sensitivities(sm, cm, cb, p, d, t0, y, yp, starts):
