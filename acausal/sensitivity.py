@@ -250,7 +250,6 @@ class SensRun:
         initial point ``(y, yp)`` of the base model: the states'
         sensitivities from the initial equations (implicit function
         theorem), the rest re-solved."""
-        from .initialize import reinitialize
         sm, cm = self.sm, self.sm.base
         d_aug = list(d) + [0.0] * len(sm._sd_syms)
         cb = sm.callbacks(p, d_aug)
@@ -258,16 +257,48 @@ class SensRun:
         S = np.zeros((sm.m, sm.n))
         S[:, :sm.ns] = ds
         Y, YP = sm.pack(y, S), sm.pack(yp, np.zeros((sm.m, sm.n)))
-        Y, YP = reinitialize(sm, cb, t0, Y, YP)
+        Y, YP = self.reinit(t0, Y, YP, d_aug)
         return Y, YP, d_aug, cb
+
+    def reinit(self, t, Y, YP, d_aug, rates=True):
+        """The re-initialisation of the augmented system at ``t`` (states and
+        their sensitivities kept): the base model's
+        (:func:`acausal.initialize.reinitialize`), then the sensitivity rows,
+        linear in ``(s_alg, s'_states)`` with the base iteration matrix, in
+        one solve; with ``rates``, y' of every algebraic slot as
+        :func:`acausal.initialize._algebraic_rates` gives it."""
+        from .initialize import _algebraic_rates, _jacobians, reinitialize
+        sm, cm = self.sm, self.sm.base
+        n, ns = sm.n, sm.ns
+        cb = cm.callbacks(self.p, list(d_aug[:len(cm.disc_syms)]))
+        (y, S), (yp, Sp) = sm.unpack(Y), sm.unpack(YP)
+        y, yp = reinitialize(cm, cb, t, y, yp)
+        S, Sp = S.copy(), Sp.copy()
+        S[:, ns:] = 0.0
+        Sp[:, :ns] = 0.0
+        cba = sm.callbacks(self.p, d_aug)
+        r = np.zeros(len(sm.dae.y))
+        cba[0](t, sm.pack(y, S), sm.pack(yp, Sp), r)
+        Jy, Jyp = _jacobians(cb, t, y, yp, n)
+        J = np.hstack([Jy[:, ns:], Jyp[:, :ns]])
+        rhs = -sm.unpack(r)[1].T                          # n x m
+        try:
+            X = np.linalg.solve(J, rhs)
+        except np.linalg.LinAlgError:
+            X = np.linalg.lstsq(J, rhs, rcond=None)[0]
+        S[:, ns:] = X[:n - ns].T
+        Sp[:, :ns] = X[n - ns:].T
+        Y, YP = sm.pack(y, S), sm.pack(yp, Sp)
+        if rates:
+            YP = _algebraic_rates(sm, cba, t, Y, YP)
+        return Y, YP
 
     # -- events ------------------------------------------------------------------
     def polish(self, t, Y, YP, d_aug):
         """The point IDA located a root at, with its algebraic unknowns and
         derivatives re-solved from the (augmented) equations: IDA's
         interpolated values there meet them only to the tolerance."""
-        from .initialize import reinitialize
-        return reinitialize(self.sm, self.sm.callbacks(self.p, d_aug), t, Y, YP)
+        return self.reinit(t, Y, YP, d_aug, rates=False)
 
     def event_time(self, t, Y, YP, d_aug, i, rates):
         """dtau/dp (m) of root ``i`` at the (polished) point ``(t, Y, Y')``;
@@ -307,20 +338,21 @@ class SensRun:
         before) at the point ``(t, Y, Y')`` with base observed values
         ``obs``: the new discrete sensitivities, the re-initialised point and
         the jump of the states' sensitivities. Returns (d, callbacks, Y, Y')."""
-        from .initialize import reinitialize
+        from .initialize import _algebraic_rates
         sm = self.sm
         nd = len(sm.base.disc_syms)
         Y, YP = self.polish(t, Y, YP, d_before)
         sd = self._action_sensitivities(events, t, Y, YP, d_before, d_after, obs)
         d_new = list(d_after[:nd]) + sd.ravel().tolist()
         cb = sm.callbacks(self.p, d_new)
-        Y1, YP1 = reinitialize(sm, cb, t, Y, YP)
+        Y1, YP1 = self.reinit(t, Y, YP, d_new, rates=False)
         ns = sm.ns
         jump = (np.asarray(YP)[:ns] - YP1[:ns])[None, :] * self.dtau[:, None]   # m x ns
         if np.any(jump != 0):
             y, S = sm.unpack(Y1)
             S[:, :ns] += jump
-            Y1, YP1 = reinitialize(sm, cb, t, sm.pack(y, S), YP1)
+            Y1, YP1 = self.reinit(t, sm.pack(y, S), YP1, d_new, rates=False)
+        YP1 = _algebraic_rates(sm, cb, t, Y1, YP1)
         return d_new, cb, Y1, YP1
 
     def _action_sensitivities(self, events, t, Y, YP, d_before, d_after, obs):
