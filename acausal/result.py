@@ -96,6 +96,12 @@ class Result:
         e = self._sens().event(param)
         return np.array([v for (_, n), v in zip(self.events, e) if name is None or n == name])
 
+    def measure_sensitivity(self, fn, param):
+        """d fn(res) / d(``param``) of a measure ``fn`` (a function of a
+        result, as a model file's measures), from the sensitivities, with no
+        further simulation (:meth:`acausal.sensitivity.Sensitivities.measure`)."""
+        return self._sens().measure(self, fn, param)
+
     def _sens(self):
         if self.sensitivities is None:
             from .errors import UsageError

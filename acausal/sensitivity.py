@@ -242,6 +242,7 @@ class SensRun:
         self.sm, self.p = sm, np.asarray(p, float)
         self.span = max(float(span), 1e-300)
         self.dtau = np.zeros(sm.m)       # of the instant being handled
+        self.sd_all = np.zeros((sm.m, len(sm.base.disc_syms)))   # of every discrete value
         self.noted = {}                  # index in run.events -> dtau/dp (m)
 
     # -- start -----------------------------------------------------------------
@@ -342,8 +343,8 @@ class SensRun:
         sm = self.sm
         nd = len(sm.base.disc_syms)
         Y, YP = self.polish(t, Y, YP, d_before)
-        sd = self._action_sensitivities(events, t, Y, YP, d_before, d_after, obs)
-        d_new = list(d_after[:nd]) + sd.ravel().tolist()
+        self.sd_all = self._action_sensitivities(events, t, Y, YP, d_before, obs, self.dtau)
+        d_new = list(d_after[:nd]) + self.sd_all[:, sm.dyn].ravel().tolist()
         cb = sm.callbacks(self.p, d_new)
         Y1, YP1 = self.reinit(t, Y, YP, d_new, rates=False)
         ns = sm.ns
@@ -355,36 +356,49 @@ class SensRun:
         YP1 = _algebraic_rates(sm, cb, t, Y1, YP1)
         return d_new, cb, Y1, YP1
 
-    def _action_sensitivities(self, events, t, Y, YP, d_before, d_after, obs):
-        """sd after the actions: their directional derivative along the total
-        derivative of what they read (central differences), for the discrete
-        values the equations use."""
+    def _action_sensitivities(self, events, t, Y, YP, d_before, obs, dtau):
+        """The sensitivities of every discrete value after ``events``' actions
+        (m x nd; ``self.sd_all`` before them): the actions' directional
+        derivative along the total derivative of what they read (the
+        observed values at the event time ``t + dtau dp``, the parameters,
+        the discrete values), by central differences."""
         from .simulate import EventState
         sm, cm = self.sm, self.sm.base
         nd, nobs = len(cm.disc_syms), len(cm.var_names)
-        sd = sm.sd_of(d_before).copy()
-        if not sm.dyn:
+        sd = self.sd_all.copy()
+        if not any(ev.action is not None for ev in events):
             return sd
         out = np.asarray(sm.callbacks(self.p, d_before)[4](t, Y, YP), float)
         dobs = out[nobs:].reshape(sm.m, nobs)
         odot = self._observed_rate(t, Y, YP, d_before)
+        obs = np.asarray(obs, float)[:nobs]
         for j, k in enumerate(sm.pidx):
             h = 1e-6 * (abs(self.p[k]) if self.p[k] != 0 else 1.0)
-            vals = []
+            vals, written = [], np.zeros(nd, bool)
             for sgn in (1.0, -1.0):
                 q = self.p.copy()
                 q[k] += sgn * h
-                dd = list(d_before[:nd])
-                for a, qd in enumerate(sm.dyn):
-                    dd[qd] += sgn * h * sd[j, a]
-                st = EventState(cm, q, dd, t + sgn * h * self.dtau[j],
-                                list(np.asarray(obs)[:nobs] + sgn * h * (dobs[j] + odot * self.dtau[j])))
+                given = np.asarray(d_before[:nd], float) + sgn * h * sd[j]
+                st = EventState(cm, q, list(given), t + sgn * h * dtau[j],
+                                list(obs + sgn * h * (dobs[j] + odot * dtau[j])))
                 for ev in events:
                     if ev.action is not None:
                         ev.action(st)
-                vals.append(np.array([st.d[qd] for qd in sm.dyn], float))
-            sd[j] = (vals[0] - vals[1]) / (2 * h)
+                vals.append(np.array(st.d[:nd], float))
+                written |= vals[-1] != given
+            # a value no action wrote keeps its sensitivity exactly
+            sd[j] = np.where(written, (vals[0] - vals[1]) / (2 * h), sd[j])
         return sd
+
+    def observer_actions(self, events, t, Y, YP, d_before, obs, taus):
+        """Observer events' actions ran at ``t``: the sensitivities of the
+        discrete values they record (``taus``: index -> dtau/dp)."""
+        from .simulate import EventState  # noqa: F401  (the same action semantics)
+        cm = self.sm.base
+        for ev in events:
+            i = cm.events.index(ev)
+            dtau = np.nan_to_num(taus.get(i, np.zeros(self.sm.m)))
+            self.sd_all = self._action_sensitivities([ev], t, Y, YP, d_before, obs, dtau)
 
     def _observed_rate(self, t, Y, YP, d_aug):
         """d(observed)/dt along the solution, by a central difference."""
@@ -398,13 +412,14 @@ class SensRun:
         return (a - b) / (2 * dt)
 
     # -- result ------------------------------------------------------------------
-    def result_data(self, T, Y, YP, D, n_events):
+    def result_data(self, T, Y, YP, D, SD, n_events):
         """A :class:`Sensitivities` of the stored rows."""
         E = np.full((n_events, self.sm.m), np.nan)
         for k, v in self.noted.items():
             if k < n_events:
                 E[k] = v
-        return Sensitivities(self.sm, self.p, T, Y, YP, D, E)
+        SD = SD.reshape(len(T), self.sm.m, len(self.sm.base.disc_syms))
+        return Sensitivities(self.sm, self.p, T, Y, YP, D, SD, E)
 
 
 def _rates(sm, p, t, Y, YP, d_aug):
@@ -495,9 +510,9 @@ def _start_derivative(cm, name, k, p, starts):
 class Sensitivities:
     """The sensitivities a run stored (``Result.sensitivity`` reads them)."""
 
-    def __init__(self, sm, p, T, Y, YP, D, E):
+    def __init__(self, sm, p, T, Y, YP, D, SD, E):
         self.sm, self.p, self.t = sm, p, T
-        self.Y, self.YP, self.D, self.events = Y, YP, D, E
+        self.Y, self.YP, self.D, self.SD, self.events = Y, YP, D, SD, E
         self._obs = None
 
     def names(self):
@@ -529,6 +544,9 @@ class Sensitivities:
     def of(self, var, param):
         j = self._j(param)
         names = self.sm.base.var_names
+        discretes = [s.name for s in self.sm.base.disc_syms]
+        if var in discretes:
+            return self.SD[:, j, discretes.index(var)]
         if var not in names:
             if var in self.sm.names or var in [e.name for e in self.sm.base.params]:
                 return np.full(len(self.t), 1.0 if var == param else 0.0)
@@ -538,3 +556,35 @@ class Sensitivities:
 
     def event(self, param):
         return self.events[:, self._j(param)]
+
+    def measure(self, result, fn, param, rel_step=1e-6):
+        """d fn(result) / d param for a measure ``fn`` (any function of a
+        result): a central difference of ``fn`` over the result moved to
+        first order along the sensitivities (unknowns, discrete values, event
+        times and the rows at events with them, the parameter itself), so no
+        simulation is repeated and the difference is exact for measures that
+        are linear in what they read (event times, values at events,
+        discrete values) and second-order accurate for others."""
+        j = self._j(param)
+        k = self.sm.pidx[j]
+        h = rel_step * (abs(self.p[k]) if self.p[k] != 0 else 1.0)
+        return (fn(self._moved(result, j, h)) - fn(self._moved(result, j, -h))) / (2 * h)
+
+    def _moved(self, result, j, h):
+        """``result`` with parameter j moved by ``h``, to first order."""
+        from .result import Result
+        sm = self.sm
+        y, S = sm.unpack(self.Y)
+        yp, Sp = sm.unpack(self.YP)
+        dtau = np.nan_to_num(self.events[:, j])
+        shift = np.zeros(len(self.t))
+        for (te, _), dt in zip(result.events, dtau):
+            shift[self.t == te] = dt      # rows at an event move with it
+        p = np.array(self.p, float)
+        p[sm.pidx[j]] += h
+        T = self.t + h * shift
+        Ym = y + h * (S[:, j] + yp * shift[:, None])
+        D = self.D[:, :self.SD.shape[2]] + h * self.SD[:, j]
+        events = [(te + h * dt, name) for (te, name), dt in zip(result.events, dtau)]
+        return Result(sm.base, p, T, Ym, yp + h * Sp[:, j], D, events, result.stats,
+                      result.status, result.message)

@@ -133,7 +133,7 @@ class _Run:
         self.t0, self.t_end = t0, t_end
         self.opts = dict(rtol=rtol, atol=atol, max_step=max_step or 0.0,
                          max_num_steps=max_steps, linsolver=linsolver)
-        self.T, self.Y, self.YP, self.D = [], [], [], []
+        self.T, self.Y, self.YP, self.D, self.SD = [], [], [], [], []
         self.events, self.event_log = [], []
         self.nfev = self.njev = self.steps = self.rows = 0
         self.sens = None   # acausal.sensitivity.SensRun when sensitivities are asked for
@@ -143,6 +143,8 @@ class _Run:
         self.Y.append(np.atleast_2d(np.asarray(y, float)))
         self.YP.append(np.atleast_2d(np.asarray(yp, float)))
         self.D.append(np.tile(np.asarray(d, float), (len(self.T[-1]), 1)))
+        if self.sens is not None:
+            self.SD.append(np.tile(self.sens.sd_all.ravel(), (len(self.T[-1]), 1)))
         self.rows += len(self.T[-1])
 
     def solver(self):
@@ -170,7 +172,8 @@ class _Run:
         sm = self.cm   # the augmented model (acausal.sensitivity)
         res = Result(sm.base, self.p, T, sm.unpack(Y)[0], sm.unpack(YP)[0],
                      D[:, :len(sm.base.disc_syms)], list(self.events), stats, status, message)
-        res.sensitivities = self.sens.result_data(T, Y, YP, D, len(self.events))
+        SD = cat(self.SD, self.sens.sd_all.size)
+        res.sensitivities = self.sens.result_data(T, Y, YP, D, SD, len(self.events))
         return res
 
 
@@ -517,6 +520,10 @@ def _observers(run, cb, seg, d):
                         "make it a regular event", t=te, component=cm.events[obs[0]].owner)
                 rows = run.T[-1] >= te
                 run.D[-1][rows, j] = b
+        if run.sens is not None:
+            run.sens.observer_actions([cm.events[i] for i in obs], te, root.y, root.yp, before,
+                                      state._obs, taus)
+            run.SD[-1][run.T[-1] >= te] = run.sens.sd_all.ravel()
     return d, final
 
 
