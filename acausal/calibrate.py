@@ -270,31 +270,30 @@ def residual_vector(path, dataset, params, signals=None, options=None):
     return np.asarray(vec), labels, raw
 
 
-def exact_jacobian_applies(dataset, signals=None):
-    """True when every residual of ``dataset`` (restricted to ``signals``) is a
-    trace sample, whose derivative :func:`residual_jacobian` takes from the
-    forward sensitivities; a measure is any function of a result, which only
-    finite differences can differentiate."""
-    return all(not [m for m in exp.measures if not signals or m in signals]
-               for exp in dataset.experiments) and \
-        any(exp.trace is not None for exp in dataset.experiments)
-
-
 def residual_jacobian(path, dataset, params, names, signals=None, options=None):
     """(weighted residuals, their Jacobian d r / d x over the parameters
-    ``names``) from one simulation per experiment with forward sensitivities
-    (:mod:`acausal.sensitivity`): the derivative of a trace sample
-    ``interp(t_k, res.t, res[var])`` is the same interpolation of
-    ``res.sensitivity(var, p)``. Only for datasets of traces
-    (:func:`exact_jacobian_applies`)."""
+    ``names``), in the order of :func:`residual_vector`, from one simulation
+    per experiment with forward sensitivities (:mod:`acausal.sensitivity`):
+    a measure's derivative is :meth:`acausal.result.Result.measure_sensitivity`
+    (the measure over the result moved along the sensitivities), a trace
+    sample's ``interp(t_k, res.t, res[var])`` the same interpolation of
+    ``res.sensitivity(var, p)``."""
     path = resolve(path)
-    if not exact_jacobian_applies(dataset, signals):
-        raise CalibrationError("the exact Jacobian needs a dataset of traces only")
+    mf = path[0]
     vec, jac = [], []
     for exp in dataset.experiments:
-        opts = {**path[0].experiment.run_options(dense=True), **(options or {}),
-                "sensitivities": list(names)}
-        res, _ = simulate_experiment(path, params, exp.conditions, opts)
+        dense = {} if exp.trace is None else mf.experiment.run_options(dense=True)
+        opts = {**dense, **(options or {}), "sensitivities": list(names)}
+        res, meas = simulate_experiment(path, params, exp.conditions, opts)
+        for m, y in exp.measures.items():
+            if signals and m not in signals:
+                continue
+            sigma = _sigma(dataset, m, y)
+            vec.append((meas[m] - y) / sigma)
+            jac.append(np.array([[_measure_derivative(mf, res, m, n) / sigma
+                                  for n in names]]))
+        if exp.trace is None:
+            continue
         for var, ys in exp.trace.signals.items():
             if signals and var not in signals:
                 continue
@@ -327,6 +326,16 @@ class SensitivityJacobian:
             return self.fallback.jac(z)
 
 
+def _measure_derivative(mf, res, measure, param):
+    try:
+        return float(res.measure_sensitivity(mf.measures[measure], param))
+    except AcausalError:
+        raise
+    except Exception as exc:  # a measure's own failure on the moved result
+        raise ModelFileError(f"{mf.path}: measure {measure!r} failed on the result moved "
+                             f"along d/d{param}: {type(exc).__name__}: {exc}") from None
+
+
 def _sigma(dataset, signal, values):
     inst = dataset.instrument.get(signal)
     s = inst.floor() if inst is not None else 0.0
@@ -351,11 +360,12 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, prof
     whose linearised interval fails :func:`acausal.profile.linear_check`;
     "all" for every fitted parameter; "none" (default) for none.
 
-    ``jacobian``: "auto" (default) takes the Jacobian from forward
-    sensitivities (:func:`residual_jacobian`, one simulation per experiment
-    and exact up to the solver tolerance) when every residual is a trace
-    sample, else finite differences (absolute step :data:`FD_STEP`);
-    "sensitivities" or "differences" force one. ``Calibration.jacobian``
+    ``jacobian``: "sensitivities" (the default, "auto") takes the Jacobian
+    from forward sensitivities (:func:`residual_jacobian`: one simulation per
+    experiment, exact up to the solver tolerance); "differences" from
+    forward differences (absolute step :data:`FD_STEP`, one simulation per
+    parameter and experiment), which also answer any Jacobian the
+    sensitivities cannot give (a run that fails). ``Calibration.jacobian``
     says which ran."""
     path = resolve(path)
     mf, cm = path
@@ -400,8 +410,7 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, prof
     z0 = np.clip(to_z(inside), zlo, zhi)
     fd = ForwardDifferences(fun, FD_STEP, zhi)
     jac, kind = fd.jac, "finite differences"
-    if jacobian == "sensitivities" or (jacobian == "auto"
-                                       and exact_jacobian_applies(dataset, signals)):
+    if jacobian in ("sensitivities", "auto"):
         def jac_x(x):
             n_sim[0] += len(dataset.experiments)
             return residual_jacobian(path, dataset, dict(zip(names, x.tolist())), names,

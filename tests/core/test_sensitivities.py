@@ -15,7 +15,7 @@ from acausal import Model, time
 from acausal.backends import compiled_available
 from acausal.compile import compile_model
 from acausal.errors import UsageError
-from acausal.mechanics.contact import Contact
+from acausal.mechanics.contact import Contact, contact_period
 from acausal.mechanics.translational import Damper, Fixed, Force, Mass, Spring
 
 # the compiled backend's cases build a C library each (about a second): slow tier
@@ -111,6 +111,11 @@ def test_hertz_contact_period_closed_form(backend):
         assert e[on] == pytest.approx(0.0, abs=1e-12 * T / value)   # free flight to the wall
         dT = e[off] - e[on]
         assert dT == pytest.approx(power * T / value, rel=1e-8), p
+    # the same through the measure (a function of the result reading the
+    # discrete values the contact's actions record at its events)
+    dT = res.measure_sensitivity(lambda r: contact_period(r, "contact"), "contact.K")
+    assert dT == pytest.approx(-0.4 * T / 1e9, rel=1e-8)
+    assert res.sensitivity("contact.t_release", "contact.K")[-1] == pytest.approx(dT, rel=1e-8)
     # after the impact the mass leaves at -v0 whatever K: d v / dK = 0, and its
     # position lags by v0 * dT/dK
     v = res.sensitivity("mass.v", "contact.K")
