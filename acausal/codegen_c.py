@@ -5,19 +5,48 @@ The compiled backend (:mod:`acausal.backends.compiled`) links it with a
 small driver around SUNDIALS IDA, so that IDA calls it with no Python in
 between. Parameters and discrete values are one input array ``pd``
 (parameters first), so that one compiled library serves every mode and
-every parameter set. Sub-expressions are shared through ``sympy.cse``
-(common-subexpression elimination, as in the Python code);
-sympy's C99 printer writes the expressions (Piecewise as ``?:``).
+every parameter set. Sub-expressions are shared by hash-consing, as in the
+Python code (:func:`acausal.codegen._repeated`: every sub-expression met
+twice gets a name; linear work, where ``sympy.cse`` took most of the time on
+a model with its sensitivity equations), and the iteration matrix's entries
+are the Python code's (:func:`acausal.codegen._jacobian_entries`); sympy's
+C99 printer writes the expressions (Piecewise as ``?:``).
 """
 from dataclasses import dataclass
 
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
 
-from .codegen import Names
+from .codegen import Names, _jacobian_entries, _repeated
 
 
 class _Printer(C99CodePrinter):
+    """C of sympy expressions in which every sub-expression named in
+    ``temps`` is written as that name."""
+
+    def __init__(self, temps=None):
+        super().__init__({"order": "none"})
+        self.temps = temps or {}
+        self._root = None
+        self._not_supported, self._number_symbols = set(), set()
+
+    def _print(self, expr, **kw):
+        if self.temps and expr is not self._root:
+            name = self.temps.get(expr)
+            if name is not None:
+                return name
+        self._root = None
+        return super()._print(expr, **kw)
+
+    def definition(self, expr):
+        """C of ``expr`` itself (not its own name), its parts by name
+        (``doprint`` without its walk of the whole tree for
+        ``UnevaluatedExpr``, which the compiler never creates; the printer
+        is strict: a function with no C form raises
+        ``PrintMethodNotImplementedError``)."""
+        self._root = expr
+        return self._print(expr)
+
     def _print_Heaviside(self, expr):   # the Python code's heaviside: 1/2 at 0
         return f"acs_heaviside({self._print(expr.args[0])})"
 
@@ -38,12 +67,13 @@ def _decls(n, has_yp):
 
 
 def _body(exprs, targets):
-    printer = _Printer()
     if not exprs:
         return []
-    reps, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("c_"), order="none")
-    lines = [f"  const double {v} = {printer.doprint(e)};" for v, e in reps]
-    lines += [f"  {t} = {printer.doprint(e)};" for t, e in zip(targets, reduced)]
+    repeated = _repeated(exprs)
+    names = {e: f"c_{k}" for k, e in enumerate(repeated)}
+    printer = _Printer(names)
+    lines = [f"  const double {names[e]} = {printer.definition(e)};" for e in repeated]
+    lines += [f"  {t} = {printer.definition(e)};" for t, e in zip(targets, exprs)]
     return lines
 
 
@@ -81,15 +111,9 @@ def generate_c(cm):
               for i in range(n)]
     cj = sp.Symbol("cj", real=True)
     jac, targets = [], []
-    for i, r in enumerate(res):
-        fs = r.free_symbols
-        for j in range(n):
-            e = sp.diff(r, ysyms[j]) if ysyms[j] in fs else sp.Integer(0)
-            if ypsyms[j] is not None and ypsyms[j] in fs:
-                e = e + cj * sp.diff(r, ypsyms[j])
-            if e != 0:
-                jac.append(e)
-                targets.append(f"J[{j * n + i}]")
+    for i, j, dy, dyp in _jacobian_entries(res, ysyms, ypsyms):
+        jac.append(dy + cj * dyp)
+        targets.append(f"J[{j * n + i}]")
     decl = _decls(n, has_yp) + _pd_decls(len(cm.param_syms), len(cm.disc_syms))
     L = ["#include <math.h>", "#include <string.h>",
          "static double acs_heaviside(double x) { return x > 0 ? 1.0 : (x == 0 ? 0.5 : 0.0); }",
