@@ -47,7 +47,7 @@ import numpy as np
 import sympy as sp
 
 from .causalize import DAE
-from .codegen import Names, _body, _namespace, _unpack, generate
+from .codegen import Names, Sparsity, _body, _namespace, _unpack, generate, load
 from .errors import UsageError
 from .fastdiff import diff
 
@@ -103,16 +103,29 @@ class SensitivityModel:
                        ns * (1 + m), [res_all[k] for k in self.order],
                        [org_all[k] for k in self.order], dae.explicit)
         self.disc_syms = list(cm.disc_syms) + self._sd_syms
-        self.observed = [cm.resolve(cm.flat.variables[v].symbol) for v in cm.var_names]
-        obs_sens = [lin.total(o) for o in self.observed]
-        observed = self.observed + [obs_sens[k][j] for j in range(m)
-                                    for k in range(len(self.observed))]
         roots = [cm.resolve(e.expr) for e in cm.events] + \
             [cm.resolve(a.expr) for a in cm.assertions]
-        gen = generate(self.dae, cm.param_syms, self.disc_syms, roots, observed)
-        self.source, self._make, self.sparsity = gen.source, gen.make, gen.sparsity
+        key = _cache_key(cm, names)
+        hit = _cache_load(key)
+        if hit is None:
+            gen = self._generate(lin, roots)
+            self.source, self.sparsity = gen.source, gen.sparsity
+            _cache_store(key, self.source, self.sparsity)
+        else:
+            self.source, self.sparsity = hit
+        self._make = load(self.source)[0]
         self.rootgrad = _root_gradients(cm, roots, P, self.dyn)
         self.inverse = np.argsort(self.order)
+
+    def _generate(self, lin, roots):
+        """The augmented system's generated callbacks (:func:`acausal.codegen.generate`):
+        its residuals, exact Jacobian, the base roots and the observed
+        variables followed by their sensitivities."""
+        cm = self.base
+        observed = [cm.resolve(cm.flat.variables[v].symbol) for v in cm.var_names]
+        obs_sens = [lin.total(o) for o in observed]
+        observed += [obs_sens[k][j] for j in range(self.m) for k in range(len(cm.var_names))]
+        return generate(self.dae, cm.param_syms, self.disc_syms, roots, observed)
 
     def __getattr__(self, name):
         if name == "base":   # not set yet (copying, pickling)
@@ -161,6 +174,58 @@ class SensitivityModel:
         a = np.broadcast_to(np.asarray(atol, float), (self.n,))
         scales = [abs(p[k]) if p[k] != 0 else 1.0 for k in self.pidx]
         return self.pack(a, [a / s for s in scales])
+
+
+def _cache_key(cm, names):
+    """Key of a sensitivity model in the on-disk cache: the base model's
+    generated source (which fixes its DAE), the parameter names and the
+    generators' sources."""
+    import hashlib
+    import os
+    h = hashlib.sha256(cm.source.encode())
+    h.update("\0".join(names).encode())
+    here = os.path.dirname(os.path.abspath(__file__))
+    for mod in ("sensitivity.py", "codegen.py", "fastdiff.py"):
+        with open(os.path.join(here, mod), "rb") as fh:
+            h.update(fh.read())
+    return h.hexdigest()[:24]
+
+
+def _cache_path(key):
+    from .cache import cache_dir
+    d = cache_dir()
+    return None if d is None else d / "sensitivities" / f"sens_{key}.json"
+
+
+def _cache_load(key):
+    """(source, Sparsity) of a cached sensitivity model, or None."""
+    import json
+    path = _cache_path(key)
+    if path is None or not path.exists():
+        return None
+    try:
+        data = json.loads(path.read_text())
+        return data["source"], Sparsity(**data["sparsity"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return None   # an unreadable entry is generated again
+
+
+def _cache_store(key, source, sparsity):
+    import dataclasses
+    import json
+    import os
+    import tempfile
+    path = _cache_path(key)
+    if path is None:
+        return
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
+        with os.fdopen(fd, "w") as fh:
+            json.dump({"source": source, "sparsity": dataclasses.asdict(sparsity)}, fh)
+        os.replace(tmp, path)   # atomic: a reader never sees a partial file
+    except OSError:
+        pass   # no cache then; the model is generated again next time
 
 
 class _Linearize:
