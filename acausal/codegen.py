@@ -7,6 +7,7 @@ and fill the solver's arrays in place (``r[i] = ...``). Parameters and
 discrete values are closure constants: ``make(p, d)`` builds the callbacks
 for one parameter vector and one set of discrete values.
 """
+import functools
 import linecache
 import math
 from dataclasses import dataclass
@@ -209,7 +210,14 @@ class Sparsity:
 def _jacobian_entries(res, ysyms, ypsyms):
     """Non-zero entries (i, j, dF_i/dy_j, dF_i/dy'_j) of the residuals'
     Jacobians, by differentiating each residual only with respect to the
-    unknowns it contains (work linear in the number of non-zeros)."""
+    unknowns it contains (work linear in the number of non-zeros). The last
+    few are kept: the C generator (:mod:`acausal.codegen_c`) asks again for
+    the same residuals right after this module."""
+    return list(_entries(tuple(res), tuple(ysyms), tuple(ypsyms)))
+
+
+@functools.lru_cache(maxsize=4)
+def _entries(res, ysyms, ypsyms):
     index = {s: ("y", j) for j, s in enumerate(ysyms)}
     index.update({s: ("yp", j) for j, s in enumerate(ypsyms) if s is not None})
     out = []
@@ -224,7 +232,7 @@ def _jacobian_entries(res, ysyms, ypsyms):
             dyp = cols[j].get("yp", sp.S.Zero)
             if dy != 0 or dyp != 0:
                 out.append((i, j, dy, dyp))
-    return out
+    return tuple(out)
 
 
 def _sparsity(n, entries):
