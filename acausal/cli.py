@@ -337,7 +337,8 @@ def calibrate(file, data, fit, method, experiments, profile, as_json):
         click.echo(json.dumps(out.to_dict(), indent=1, default=float))
         return
     click.echo(f"calibration ({out.method}) of {file} against {data} "
-               f"({', '.join(e.name for e in ds.experiments)}): {out.n_sim} simulations")
+               f"({', '.join(e.name for e in ds.experiments)}): {out.n_sim} simulations"
+               + (f", Jacobian from {out.jacobian}" if out.method == "least_squares" else ""))
     for name, v in out.values.items():
         ci = out.ci95.get(name)
         ci_s = f"  95% CI [{ci[0]:.6g}, {ci[1]:.6g}]" if ci else ""
