@@ -309,6 +309,7 @@ class SensRun:
         self.dtau = np.zeros(sm.m)       # of the instant being handled
         self.sd_all = np.zeros((sm.m, len(sm.base.disc_syms)))   # of every discrete value
         self.noted = {}                  # index in run.events -> dtau/dp (m)
+        self._polished = None            # the last polished point (see polish)
 
     # -- start -----------------------------------------------------------------
     def start(self, p, d, t0, y, yp, starts):
@@ -363,8 +364,15 @@ class SensRun:
     def polish(self, t, Y, YP, d_aug):
         """The point IDA located a root at, with its algebraic unknowns and
         derivatives re-solved from the (augmented) equations: IDA's
-        interpolated values there meet them only to the tolerance."""
-        return self.reinit(t, Y, YP, d_aug, rates=False)
+        interpolated values there meet them only to the tolerance. The last
+        one is kept: a mode change polishes the point its event time did."""
+        last = self._polished
+        if (last is not None and last[0] == t and np.array_equal(last[1], Y)
+                and np.array_equal(last[2], YP) and last[3] == list(d_aug)):
+            return last[4], last[5]
+        out = self.reinit(t, Y, YP, d_aug, rates=False)
+        self._polished = (t, np.array(Y), np.array(YP), list(d_aug)) + out
+        return out
 
     def event_time(self, t, Y, YP, d_aug, i, rates):
         """dtau/dp (m) of root ``i`` at the (polished) point ``(t, Y, Y')``;
