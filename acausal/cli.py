@@ -379,6 +379,22 @@ def _profile_line(prof):
             f"{prof.n_evaluations} evaluations)")
 
 
+def _sweep_units(mf, cm, params, measures):
+    """The SI unit of each swept parameter (or fixed start value) and of each
+    measure that declares one, for the sweep CSV's header."""
+    units = {}
+    for name in params:
+        if name in {e.name for e in cm.params}:
+            units[name] = cm.params[cm.param_index(name)].unit
+        elif name in cm.flat.variables:
+            units[name] = cm.flat.variables[name].unit
+    for m in measures:
+        unit = getattr(mf.measures[m], "unit", None)
+        if unit:
+            units[m] = unit
+    return units
+
+
 @main.command()
 @click.argument("file", type=click.Path(dir_okay=False))
 @click.option("--param", "params", multiple=True, required=True, metavar="NAME=A:B:N",
@@ -414,9 +430,10 @@ def sweep(file, params, measures, out, plot, scheduler, workers, no_progress):
                 raise click.BadParameter(f"--measure {m!r}: the model file defines "
                                          f"{sorted(mf.measures) or 'no measures'}")
         task = functools.partial(sweep_task, os.path.abspath(file))
+        units = _sweep_units(mf, cm, [name for name, _ in specs], measures)
         with terminate_on_sigterm(), _resumable(out), open_executor(scheduler, workers) as ex:
             rows = run_sweep(task, grid(specs), out, executor=ex, measures=measures,
-                             progress=not no_progress, inputs=source_files(file))
+                             progress=not no_progress, inputs=source_files(file), units=units)
         if plot:
             plot_sweep(rows, specs[0][0], measures[0], plot)
     except (AcausalError, click.BadParameter) as exc:
