@@ -466,7 +466,6 @@ class SensRun:
     def observer_actions(self, events, t, Y, YP, d_before, obs, taus):
         """Observer events' actions ran at ``t``: the sensitivities of the
         discrete values they record (``taus``: index -> dtau/dp)."""
-        from .simulate import EventState  # noqa: F401  (the same action semantics)
         cm = self.sm.base
         for ev in events:
             i = cm.events.index(ev)

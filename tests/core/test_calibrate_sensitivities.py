@@ -68,7 +68,8 @@ def test_jacobian_against_central_differences(tmp_path):
         up, dn = dict(x), dict(x)
         up[n] += h
         dn[n] -= h
-        fd = (cal.residual_vector(model, ds, up)[0] - cal.residual_vector(model, ds, dn)[0]) / (2 * h)
+        fd = (cal.residual_vector(model, ds, up)[0]
+              - cal.residual_vector(model, ds, dn)[0]) / (2 * h)
         assert np.max(np.abs(J[:, k] - fd)) < 1e-4 * np.max(np.abs(fd)), n
 
 
