@@ -36,10 +36,17 @@ derivative, by a central difference of the action along the total
 derivative of its inputs (exact for the piecewise-linear actions of the
 library; an action must be a function of what it reads).
 
-Limits: the term ``g_y' y''`` of a root that contains a state's derivative is
-left out of ``dtau/dp`` (roots of positions, velocities and forces are
-exact); rates of observed variables read by actions are central differences
-in time.
+The event time's derivative is taken at the located point polished
+(algebraic unknowns and derivatives re-solved from the equations, y' of the
+algebraic unknowns and y'' of the states from the equations differentiated
+once), so roots of forces and rates are as exact as roots of positions.
+A measure (any function of a result) is differentiated over the result
+moved to first order along the sensitivities (:meth:`Sensitivities.measure`).
+
+Limits: rates of observed variables read by actions are central
+differences in time; an action must be a function of what it reads.
+The generated augmented model is cached on disk (``sensitivities/`` in the
+model cache, :func:`_cache_key`).
 """
 import weakref
 
