@@ -112,7 +112,7 @@ class SensitivityModel:
         self.disc_syms = list(cm.disc_syms) + self._sd_syms
         roots = [cm.resolve(e.expr) for e in cm.events] + \
             [cm.resolve(a.expr) for a in cm.assertions]
-        key = _cache_key(cm, names)
+        key = _cache_key(cm, names, self.dae.residuals)
         hit = _cache_load(key)
         if hit is None:
             gen = self._generate(lin, roots)
@@ -183,14 +183,16 @@ class SensitivityModel:
         return self.pack(a, [a / s for s in scales])
 
 
-def _cache_key(cm, names):
+def _cache_key(cm, names, residuals):
     """Key of a sensitivity model in the on-disk cache: the base model's
-    generated source (which fixes its DAE), the parameter names and the
-    generators' sources."""
+    generated source (which fixes its DAE), the parameter names, the
+    augmented residuals (which the derivative rules of the model's own
+    functions shape) and the generators' sources."""
     import hashlib
     import os
     h = hashlib.sha256(cm.source.encode())
     h.update("\0".join(names).encode())
+    h.update("\0".join(map(str, residuals)).encode())
     here = os.path.dirname(os.path.abspath(__file__))
     for mod in ("sensitivity.py", "codegen.py", "fastdiff.py"):
         with open(os.path.join(here, mod), "rb") as fh:

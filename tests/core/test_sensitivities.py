@@ -274,3 +274,19 @@ def test_asking_for_what_was_not_computed(oscillator):
     # the same trajectory within the tolerance (the error test of a sensitivity
     # run also covers the sensitivities, so it takes other steps)
     np.testing.assert_allclose(plain["mass.s"], res["mass.s"], rtol=0, atol=20 * 1e-6 * 0.1)
+
+
+@pytest.mark.slow
+def test_hertz_exponent_sensitivity_against_central_differences():
+    """d/d gamma takes PosPow's derivative in its exponent, x^g log x, which
+    must not evaluate log x out of contact (x <= 0): the generated code
+    computes shared sub-expressions ahead of the branches."""
+    cm = _hertz()
+    kw = dict(t_end=5e-4, rtol=1e-11, atol=1e-15)
+    res = cm.simulate(sensitivities=["contact.gamma"], **kw)
+    h = 1e-4 * 1.5
+    a = cm.simulate(params={"contact.gamma": 1.5 + h}, **kw)
+    b = cm.simulate(params={"contact.gamma": 1.5 - h}, **kw)
+    fd = (np.array(a.event_times()) - np.array(b.event_times())) / (2 * h)
+    got = res.event_sensitivity("contact.gamma")
+    assert np.max(np.abs(got - fd)) < 1e-6 * np.max(np.abs(fd))
