@@ -55,7 +55,7 @@ import sympy as sp
 
 from .causalize import DAE
 from .codegen import Names, Sparsity, _body, _namespace, _unpack, generate, load
-from .errors import UsageError
+from .errors import ModelError, UsageError
 from .fastdiff import diff
 
 _models = weakref.WeakKeyDictionary()   # CompiledModel -> {names: SensitivityModel}
@@ -71,7 +71,15 @@ def sensitivity_model(cm, names):
         raise UsageError(f"sensitivities: a parameter is named twice in {list(names)}")
     per = _models.setdefault(cm, {})
     if names not in per:
-        per[names] = SensitivityModel(cm, names)
+        for n in names:
+            cm.param_index(n)   # a ParameterError naming a parameter that is not one
+        try:
+            per[names] = SensitivityModel(cm, names)
+        except (TypeError, ValueError, NotImplementedError, AttributeError) as exc:
+            # e.g. a function of the model whose derivative sympy cannot print
+            raise ModelError(f"sensitivities with respect to {', '.join(names)}: the "
+                             f"sensitivity equations cannot be generated "
+                             f"({type(exc).__name__}: {str(exc).splitlines()[0]})") from None
     return per[names]
 
 

@@ -14,7 +14,7 @@ import sympy as sp
 from acausal import Model, time
 from acausal.backends import compiled_available
 from acausal.compile import compile_model
-from acausal.errors import UsageError
+from acausal.errors import ParameterError, UsageError
 from acausal.mechanics.contact import Contact, contact_period
 from acausal.mechanics.translational import Damper, Fixed, Force, Mass, Spring
 
@@ -268,6 +268,8 @@ def test_asking_for_what_was_not_computed(oscillator):
     res = oscillator.simulate(t_end=0.01, sensitivities=["spring.c"])
     with pytest.raises(UsageError, match="damper.d"):
         res.sensitivity("mass.s", "damper.d")
+    with pytest.raises(ParameterError, match="no parameter 'spring.k'"):
+        oscillator.simulate(t_end=0.01, sensitivities=["spring.k"])
     plain = oscillator.simulate(t_end=0.01)
     with pytest.raises(UsageError, match="sensitivities="):
         plain.sensitivity("mass.s", "spring.c")
