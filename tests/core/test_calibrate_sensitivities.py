@@ -115,3 +115,22 @@ def test_measures_take_the_exact_jacobian(tmp_path):
     sigma = 1e-9 / np.sqrt(12.0)
     np.testing.assert_allclose(J[:, 0], [-0.4 * period(v) / 1.3e9 / sigma for v in (1.0, 2.0)],
                                rtol=1e-7)
+
+
+def test_diagnosis_fit_with_the_sensitivity_jacobian(tmp_path):
+    """The diagnosis's fit (acausal.diagnose.fitting.fit) with
+    jacobian="sensitivities": the same optimum as with differences, and its
+    Jacobian against the differences' at the optimum."""
+    from acausal.diagnose import fitting
+    model, ds = _data(tmp_path)
+    names = ["spring.c", "damper.d"]
+    kw = dict(x0={"spring.c": 100.0, "damper.d": 2.0}, low={"spring.c": 10.0, "damper.d": 0.0},
+              high={"spring.c": 1e3, "damper.d": 20.0}, scale={"spring.c": 100.0, "damper.d": 2.0})
+    a = fitting.fit(model, ds, names, jacobian="sensitivities", **kw)
+    b = fitting.fit(model, ds, names, **kw)
+    assert a.ok and b.ok
+    for n in names:
+        assert a.values[n] == pytest.approx(b.values[n], rel=1e-6)
+    np.testing.assert_allclose(a.jacobian, b.jacobian, rtol=0,
+                               atol=1e-3 * np.max(np.abs(b.jacobian)))
+    assert a.n_sim < b.n_sim
