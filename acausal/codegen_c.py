@@ -58,10 +58,28 @@ def _function(name, extra_args, decl, body):
     return [head, "{", "  (void)t; (void)y; (void)yp; (void)pd;"] + decl + body + ["}", ""]
 
 
+def _jacs_entries(res, ysyms, ypsyms, n):
+    """(expressions, targets) of ``dF/dy`` and ``dF/dy'`` as two row-major
+    ``n`` x ``n`` arrays (what the Python ``jacs`` callback fills): the
+    initialisation and the re-initialisation at events need them apart."""
+    exprs, targets = [], []
+    for i, r in enumerate(res):
+        fs = r.free_symbols
+        for j in range(n):
+            if ysyms[j] in fs:
+                exprs.append(sp.diff(r, ysyms[j]))
+                targets.append(f"Jy[{i * n + j}]")
+            if ypsyms[j] is not None and ypsyms[j] in fs:
+                exprs.append(sp.diff(r, ypsyms[j]))
+                targets.append(f"Jyp[{i * n + j}]")
+    return exprs, targets
+
+
 def generate_c(cm):
     """C source of ``acs_res``, ``acs_jac`` (column-major ``J = dF/dy + cj
-    dF/dy'``, every entry written) and ``acs_roots`` for compiled model
-    ``cm`` (events first, then assertions, as in ``cm.callbacks``)."""
+    dF/dy'``, every entry written), ``acs_roots`` for compiled model ``cm``
+    (events first, then assertions, as in ``cm.callbacks``) and ``acs_jacs``
+    (``dF/dy`` and ``dF/dy'`` apart, row-major, as ``cm.callbacks``' jacs)."""
     dae = cm.dae
     n = len(dae.y)
     names = Names(dae.y, dae.yp, cm.param_syms, cm.disc_syms)
@@ -99,4 +117,8 @@ def generate_c(cm):
                    [f"  memset(J, 0, sizeof(double) * {n * n});"] + _body(jac, targets))
     L += _function("acs_roots", ", double* g", decl,
                    _body(g, [f"g[{i}]" for i in range(len(g))]))
+    L += _function("acs_jacs", ", double* Jy, double* Jyp", decl,
+                   [f"  memset(Jy, 0, sizeof(double) * {n * n});",
+                    f"  memset(Jyp, 0, sizeof(double) * {n * n});"]
+                   + _body(*_jacs_entries(res, ysyms, ypsyms, n)))
     return CSource("\n".join(L), n, len(g), len(cm.param_syms) + len(cm.disc_syms))

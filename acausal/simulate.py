@@ -144,6 +144,11 @@ class _Run:
         self.D.append(np.tile(np.asarray(d, float), (len(self.T[-1]), 1)))
         self.rows += len(self.T[-1])
 
+    def callbacks(self, d):
+        """Mode ``d``'s generated callbacks, as the backend serves them to
+        the loop (the compiled backend's call C: :meth:`SegmentSolver.callbacks`)."""
+        return self.solver().callbacks(self.cm.callbacks(self.p, d), d)
+
     def solver(self):
         """The segment solver of this run (:mod:`acausal.backends`), made once."""
         if getattr(self, "_solver", None) is None:
@@ -213,7 +218,7 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
     d = cm.discrete_start()
     run = _Run(cm, p, t0, t_end, rtol, _atol_vector(cm, atol, atol_algebraic), max_step,
                max_steps, backend, linsolver)
-    cb = cm.callbacks(p, d)
+    cb = run.callbacks(d)
     run.cb_d = list(d)
     y, yp = initial_point(cm, p, d, cb, t0, starts)
     y, yp, d, cb, stop = _event_iteration(run, cb, t0, y, yp, d, initial=True)
@@ -238,7 +243,7 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
             watch.check(t)
             d, fired = _observers(run, cb, seg, d)
             if d != run.cb_d:
-                cb = cm.callbacks(run.p, d)
+                cb = run.callbacks(d)
             run.cb_d = list(d)
             if seg.status != 2:
                 if tspan[-1] < t_end:   # the end of a window of the watch
@@ -512,7 +517,7 @@ def _handle(run, cb, t, y, yp, d, fired):
         if ev.terminal:
             stop = True
     if state.changed:
-        cb = cm.callbacks(run.p, d)
+        cb = run.callbacks(d)
         y, yp = reinitialize(cm, cb, t, y, yp)
         y, yp, d, cb, stop2 = _event_iteration(run, cb, t, y, yp, d)
         stop = stop or stop2
@@ -539,7 +544,7 @@ def _event_iteration(run, cb, t, y, yp, d, initial=False):
         if not state.changed:
             return y, yp, d, cb, False
         d = state.d
-        cb = cm.callbacks(run.p, d)
+        cb = run.callbacks(d)
         y, yp = reinitialize(cm, cb, t, y, yp)
     raise ChatteringError(f"event iteration did not settle at t = {t:.6g} s "
                           f"({MAX_ITER} mode changes at one instant) in "
