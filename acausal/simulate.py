@@ -136,6 +136,7 @@ class _Run:
         self.T, self.Y, self.YP, self.D = [], [], [], []
         self.events, self.event_log = [], []
         self.nfev = self.njev = self.steps = self.rows = 0
+        self._cbs = {}
 
     def record(self, t, y, yp, d):
         self.T.append(np.atleast_1d(np.asarray(t, float)))
@@ -146,8 +147,13 @@ class _Run:
 
     def callbacks(self, d):
         """Mode ``d``'s generated callbacks, as the backend serves them to
-        the loop (the compiled backend's call C: :meth:`SegmentSolver.callbacks`)."""
-        return self.solver().callbacks(self.cm.callbacks(self.p, d), d)
+        the loop (the compiled backend's call C: :meth:`SegmentSolver.callbacks`),
+        made once per mode of the run (contacts switch back and forth)."""
+        key = tuple(map(float, d))
+        cb = self._cbs.get(key)
+        if cb is None:
+            cb = self._cbs[key] = self.solver().callbacks(self.cm.callbacks(self.p, d), d)
+        return cb
 
     def solver(self):
         """The segment solver of this run (:mod:`acausal.backends`), made once."""
