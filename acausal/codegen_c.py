@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
+from sympy.printing.codeprinter import PrintMethodNotImplementedError
 
 from .codegen import Names
 
@@ -75,11 +76,28 @@ def _jacs_entries(res, ysyms, ypsyms, n):
     return exprs, targets
 
 
+def _observe(cm, names, real, decl):
+    """``acs_observe`` (every variable of ``cm.var_names``, as the Python
+    ``observe`` callback) and ``acs_has_observe``: 0 when an observed
+    expression has no C form, and the caller keeps the Python one (the
+    residual and root functions decide whether the backend can run)."""
+    obs = [cm.resolve(cm.flat.variables[nm].symbol) for nm in cm.var_names]
+    exprs = [e.xreplace(real) for e in names.rename(obs, "an observed variable")]
+    try:
+        body = _body(exprs, [f"o[{i}]" for i in range(len(exprs))])
+        has = 1
+    except PrintMethodNotImplementedError:
+        body, has = [], 0
+    return _function("acs_observe", ", double* o", decl, body) + \
+        [f"int acs_has_observe(void) {{ return {has}; }}", ""]
+
+
 def generate_c(cm):
     """C source of ``acs_res``, ``acs_jac`` (column-major ``J = dF/dy + cj
     dF/dy'``, every entry written), ``acs_roots`` for compiled model ``cm``
     (events first, then assertions, as in ``cm.callbacks``) and ``acs_jacs``
-    (``dF/dy`` and ``dF/dy'`` apart, row-major, as ``cm.callbacks``' jacs)."""
+    (``dF/dy`` and ``dF/dy'`` apart, row-major, as ``cm.callbacks``' jacs)
+    and ``acs_observe`` (every variable, as its observe; see :func:`_observe`)."""
     dae = cm.dae
     n = len(dae.y)
     names = Names(dae.y, dae.yp, cm.param_syms, cm.disc_syms)
@@ -117,6 +135,7 @@ def generate_c(cm):
                    [f"  memset(J, 0, sizeof(double) * {n * n});"] + _body(jac, targets))
     L += _function("acs_roots", ", double* g", decl,
                    _body(g, [f"g[{i}]" for i in range(len(g))]))
+    L += _observe(cm, names, real, decl)
     L += _function("acs_jacs", ", double* Jy, double* Jyp", decl,
                    [f"  memset(Jy, 0, sizeof(double) * {n * n});",
                     f"  memset(Jyp, 0, sizeof(double) * {n * n});"]

@@ -184,6 +184,8 @@ class _Library:
         lib.acs_roots.argtypes = [ctypes.c_double, vp, vp, vp, vp]
         lib.acs_jacs.argtypes = [ctypes.c_double, vp, vp, vp, vp, vp]
         lib.acs_reinit.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_double, vp, vp, vp]
+        lib.acs_observe.argtypes = [ctypes.c_double, vp, vp, vp, vp]
+        self.n_obs = len(cm.var_names) if lib.acs_has_observe() else None
 
 
 def library(cm):
@@ -305,7 +307,7 @@ class CCallbacks(tuple):
     re-initialisation. ``reinit(t, y, yp)`` is the re-initialisation in C
     (``reinit.c``; :func:`acausal.initialize.reinitialize` calls it), or
     None where the Python version must run. The observed variables
-    (``cb[4]``) stay Python."""
+    (``cb[4]``, an array here) are C too unless one has no C form."""
 
     def __new__(cls, L, cm, p, d, cb):
         lib, n, ns = L.lib, len(cm.dae.y), cm.dae.n_states
@@ -328,11 +330,18 @@ class CCallbacks(tuple):
             if jy is not Jy:
                 Jy[...] = jy.reshape(np.shape(Jy))
 
+        def observe(t, y, yp):
+            y, yp = _f64(y), _f64(yp)
+            o = np.empty(L.n_obs)
+            lib.acs_observe(t, y.ctypes.data, yp.ctypes.data, pdp, o.ctypes.data)
+            return o
+
         def reinit(t, y, yp):
             y2, yp2 = np.array(y, dtype=float), np.array(yp, dtype=float)
             flag = lib.acs_reinit(n, ns, float(t), y2.ctypes.data, yp2.ctypes.data, pdp)
             return (y2, yp2) if flag == 0 else None
 
-        self = super().__new__(cls, (res, cb[1], roots, jacs) + tuple(cb[4:]))
+        obs = cb[4] if L.n_obs is None else observe
+        self = super().__new__(cls, (res, cb[1], roots, jacs, obs) + tuple(cb[5:]))
         self.pd, self.reinit = pd, reinit
         return self
