@@ -186,6 +186,31 @@ class _Library:
         lib.acs_reinit.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_double, vp, vp, vp]
         lib.acs_observe.argtypes = [ctypes.c_double, vp, vp, vp, vp]
         self.n_obs = len(cm.var_names) if lib.acs_has_observe() else None
+        self.idle = {}
+        weakref.finalize(self, _free_idle, lib, self.idle)
+
+
+    # IDA handles of finished runs, by settings: every segment starts with
+    # IDAReInit (acs_start), so a later run of the model takes one over
+    # instead of creating SUNDIALS objects again
+    IDLE = 2   # kept per setting
+
+    def take(self, key):
+        idle = self.idle.get(key)
+        return idle.pop() if idle else None
+
+    def give(self, key, h):
+        idle = self.idle.setdefault(key, [])
+        if len(idle) < self.IDLE:
+            idle.append(h)
+        else:
+            self.lib.acs_free(ctypes.c_void_p(h))
+
+
+def _free_idle(lib, idle):
+    for handles in idle.values():
+        for h in handles:
+            lib.acs_free(ctypes.c_void_p(h))
 
 
 def library(cm):
@@ -220,12 +245,13 @@ class CompiledSolver(SegmentSolver):
         self.dirs = np.array([e.direction for e in cm.events] + [-1] * len(cm.assertions)
                              or [0], dtype=np.intc)
         self.terminal = [not e.observer for e in cm.events] + [True] * len(cm.assertions)
-        self.h = L.lib.acs_new(n, self.nr, L.n_pd, float(opts["rtol"]), _ptr(atol),
-                               _ptr(ident), _ptr(self.dirs, ctypes.c_int),
-                               float(opts.get("max_step") or 0.0), int(opts["max_num_steps"]))
+        rtol, hmax = float(opts["rtol"]), float(opts.get("max_step") or 0.0)
+        key = (rtol, atol.tobytes(), hmax, int(opts["max_num_steps"]))
+        self.h = L.take(key) or L.lib.acs_new(n, self.nr, L.n_pd, rtol, _ptr(atol), _ptr(ident),
+                                              _ptr(self.dirs, ctypes.c_int), hmax, key[3])
         if not self.h:
             raise Unavailable("SUNDIALS refused the solver settings")
-        self._free = weakref.finalize(self, L.lib.acs_free, ctypes.c_void_p(self.h))
+        self._free = weakref.finalize(self, L.give, key, self.h)
         self.troot = np.zeros(1)
         self.yroot, self.yproot = np.zeros(n), np.zeros(n)
         self.rootinfo = np.zeros(max(self.nr, 1), dtype=np.intc)
