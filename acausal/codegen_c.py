@@ -15,7 +15,7 @@ import sympy as sp
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.codeprinter import PrintMethodNotImplementedError
 
-from .codegen import Names
+from .codegen import Names, _fixed_entries
 
 
 class _Printer(C99CodePrinter):
@@ -76,7 +76,7 @@ def _jacs_entries(res, ysyms, ypsyms, n):
     return exprs, targets
 
 
-def _observe(cm, names, real, decl):
+def _observe(cm, names, real, decl, ysyms, ypsyms):
     """``acs_observe`` (every variable of ``cm.var_names``, as the Python
     ``observe`` callback) and ``acs_has_observe``: 0 when an observed
     expression has no C form, and the caller keeps the Python one (the
@@ -85,11 +85,26 @@ def _observe(cm, names, real, decl):
     exprs = [e.xreplace(real) for e in names.rename(obs, "an observed variable")]
     try:
         body = _body(exprs, [f"o[{i}]" for i in range(len(exprs))])
+        fixjac = _fixjac(cm, exprs, ysyms, ypsyms)
         has = 1
     except PrintMethodNotImplementedError:
-        body, has = [], 0
+        body, fixjac, has = [], [], 0
     return _function("acs_observe", ", double* o", decl, body) + \
-        [f"int acs_has_observe(void) {{ return {has}; }}", ""]
+        _function("acs_fixjac", ", double* F", decl, fixjac) + \
+        [f"int acs_has_observe(void) {{ return {has}; }}",
+         f"int acs_n_observed(void) {{ return {len(exprs)}; }}", ""]
+
+
+def _fixjac(cm, observed, ysyms, ypsyms):
+    """Body of ``acs_fixjac``: the rows the initialisation adds for the fixed
+    start values (as ``cm.fixed_jacobian()``), row-major over z = (y, y'
+    of the states), every entry written."""
+    ns, n = cm.dae.n_states, len(ysyms)
+    rows = [k for k, nm in enumerate(cm.var_names) if cm.flat.variables[nm].start.fixed]
+    entries = _fixed_entries(dict((k, observed[k]) for k in rows), rows, ysyms, ypsyms, ns)
+    width = n + ns
+    return [f"  memset(F, 0, sizeof(double) * {max(len(rows), 1) * width});"] + \
+        _body([e for _, _, e in entries], [f"F[{a * width + col}]" for a, col, _ in entries])
 
 
 def generate_c(cm):
@@ -135,7 +150,7 @@ def generate_c(cm):
                    [f"  memset(J, 0, sizeof(double) * {n * n});"] + _body(jac, targets))
     L += _function("acs_roots", ", double* g", decl,
                    _body(g, [f"g[{i}]" for i in range(len(g))]))
-    L += _observe(cm, names, real, decl)
+    L += _observe(cm, names, real, decl, ysyms, ypsyms)
     L += _function("acs_jacs", ", double* Jy, double* Jyp", decl,
                    [f"  memset(Jy, 0, sizeof(double) * {n * n});",
                     f"  memset(Jyp, 0, sizeof(double) * {n * n});"]

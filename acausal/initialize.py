@@ -88,7 +88,10 @@ def _solve_initial(cm, p, d, cb, t0, starts=None):
     # trust-region least squares is the fallback; its long steps (in
     # variables with small Jacobian columns, such as lengths in m) can reach
     # another solution.
-    z = _newton(lambda zz: residual(zz, guess_rows), lambda zz: jac(zz, guess_rows), z0)
+    newton = getattr(cb, "init_newton", None)    # the same Newton in C (compiled backend)
+    z = newton(t0, z0, guess_rows, fixed) if newton is not None else NotImplemented
+    if z is NotImplemented:
+        z = _newton(lambda zz: residual(zz, guess_rows), lambda zz: jac(zz, guess_rows), z0)
     checked = z is not None and _consistent(cm, residual(z, []), jac(z, []), z, fixed, n)
     if not checked:
         sol = least_squares(residual, z0, jac=jac, args=(guess_rows,), method="trf",

@@ -185,6 +185,9 @@ class _Library:
         lib.acs_jacs.argtypes = [ctypes.c_double, vp, vp, vp, vp, vp]
         lib.acs_reinit.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_double, vp, vp, vp]
         lib.acs_observe.argtypes = [ctypes.c_double, vp, vp, vp, vp]
+        lib.acs_init_newton.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_double, vp, vp,
+                                        ctypes.c_int, vp, vp, ctypes.c_int, vp, ctypes.c_int]
+        self.n_fixed = sum(1 for nm in cm.var_names if cm.flat.variables[nm].start.fixed)
         self.n_obs = len(cm.var_names) if lib.acs_has_observe() else None
         self.idle = {}
         weakref.finalize(self, _free_idle, lib, self.idle)
@@ -332,8 +335,11 @@ class CCallbacks(tuple):
     Python between segments: the initialisation, event actions and
     re-initialisation. ``reinit(t, y, yp)`` is the re-initialisation in C
     (``reinit.c``; :func:`acausal.initialize.reinitialize` calls it), or
-    None where the Python version must run. The observed variables
-    (``cb[4]``, an array here) are C too unless one has no C form."""
+    None where the Python version must run; ``init_newton(t, z0,
+    guess_rows, fixed)`` the initialisation's Gauss-Newton in C (the same
+    return as :func:`acausal.initialize._newton`, or NotImplemented where the
+    Python version must run). The observed variables (``cb[4]``, an array
+    here) are C too unless one has no C form."""
 
     def __new__(cls, L, cm, p, d, cb):
         lib, n, ns = L.lib, len(cm.dae.y), cm.dae.n_states
@@ -362,6 +368,18 @@ class CCallbacks(tuple):
             lib.acs_observe(t, y.ctypes.data, yp.ctypes.data, pdp, o.ctypes.data)
             return o
 
+        def init_newton(t, z0, guess_rows, fixed, max_iter=50):
+            if L.n_obs is None or len(fixed) != L.n_fixed:
+                return NotImplemented
+            z = np.array(z0, dtype=float)
+            fk = np.array([k for k, _, _ in fixed] or [0], dtype=np.intc)
+            fv = np.array([v for _, v, _ in fixed] or [0.0], dtype=float)
+            gk = np.array(list(guess_rows) or [0], dtype=np.intc)
+            flag = lib.acs_init_newton(n, ns, float(t), z.ctypes.data, pdp, len(fixed),
+                                       fk.ctypes.data, fv.ctypes.data, len(guess_rows),
+                                       gk.ctypes.data, max_iter)
+            return z if flag == 0 else (None if flag == 1 else NotImplemented)
+
         def reinit(t, y, yp):
             y2, yp2 = np.array(y, dtype=float), np.array(yp, dtype=float)
             flag = lib.acs_reinit(n, ns, float(t), y2.ctypes.data, yp2.ctypes.data, pdp)
@@ -369,5 +387,5 @@ class CCallbacks(tuple):
 
         obs = cb[4] if L.n_obs is None else observe
         self = super().__new__(cls, (res, cb[1], roots, jacs, obs) + tuple(cb[5:]))
-        self.pd, self.reinit = pd, reinit
+        self.pd, self.reinit, self.init_newton = pd, reinit, init_newton
         return self

@@ -134,3 +134,167 @@ int acs_reinit(int n, int ns, double t, double* y, double* yp, const double* pd)
   free(w);
   return flag;
 }
+
+/* ---------------------------------------------------------------------------
+ * The initialisation's Gauss-Newton (acausal.initialize._newton with
+ * _lstsq_scaled) on z = (y, y' of the states), for the system
+ *   F(t, y, y') = 0,  observed[fk[a]] - fv[a] = 0 (fixed starts),
+ *   z[gk[b]] - z0[gk[b]] = 0 (imposed guesses),
+ * its Jacobian from acs_jacs, acs_fixjac (the fixed-start rows) and unit
+ * rows. The least-squares step is Householder QR of the column-scaled
+ * Jacobian: the same solution as the SVD's (numpy's lstsq) when the scaled
+ * Jacobian has full column rank and is well conditioned; otherwise (and on
+ * a non-finite matrix) this returns -1 and the caller runs the Python version.
+ */
+void acs_observe(double t, const double* y, const double* yp, const double* pd, double* o);
+void acs_fixjac(double t, const double* y, const double* yp, const double* pd, double* F);
+int acs_n_observed(void);
+
+typedef struct {
+  int n, ns, m, c, nf, ng, nobs;
+  double t;
+  const double *pd, *fv, *z0;
+  const int *fk, *gk;
+  double *y, *yp, *o, *r, *Jy, *Jyp, *F;
+} init_sys;
+
+static void split(init_sys* s, const double* z) {
+  memcpy(s->y, z, sizeof(double) * s->n);
+  memset(s->yp, 0, sizeof(double) * s->n);
+  memcpy(s->yp, z + s->n, sizeof(double) * s->ns);
+}
+
+static void init_residual(init_sys* s, const double* z, double* out) {
+  split(s, z);
+  acs_res(s->t, s->y, s->yp, s->pd, out);
+  if (s->nf) {
+    acs_observe(s->t, s->y, s->yp, s->pd, s->o);
+    for (int a = 0; a < s->nf; a++) out[s->n + a] = s->o[s->fk[a]] - s->fv[a];
+  }
+  for (int b = 0; b < s->ng; b++) out[s->n + s->nf + b] = z[s->gk[b]] - s->z0[s->gk[b]];
+}
+
+/* J row-major m x c */
+static void init_jacobian(init_sys* s, const double* z, double* J) {
+  int n = s->n, c = s->c;
+  split(s, z);
+  acs_jacs(s->t, s->y, s->yp, s->pd, s->Jy, s->Jyp);
+  memset(J, 0, sizeof(double) * (size_t)s->m * c);
+  for (int i = 0; i < n; i++) {
+    memcpy(J + (size_t)i * c, s->Jy + (size_t)i * n, sizeof(double) * n);
+    memcpy(J + (size_t)i * c + n, s->Jyp + (size_t)i * n, sizeof(double) * s->ns);
+  }
+  if (s->nf) {
+    acs_fixjac(s->t, s->y, s->yp, s->pd, s->F);
+    memcpy(J + (size_t)n * c, s->F, sizeof(double) * (size_t)s->nf * c);
+  }
+  for (int b = 0; b < s->ng; b++) J[(size_t)(n + s->nf + b) * c + s->gk[b]] = 1.0;
+}
+
+static double norm2(const double* a, int m) {
+  double s = 0.0;
+  for (int i = 0; i < m; i++) s += a[i] * a[i];
+  return sqrt(s);
+}
+
+/* x (length c) = argmin |J x - b| with J's columns scaled to unit norm
+ * first; J (m x c, row-major) and b are overwritten. -1: not of full,
+ * well-conditioned column rank, or non-finite. */
+static int lstsq_scaled(int m, int c, double* J, double* b, double* x, double* dcol) {
+  if (m < c || !all_finite(J, m * c) || !all_finite(b, m)) return -1;
+  for (int j = 0; j < c; j++) {
+    double s = 0.0;
+    for (int i = 0; i < m; i++) s += J[(size_t)i * c + j] * J[(size_t)i * c + j];
+    s = sqrt(s);
+    if (!(s > 0.0)) return -1;              /* a zero column: rank deficient */
+    dcol[j] = 1.0 / s;
+    for (int i = 0; i < m; i++) J[(size_t)i * c + j] *= dcol[j];
+  }
+  double rmax = 0.0, rmin = INFINITY;
+  for (int k = 0; k < c; k++) {             /* Householder QR, applied to b */
+    double alpha = 0.0;
+    for (int i = k; i < m; i++) alpha += J[(size_t)i * c + k] * J[(size_t)i * c + k];
+    alpha = sqrt(alpha);
+    if (!(alpha > 0.0)) return -1;
+    if (J[(size_t)k * c + k] > 0) alpha = -alpha;
+    double v0 = J[(size_t)k * c + k] - alpha;
+    J[(size_t)k * c + k] = v0;              /* v = (v0, J[k+1.., k]) */
+    double vnorm2 = v0 * v0;
+    for (int i = k + 1; i < m; i++) vnorm2 += J[(size_t)i * c + k] * J[(size_t)i * c + k];
+    if (vnorm2 > 0.0) {
+      for (int j = k + 1; j < c; j++) {
+        double s = 0.0;
+        for (int i = k; i < m; i++) s += J[(size_t)i * c + k] * J[(size_t)i * c + j];
+        s = 2.0 * s / vnorm2;
+        for (int i = k; i < m; i++) J[(size_t)i * c + j] -= s * J[(size_t)i * c + k];
+      }
+      double s = 0.0;
+      for (int i = k; i < m; i++) s += J[(size_t)i * c + k] * b[i];
+      s = 2.0 * s / vnorm2;
+      for (int i = k; i < m; i++) b[i] -= s * J[(size_t)i * c + k];
+    }
+    J[(size_t)k * c + k] = alpha;           /* R's diagonal */
+    rmax = fmax(rmax, fabs(alpha));
+    rmin = fmin(rmin, fabs(alpha));
+  }
+  if (!(rmin > 1e-10 * rmax)) return -1;    /* near rank deficiency: the SVD decides */
+  for (int k = c - 1; k >= 0; k--) {
+    double s = b[k];
+    for (int j = k + 1; j < c; j++) s -= J[(size_t)k * c + j] * x[j];
+    x[k] = s / J[(size_t)k * c + k];
+  }
+  for (int j = 0; j < c; j++) x[j] *= dcol[j];
+  return all_finite(x, c) ? 0 : -1;
+}
+
+/* z (length n + ns): in the start z0, out the last iterate. Returns 0 (z
+ * is the iterate _newton returns), 1 (_newton returns None: a non-finite
+ * residual) or -1 (run the Python version). */
+int acs_init_newton(int n, int ns, double t, double* z, const double* pd, int nf,
+                    const int* fk, const double* fv, int ng, const int* gk, int max_iter) {
+  init_sys s;
+  int c = n + ns, m = n + nf + ng, flag = -1;
+  s.n = n; s.ns = ns; s.m = m; s.c = c; s.nf = nf; s.ng = ng; s.t = t; s.pd = pd;
+  s.fv = fv; s.fk = fk; s.gk = gk; s.nobs = acs_n_observed();
+  size_t words = 2 * (size_t)n + (size_t)s.nobs + 1 + 2 * (size_t)n * n
+                 + (size_t)(nf ? nf : 1) * c + (size_t)m * c + 3 * (size_t)m + 4 * (size_t)c;
+  double* w = (double*)calloc(words, sizeof(double));
+  if (!w) return -1;
+  s.y = w; s.yp = s.y + n; s.o = s.yp + n; s.Jy = s.o + s.nobs + 1; s.Jyp = s.Jy + n * n;
+  s.F = s.Jyp + n * n;
+  double *J = s.F + (size_t)(nf ? nf : 1) * c, *r = J + (size_t)m * c, *r2 = r + m,
+         *b = r2 + m, *dz = b + m, *z2 = dz + c, *dcol = z2 + c, *z0 = dcol + c;
+  memcpy(z0, z, sizeof(double) * c);
+  s.z0 = z0;
+  init_residual(&s, z, r);
+  double nr = norm2(r, m);
+  for (int it = 0; it < max_iter; it++) {
+    if (!all_finite(r, m)) { flag = 1; goto done; }
+    init_jacobian(&s, z, J);
+    for (int i = 0; i < m; i++) b[i] = -r[i];
+    if (lstsq_scaled(m, c, J, b, dz, dcol) < 0) goto done;     /* flag -1 */
+    double step = 1.0, n2 = 0.0;
+    int accepted = 0;
+    for (int h = 0; h < 30; h++) {
+      for (int j = 0; j < c; j++) z2[j] = z[j] + step * dz[j];
+      init_residual(&s, z2, r2);
+      n2 = norm2(r2, m);
+      if ((isfinite(n2) && n2 <= nr * (1 - 1e-4 * step)) || n2 <= 1e-300) { accepted = 1; break; }
+      step *= 0.5;
+    }
+    if (!accepted) { flag = 0; goto done; }   /* no more progress */
+    int small = 1;
+    for (int j = 0; j < c; j++) {
+      z[j] = z2[j];
+      small &= fabs(step * dz[j]) <= 1e-13 * (1.0 + fabs(z[j]));
+    }
+    memcpy(r, r2, sizeof(double) * m);
+    nr = n2;
+    if (small || nr == 0.0) { flag = 0; goto done; }
+  }
+  flag = 0;
+done:
+  if (flag < 0) memcpy(z, z0, sizeof(double) * c);
+  free(w);
+  return flag;
+}
