@@ -23,6 +23,7 @@ per second, a batched sweep >= 500 per second.
 import argparse
 import functools
 import os
+import resource
 import sys
 import time
 
@@ -69,24 +70,34 @@ def main():
     measures = functools.partial(evaluate_measures, mf)
     sets = param_sets(args.sets)
     cm.simulate(**opts)                                        # warm-up
-    t0 = time.perf_counter()
+    c0, t0 = _cpu(), time.perf_counter()
     one = [measures(cm.simulate(params=p, **opts)) for p in sets]
-    t_one, load_one = time.perf_counter() - t0, os.getloadavg()[0]
-    t0 = time.perf_counter()
+    t_one, load_one, cpu_one = time.perf_counter() - t0, os.getloadavg()[0], _cpu() - c0
+    c0, t0 = _cpu(), time.perf_counter()
     batch = cm.simulate_batch(sets, workers=args.workers, reduce=measures, **opts)
-    t_batch, load_batch = time.perf_counter() - t0, os.getloadavg()[0]
+    t_batch, load_batch, cpu_batch = time.perf_counter() - t0, os.getloadavg()[0], _cpu() - c0
     agree = max(abs(a["thrt"] - b["thrt"]) for a, b in zip(one, batch))
-    print(f"breaker on {args.backend}, {len(sets)} parameter sets, {args.workers} workers "
-          f"({os.cpu_count()} CPUs)")
-    print(f"  one-by-one : {len(sets) / t_one:7.1f} simulations/s  (load {load_one:.1f})")
-    print(f"  batched    : {len(sets) / t_batch:7.1f} simulations/s  (load {load_batch:.1f}; "
-          f"x{t_one / t_batch:.2f}; THRT agrees to {agree:.1e} s)")
+    n = len(sets)
+    print(f"breaker on {args.backend}, {n} parameter sets, {args.workers} workers "
+          f"({os.cpu_count()} CPUs); per CPU-second: what one idle core would do")
+    print(f"  one-by-one : {n / t_one:7.1f} simulations/s  (load {load_one:.1f}; "
+          f"{n / cpu_one:.0f} per CPU-second)")
+    print(f"  batched    : {n / t_batch:7.1f} simulations/s  (load {load_batch:.1f}; "
+          f"{n / cpu_batch:.0f} per CPU-second, workers included; x{t_one / t_batch:.2f} "
+          f"in wall time; THRT agrees to {agree:.1e} s)")
     if not args.no_calibrate:
+        c0 = _cpu()
         n_sim, wall = calibrate_rate()
         print(f"  calibrate  : {n_sim / wall:7.1f} simulations/s  (load "
-              f"{os.getloadavg()[0]:.1f}; {n_sim} simulations in {wall:.1f} s, least "
-              "squares over 6 voltages)")
+              f"{os.getloadavg()[0]:.1f}; {n_sim / (_cpu() - c0):.0f} per CPU-second; "
+              f"{n_sim} simulations in {wall:.1f} s, least squares over 6 voltages)")
 
+
+def _cpu():
+    """CPU seconds of this process and of its finished child processes."""
+    own = resource.getrusage(resource.RUSAGE_SELF)
+    kids = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
 
 if __name__ == "__main__":
     main()
