@@ -324,9 +324,12 @@ class CompiledModel:
     def state_guess_order(self):
         """State slots in the order their guesses are imposed when the fixed
         starts leave degrees of freedom (declared non-zero starts first)."""
-        ns = self.dae.n_states
-        guess = self.guess_vector(self.param_vector())
-        return sorted(range(ns), key=lambda i: (guess[i] == 0.0, i))
+        order = getattr(self, "_guess_order", None)
+        if order is None:   # (of the default values: made once per model)
+            ns = self.dae.n_states
+            guess = self.guess_vector(self.param_vector())
+            order = self._guess_order = sorted(range(ns), key=lambda i: (guess[i] == 0.0, i))
+        return list(order)
 
     def discrete_start(self):
         return [float(d.start.value) for d in self.discretes]

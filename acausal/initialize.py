@@ -88,8 +88,12 @@ def _solve_initial(cm, p, d, cb, t0, starts=None):
     # trust-region least squares is the fallback; its long steps (in
     # variables with small Jacobian columns, such as lengths in m) can reach
     # another solution.
-    z = _newton(lambda zz: residual(zz, guess_rows), lambda zz: jac(zz, guess_rows), z0)
-    if z is None or not _consistent(cm, residual(z, []), jac(z, []), z, fixed, n):
+    newton = getattr(cb, "init_newton", None)    # the same Newton in C (compiled backend)
+    z = newton(t0, z0, guess_rows, fixed) if newton is not None else NotImplemented
+    if z is NotImplemented:
+        z = _newton(lambda zz: residual(zz, guess_rows), lambda zz: jac(zz, guess_rows), z0)
+    checked = z is not None and _consistent(cm, residual(z, []), jac(z, []), z, fixed, n)
+    if not checked:
         sol = least_squares(residual, z0, jac=jac, args=(guess_rows,), method="trf",
                             xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=200,
                             x_scale="jac")
@@ -97,7 +101,8 @@ def _solve_initial(cm, p, d, cb, t0, starts=None):
     y, yp = split(z)
     violated = _violated_assertion(cm, cb, t0, y, yp)
     try:
-        _check(cm, residual(z, []), jac(z, []), z, fixed, n)
+        if not checked:   # (Newton's point has just passed this same check)
+            _check(cm, residual(z, []), jac(z, []), z, fixed, n)
     except InitializationError as exc:
         if violated:
             raise InitializationError(f"{violated}; {exc}") from None
@@ -114,7 +119,7 @@ def _solve_initial(cm, p, d, cb, t0, starts=None):
     y, yp = reinitialize(cm, cb, t0, y, yp)
     z = np.concatenate([y, yp[:ns]])
     _check(cm, residual(z, []), jac(z, []), z, fixed, n)
-    return y, _algebraic_rates(cm, cb, t0, y, yp)
+    return y, yp    # reinitialize has filled the algebraic rates
 
 
 def _raise_if_parameter_breaks(cm, t0, p, d, exc):
@@ -321,7 +326,15 @@ def ask_components(model, method, paths, *args):
 
 
 def reinitialize(cm, cb, t, y, yp):
-    """After an event: keep the states, recompute algebraic unknowns and y'."""
+    """After an event: keep the states, recompute algebraic unknowns and y'.
+    Callbacks that bring their own implementation of this algorithm
+    (``cb.reinit``, the compiled backend's C) run it instead; it returns
+    None where this one must run (a singular matrix)."""
+    fast = getattr(cb, "reinit", None)
+    if fast is not None:
+        out = fast(t, y, yp)
+        if out is not None:
+            return out
     dae = cm.dae
     n, ns = len(dae.y), dae.n_states
     r = np.zeros(n)

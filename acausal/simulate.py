@@ -137,6 +137,7 @@ class _Run:
         self.events, self.event_log = [], []
         self.nfev = self.njev = self.steps = self.rows = 0
         self.sens = None   # acausal.sensitivity.SensRun when sensitivities are asked for
+        self._cbs = {}
 
     def record(self, t, y, yp, d):
         self.T.append(np.atleast_1d(np.asarray(t, float)))
@@ -146,6 +147,18 @@ class _Run:
         if self.sens is not None:
             self.SD.append(np.tile(self.sens.sd_all.ravel(), (len(self.T[-1]), 1)))
         self.rows += len(self.T[-1])
+
+    def callbacks(self, d):
+        """Mode ``d``'s generated callbacks, as the backend serves them to
+        the loop (the compiled backend's call C: :meth:`SegmentSolver.callbacks`),
+        made once per mode of the run (contacts switch back and forth)."""
+        if self.sens is not None:   # the augmented model's own callbacks (Python)
+            return self.cm.callbacks(self.p, d)
+        key = tuple(map(float, d))
+        cb = self._cbs.get(key)
+        if cb is None:
+            cb = self._cbs[key] = self.solver().callbacks(self.cm.callbacks(self.p, d), d)
+        return cb
 
     def solver(self):
         """The segment solver of this run (:mod:`acausal.backends`), made once."""
@@ -236,7 +249,7 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
         model = sensitivity_model(cm, sensitivities)
         atol = model.atol(atol, p)
     run = _Run(model, p, t0, t_end, rtol, atol, max_step, max_steps, backend, linsolver)
-    cb = cm.callbacks(p, d)
+    cb = cm.callbacks(p, d) if sensitivities else run.callbacks(d)
     run.cb_d = list(d)
     y, yp = initial_point(cm, p, d, cb, t0, starts)
     if sensitivities:
@@ -265,7 +278,7 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
             watch.check(t)
             d, fired = _observers(run, cb, seg, d)
             if d != run.cb_d:
-                cb = run.cm.callbacks(run.p, d)
+                cb = run.callbacks(d)
             run.cb_d = list(d)
             if seg.status != 2:
                 if tspan[-1] < t_end:   # the end of a window of the watch
@@ -564,7 +577,7 @@ def _new_mode(run, events, t, y, yp, d_before, d, obs):
     at ``t``; with sensitivities, their jumps (:meth:`acausal.sensitivity.SensRun.mode_change`)."""
     if run.sens is not None:
         return run.sens.mode_change(events, t, y, yp, d_before, d, obs)
-    cb = run.cm.callbacks(run.p, d)
+    cb = run.callbacks(d)
     y, yp = reinitialize(run.cm, cb, t, y, yp)
     return d, cb, y, yp
 
