@@ -371,30 +371,12 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, prof
     mf, cm = path
     entries = [cm.params[cm.param_index(n)] for n in names]
     start = np.array([(x0 or {}).get(e.name, e.default) for e in entries], float)
-    lo, hi = np.empty(len(names)), np.empty(len(names))
-    for k, e in enumerate(entries):
-        b = (bounds or {}).get(e.name) or mf.free.get(e.name) or (
-            e.decl.min if e.decl.min is not None else -np.inf,
-            e.decl.max if e.decl.max is not None else np.inf)
-        lo[k], hi[k] = b
-    logp = lo > 0
-    scale = np.where(start != 0, np.abs(start), 1.0)
-    # log-parameters as log(x / ref): z is about 0 at the start, so that the
-    # relative finite-difference step (FD_STEP, of max(1, |z|)) is 1e-3 of
-    # the parameter, not 1e-3 of log(x) ~ 20
-    inside = np.clip(start, lo, hi)
-    ref = np.where(logp, inside, 1.0)
-
-    def to_x(z):
-        return np.where(logp, ref * np.exp(z), z * scale)
-
-    def to_z(x):
-        return np.where(logp, np.log(np.where(logp, x, 1.0) / ref), x / scale)
+    sc = _Scaling.of(start, *_fit_bounds(mf, entries, bounds))
     n_sim = [0]
 
     def fun(z):
         n_sim[0] += len(dataset.experiments)
-        params = dict(zip(names, to_x(z).tolist()))
+        params = dict(zip(names, sc.to_x(z).tolist()))
         try:
             return residual_vector(path, dataset, params, signals)[0]
         except AcausalError:
@@ -404,43 +386,17 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, prof
     if n_res < len(names):
         raise CalibrationError(f"{n_res} measured values cannot determine {len(names)} "
                                "parameters")
-    zlo, zhi = to_z(lo), to_z(hi)
-    zlo = np.where(np.isfinite(lo), zlo, -np.inf)
-    zhi = np.where(np.isfinite(hi), zhi, np.inf)
-    z0 = np.clip(to_z(inside), zlo, zhi)
-    fd = ForwardDifferences(fun, FD_STEP, zhi)
-    jac, kind = fd.jac, "finite differences"
-    if jacobian in ("sensitivities", "auto"):
-        def jac_x(x):
-            n_sim[0] += len(dataset.experiments)
-            return residual_jacobian(path, dataset, dict(zip(names, x.tolist())), names,
-                                     signals)[1]
-        exact = SensitivityJacobian(jac_x, to_x, lambda z: np.where(logp, to_x(z), scale), fd)
-        jac, kind = exact.jac, "sensitivities"
-    elif jacobian not in ("auto", "differences"):
-        raise CalibrationError(f"jacobian={jacobian!r}: choose 'auto', 'sensitivities' or "
-                               "'differences'")
-    sol = optimize.least_squares(fd, z0, jac=jac, bounds=(zlo, zhi),
+    fd = ForwardDifferences(fun, FD_STEP, sc.zhi)
+    jac, exact = _jacobian_choice(jacobian, fd, path, dataset, names, signals, sc, n_sim)
+    sol = optimize.least_squares(fd, sc.z0, jac=jac, bounds=(sc.zlo, sc.zhi),
                                  xtol=1e-12, ftol=1e-12, gtol=1e-12)
-    if kind == "sensitivities" and exact.fallbacks:
+    kind = "finite differences" if exact is None else "sensitivities"
+    if exact is not None and exact.fallbacks:
         kind += f" ({exact.fallbacks} of {exact.calls} by finite differences)"
-    xs = to_x(sol.x)
+    xs = sc.to_x(sol.x)
     values = dict(zip(names, xs.tolist()))
     dof = max(n_res - len(names), 0)
-    ci, corr = {}, None
-    try:
-        cov = np.linalg.inv(sol.jac.T @ sol.jac)
-        s2 = 2 * sol.cost / dof if dof > 0 else 1.0
-        cov = cov * max(s2, 1.0)
-        sd = np.sqrt(np.diag(cov))
-        tq = stats.t.ppf(0.975, dof) if dof > 0 else stats.norm.ppf(0.975)
-        for k, n in enumerate(names):
-            zk = sol.x[k] + np.array([-1.0, 1.0]) * tq * sd[k]
-            xk = ref[k] * np.exp(zk) if logp[k] else zk * scale[k]
-            ci[n] = (float(xk[0]), float(xk[1]))
-        corr = cov / np.outer(sd, sd)
-    except np.linalg.LinAlgError:
-        ci = {n: (float("nan"), float("nan")) for n in names}
+    ci, corr = _linear_intervals(sol, names, sc, dof)
     raw = residual_vector(path, dataset, values, signals)[2]
     out = Calibration("least_squares", values, ci, corr, raw, float(2 * sol.cost), dof,
                       n_sim[0], jacobian=kind)
@@ -449,12 +405,95 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, prof
         # otherwise), so that the profiles' Wald intervals are the ones above
         out.profile_ci95 = profiles(
             _no_evidence_on_failure(path, dataset, names, signals, n_res, n_sim), xs, names,
-            every=profile == "all", bounds=(lo, hi),
-            log=logp, scale=scale, dispersion=max(2 * sol.cost / dof, 1.0) if dof > 0 else 1.0,
+            every=profile == "all", bounds=(sc.lo, sc.hi),
+            log=sc.logp, scale=sc.scale,
+            dispersion=max(2 * sol.cost / dof, 1.0) if dof > 0 else 1.0,
             dof=dof or None, jacobian=sol.jac, fd_step=FD_STEP, inner_max_nfev=20,
             inner_tol=1e-6, crossing_tol=1e-2)
         out.n_sim = n_sim[0]
     return out
+
+
+def _fit_bounds(mf, entries, bounds):
+    """(lo, hi) of each fitted parameter: ``bounds``, else the model file's
+    ``free_parameters``, else the parameter's declared limits."""
+    lo, hi = np.empty(len(entries)), np.empty(len(entries))
+    for k, e in enumerate(entries):
+        lo[k], hi[k] = (bounds or {}).get(e.name) or mf.free.get(e.name) or (
+            e.decl.min if e.decl.min is not None else -np.inf,
+            e.decl.max if e.decl.max is not None else np.inf)
+    return lo, hi
+
+
+@dataclass
+class _Scaling:
+    """The fit's variables z: log(x / ref) for a positive range (so z is
+    about 0 at the start, and the finite-difference step FD_STEP, of
+    max(1, |z|), is 1e-3 of the parameter, not 1e-3 of log(x) ~ 20), else
+    x / scale. ``z0, zlo, zhi``: the start and the bounds in z."""
+    lo: np.ndarray
+    hi: np.ndarray
+    logp: np.ndarray
+    scale: np.ndarray
+    ref: np.ndarray
+    z0: np.ndarray = None
+    zlo: np.ndarray = None
+    zhi: np.ndarray = None
+
+    @classmethod
+    def of(cls, start, lo, hi):
+        logp = lo > 0
+        inside = np.clip(start, lo, hi)
+        sc = cls(lo, hi, logp, np.where(start != 0, np.abs(start), 1.0),
+                 np.where(logp, inside, 1.0))
+        sc.zlo = np.where(np.isfinite(lo), sc.to_z(lo), -np.inf)
+        sc.zhi = np.where(np.isfinite(hi), sc.to_z(hi), np.inf)
+        sc.z0 = np.clip(sc.to_z(inside), sc.zlo, sc.zhi)
+        return sc
+
+    def to_x(self, z):
+        return np.where(self.logp, self.ref * np.exp(z), z * self.scale)
+
+    def to_z(self, x):
+        return np.where(self.logp, np.log(np.where(self.logp, x, 1.0) / self.ref), x / self.scale)
+
+    def dx_dz(self, z):
+        return np.where(self.logp, self.to_x(z), self.scale)
+
+
+def _jacobian_choice(jacobian, fd, path, dataset, names, signals, sc, n_sim):
+    """(the ``jac`` for scipy, the :class:`SensitivityJacobian` or None)."""
+    if jacobian not in ("auto", "sensitivities", "differences"):
+        raise CalibrationError(f"jacobian={jacobian!r}: choose 'auto', 'sensitivities' or "
+                               "'differences'")
+    if jacobian == "differences":
+        return fd.jac, None
+
+    def jac_x(x):
+        n_sim[0] += len(dataset.experiments)
+        return residual_jacobian(path, dataset, dict(zip(names, x.tolist())), names, signals)[1]
+    exact = SensitivityJacobian(jac_x, sc.to_x, sc.dx_dz, fd)
+    return exact.jac, exact
+
+
+def _linear_intervals(sol, names, sc, dof):
+    """(95 % intervals, correlation) from the Jacobian at the optimum, scaled
+    by the reduced chi-square when it exceeds 1, with Student t quantiles;
+    mapped back through the log for positive ranges (so asymmetric)."""
+    try:
+        cov = np.linalg.inv(sol.jac.T @ sol.jac)
+    except np.linalg.LinAlgError:
+        return {n: (float("nan"), float("nan")) for n in names}, None
+    s2 = 2 * sol.cost / dof if dof > 0 else 1.0
+    cov = cov * max(s2, 1.0)
+    sd = np.sqrt(np.diag(cov))
+    tq = stats.t.ppf(0.975, dof) if dof > 0 else stats.norm.ppf(0.975)
+    ci = {}
+    for k, n in enumerate(names):
+        zk = sol.x[k] + np.array([-1.0, 1.0]) * tq * sd[k]
+        xk = sc.ref[k] * np.exp(zk) if sc.logp[k] else zk * sc.scale[k]
+        ci[n] = (float(xk[0]), float(xk[1]))
+    return ci, cov / np.outer(sd, sd)
 
 
 def _no_evidence_on_failure(path, dataset, names, signals, n_res, n_sim):
