@@ -26,7 +26,7 @@ shaft at (f, 0))::
   until the hook has turned by ``over_centre``; past the dead centre the
   same load drives the hook towards release (about 20 N*m at 5 deg);
 * the main shaft starts where the loop closes at the latched hook angle
-  (within 0.04 deg of the base's), with the base's preloads there.
+  (within 0.003 deg of the base's), with the base's preloads there.
 
 Default values: l2 = 25 mm, l1 = |O C0| - l2 = 64.4 mm, over_centre =
 1 deg. The loop is a :class:`~acausal.mechanics.planar.linkages.FourBarLinkage`
