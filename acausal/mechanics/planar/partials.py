@@ -65,6 +65,14 @@ class PartialJoint(PartialRigidLink):
 
     loop_role = "joint"   # named when its loop cannot close
     coordinate = None
+    diagnosis_site = "joint"      # what acausal.diagnose may extend here: across the joint,
+    diagnosis_flange = "axis"     # on its 1-D axis flange (relative coordinates)
+
+    @property
+    def flange(self):
+        """The joint's 1-D ``axis`` under the name the diagnosis uses for the
+        flange of a joint site (acausal.diagnose.graph)."""
+        return self.port("axis")
 
     drives = Discrete(-1, "1", "1: the coordinate drives its loop (a state), 0: it follows")
 
