@@ -24,11 +24,15 @@ latch variant (models/breaker_24kv_toggle.py) and any crank-rocker::
 The links are massless (put a ``Body`` on ``crank`` / ``rocker`` or 1-D
 inertias on the flanges). The start guesses of the four joint angles are the
 closed-form assembly (two circles' intersection) at ``theta_a0`` for the
-given numeric geometry and assembly ``mode`` (+1: C to the left of the line
-from B to D, -1: to the right); the initialisation then closes the loop for
-the parameters of the run (and names the loop when it cannot).
+assembly ``mode`` (+1: C to the left of the line from B to D, -1: to the
+right), as expressions of the linkage's parameters (so a run with other
+lengths starts from their assembly); the initialisation then closes the
+loop (and names it when it cannot). The geometry may be given as numbers or
+as expressions of the enclosing model's parameters.
 """
 import math
+
+import sympy as sp
 
 from acausal import Model, guess
 from acausal.errors import ParameterError
@@ -46,20 +50,26 @@ GEOMETRY = (("xa", "m", "pivot A, world x"), ("ya", "m", "pivot A, world y"),
             ("c", "m", "coupler length C-D"))
 
 
-def fourbar_assembly(theta_a, mode=1, **g):
+def fourbar_assembly(theta_a, mode=1, lib=math, **g):
     """(theta_b, pin_c, pin_d) [rad]: the rocker's angle and the two coupler
     joints' angles that close the loop at crank angle ``theta_a``, for the
-    numbers ``g`` (the names of :data:`GEOMETRY`); None when the loop cannot
-    close there."""
+    geometry ``g`` (the names of :data:`GEOMETRY`). With ``lib=math`` (numbers)
+    None when the loop cannot close there; with ``lib=sympy`` expressions
+    (the cosine clipped to [-1, 1], so that a loop that cannot close still
+    gets start guesses and the initialisation names it)."""
     ua = g["phia"] + theta_a
-    dx, dy = g["xa"] + g["a"] * math.cos(ua) - g["xb"], g["ya"] + g["a"] * math.sin(ua) - g["yb"]
-    d = math.hypot(dx, dy)
-    cos_l = (d * d + g["b"] ** 2 - g["c"] ** 2) / (2 * g["b"] * d) if d > 0 else 2.0
-    if abs(cos_l) > 1:
-        return None
-    ub = math.atan2(dy, dx) + mode * math.acos(cos_l)          # rocker direction (world)
-    cx, cy = g["b"] * math.cos(ub), g["b"] * math.sin(ub)       # C - B
-    uc = math.atan2(dy - cy, dx - cx)                           # coupler direction C -> D
+    dx = g["xa"] + g["a"] * lib.cos(ua) - g["xb"]
+    dy = g["ya"] + g["a"] * lib.sin(ua) - g["yb"]
+    d = lib.sqrt(dx**2 + dy**2)
+    if lib is math:
+        cos_l = (d * d + g["b"] ** 2 - g["c"] ** 2) / (2 * g["b"] * d) if d > 0 else 2.0
+        if abs(cos_l) > 1:
+            return None
+    else:
+        cos_l = sp.Min(sp.Max((d**2 + g["b"]**2 - g["c"]**2) / (2 * g["b"] * d), -1), 1)
+    ub = lib.atan2(dy, dx) + mode * lib.acos(cos_l)            # rocker direction (world)
+    cx, cy = g["b"] * lib.cos(ub), g["b"] * lib.sin(ub)         # C - B
+    uc = lib.atan2(dy - cy, dx - cx)                            # coupler direction C -> D
     return ub - g["phib"], uc - ub, uc - ua
 
 
@@ -85,13 +95,14 @@ class FourBarLinkage(Model):
         for name, unit, desc in GEOMETRY:
             bounds = dict(min=0.0, min_open=True) if name in "abc" else {}
             s[name] = self.parameter(name, given[name], unit, desc, **bounds)
-        closed = fourbar_assembly(theta_a0, mode, **given)
-        if closed is None:
+        numbers = all(isinstance(v, (int, float)) for v in (theta_a0, *given.values()))
+        if numbers and fourbar_assembly(theta_a0, mode, **given) is None:
             raise ParameterError(
                 f"FourBarLinkage: the loop cannot close at theta_a0 = {theta_a0:g} rad with "
                 f"a = {a:g}, b = {b:g}, c = {c:g} m and the pivots "
                 f"{math.hypot(xa - xb, ya - yb):g} m apart")
-        th_b, th_c, th_d = closed
+        # the guesses follow the parameters of the run (a sweep of a length or angle)
+        th_b, th_c, th_d = fourbar_assembly(theta_a0, mode, lib=sp, **s)
         self.ground_a = Fixed(x0=s["xa"], y0=s["ya"], phi0=s["phia"])
         self.ground_b = Fixed(x0=s["xb"], y0=s["yb"], phi0=s["phib"])
         self.pin_a = Revolute(phi=guess(theta_a0))
