@@ -214,3 +214,37 @@ def test_ball_rolls_off_polyline_vertices_as_scipy_nearest_point_reference():
     assert 4.0 in feats and len(feats) >= 3          # vertex 2 (the apex) and flanks met
     E = energy(res)
     assert np.max(np.abs(E / E[0] - 1)) < 1e-9
+
+
+@pytest.mark.slow
+def test_polyline_on_a_free_body_keeps_momentum_with_friction_and_damping():
+    """A ball (spinning) strikes a polyline attached to a free, turned body
+    (no gravity), with Coulomb friction and Hunt-Crossley damping: the force
+    and its moment act on both bodies at the same contact point, so linear
+    momentum and angular momentum about the origin are kept exactly, while
+    the energy drops."""
+    m2, I2 = 0.5, 2e-3
+    model = Model()
+    model.plate = Body(m=m2, I=I2, x=0.0, y=0.0, phi=0.3, vx=0.1, vy=0.0, w=0.5)
+    model.ball = Body(m=M, I=0.4 * M * R**2, x=0.01, y=0.05, phi=0.0, vx=-0.2, vy=-2.0,
+                      w=30.0)
+    model.c = CirclePolylineContact(R=R, K=K, e=0.6, law="hunt_crossley", mu=0.3,
+                                    v_reg=1e-3, peak_event=False,
+                                    points=((-0.06, 0.0), (-0.01, 0.005), (0.03, 0.0),
+                                            (0.06, -0.02)))
+    model.connect(model.plate.frame, model.c.frame_a)
+    model.connect(model.c.frame_b, model.ball.frame)
+    res = compile_model(model).simulate(t_end=0.05, output_step=1e-4, **TOL)
+    assert "c.onset" in [nm for _, nm in res.events]
+    p = np.column_stack([M * res["ball.vx"] + m2 * res["plate.vx"],
+                         M * res["ball.vy"] + m2 * res["plate.vy"]])
+    assert np.max(np.abs(p - p[0])) < 1e-10
+    L = (M * (res["ball.x"] * res["ball.vy"] - res["ball.y"] * res["ball.vx"])
+         + 0.4 * M * R**2 * res["ball.w"]
+         + m2 * (res["plate.x"] * res["plate.vy"] - res["plate.y"] * res["plate.vx"])
+         + I2 * res["plate.w"])
+    assert np.max(np.abs(L - L[0])) < 1e-11
+    E = (0.5 * M * (res["ball.vx"]**2 + res["ball.vy"]**2) + 0.2 * M * R**2 * res["ball.w"]**2
+         + 0.5 * m2 * (res["plate.vx"]**2 + res["plate.vy"]**2) + 0.5 * I2 * res["plate.w"]**2)
+    assert E[-1] < 0.9 * E[0]                     # damping and friction took energy
+    assert abs(res["ball.w"][-1] - 30.0) > 1.0    # friction changed the spin
