@@ -87,6 +87,16 @@ class PartialCircleContact(PartialContact, PartialTwoFrames):
         return np.stack([np.column_stack([bx, by])], axis=1)
 
 
+def _in_world(res, frame, local):
+    """Points (n, 2) given in a frame's axes, in the world along a result:
+    an array (n_times, n, 2)."""
+    import numpy as np
+    x, y, phi = (np.asarray(res[f"{frame}.{k}"])[:, None] for k in ("x", "y", "phi"))
+    c, s = np.cos(phi), np.sin(phi)
+    return np.stack([x + c * local[:, 0] - s * local[:, 1],
+                     y + s * local[:, 0] + c * local[:, 1]], axis=2)
+
+
 class CircleLineContact(PartialCircleContact):
     """A circle of radius ``R`` centred on frame_b against a straight line
     fixed in frame_a: through ``p = r_a + R(phi_a) (px, py)`` with unit
@@ -146,6 +156,15 @@ class CircleCircleContact(PartialCircleContact):
                        structural=True, choices=(False, True))
 
     d = Variable(0.02, "m", "distance between the circle centres")
+
+    def drawing_profile(self, res):
+        """Frame_a's circle (48 points) in the world along a result (for
+        :mod:`acausal.animate`)."""
+        import numpy as np
+        p, u = self.path, np.linspace(0, 2 * np.pi, 49)
+        ra, cx, cy = (float(res[f"{p}.{k}"][0]) for k in ("Ra", "px", "py"))
+        local = np.column_stack([cx + ra * np.cos(u), cy + ra * np.sin(u)])
+        return _in_world(res, f"{p}.frame_a", local)
 
     def geometry(self):
         a, b = self.frame_a, self.frame_b

@@ -142,6 +142,12 @@ class CirclePolylineContact(PartialCircleContact):
         """The polyline's :class:`Profile` (from ``points``)."""
         return Profile(self.points, self.path or type(self).__name__)
 
+    def drawing_profile(self, res):
+        """The polyline in the world along a result (for :mod:`acausal.animate`)."""
+        import numpy as np
+        from .contact import _in_world
+        return _in_world(res, f"{self.path}.frame_a", np.array(self.profile.P))
+
     def _local(self):
         """The centre relative to each vertex, in frame_a's axes."""
         return [(self.xl - px, self.yl - py) for px, py in self.profile.P]
