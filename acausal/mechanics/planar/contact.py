@@ -44,8 +44,9 @@ class PartialCircleContact(PartialContact, PartialTwoFrames):
     coefficient (>= 0), ``v_reg`` [m/s] regularisation speed of the friction
     (> 0), and those of :class:`~acausal.mechanics.contact.PartialContact`
     (``K``, ``gamma``, ``e``, ``law``...). States: ``v_t`` [m/s] slip
-    velocity, ``ft`` [N] friction force on the circle along t, and those of
-    PartialContact (``delta``, ``delta_dot``, ``fc``, ``mode``...).
+    velocity, ``ft`` [N] friction force on the circle along t, ``n_x``,
+    ``n_y`` [1] the unit normal (world), and those of PartialContact
+    (``delta``, ``delta_dot``, ``fc``, ``mode``...).
     Connectors: ``frame_a`` (the profile's body), ``frame_b`` (circle centre).
     """
 
@@ -55,6 +56,8 @@ class PartialCircleContact(PartialContact, PartialTwoFrames):
 
     v_t = Variable(0.0, "m/s", "slip velocity of the circle over the profile along t")
     ft = Variable(0.0, "N", "friction force on the circle along t")
+    n_x = Variable(0.0, "1", "contact normal (profile to circle), world x")
+    n_y = Variable(1.0, "1", "contact normal (profile to circle), world y")
 
     def geometry(self):
         """((nx, ny), delta): the world unit normal from the profile towards
@@ -63,7 +66,8 @@ class PartialCircleContact(PartialContact, PartialTwoFrames):
 
     def equations(self):
         a, b = self.frame_a, self.frame_b
-        (nx, ny), delta = self.geometry()
+        (nx_expr, ny_expr), delta = self.geometry()
+        nx, ny = self.n_x, self.n_y          # named once: the leaf's normal may be long
         tx, ty = -ny, nx
         cx, cy = b.x - self.R * nx, b.y - self.R * ny        # contact point
         wa, wb = der(a.phi), der(b.phi)
@@ -72,7 +76,7 @@ class PartialCircleContact(PartialContact, PartialTwoFrames):
         vcy = der(b.y) - wb * self.R * nx - (der(a.y) + wa * (cx - a.x))
         Fx = self.fc * nx + self.ft * tx
         Fy = self.fc * ny + self.ft * ty
-        return [Eq(self.delta, delta),
+        return [Eq(self.delta, delta), Eq(nx, nx_expr), Eq(ny, ny_expr),
                 Eq(self.v_t, vcx * tx + vcy * ty),
                 Eq(self.ft, -self.mu * self.fc * tanh(self.v_t / self.v_reg)),
                 Eq(b.fx, -Fx), Eq(b.fy, -Fy), Eq(a.fx, Fx), Eq(a.fy, Fy),
