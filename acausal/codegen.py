@@ -137,8 +137,14 @@ def _cse_print(exprs, indent="        ", prefix="c_", symbols=None):
     expressions."""
     repeated = _repeated(exprs)
     names = {e: f"{prefix}{k}" for k, e in enumerate(repeated)}
-    printer = _Printer(names, symbols)
-    lines = [f"{indent}{names[e]} = {printer.definition(e)}" for e in repeated]
+    # a definition may only use the names defined before it: the printer
+    # rebuilds some parts (x**(-1/2) in a product is printed as 1/sqrt(x)),
+    # and such a rebuilt part may be a repeated expression defined later
+    printer = _Printer({}, symbols)
+    lines = []
+    for e in repeated:
+        lines.append(f"{indent}{names[e]} = {printer.definition(e)}")
+        printer.temps[e] = names[e]
     return lines, [printer.code(e) for e in exprs]
 
 

@@ -273,6 +273,7 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
             if len(seg.t) > 1:
                 run.record(seg.t[1:], seg.y[1:], seg.yp[1:], d)
             if seg.status < 0:
+                _observers(run, cb, seg, d)   # those located before it (a dead-centre warning)
                 raise _failure(run, run.cm, seg, cb)
             t, y, yp = float(seg.t[-1]), np.array(seg.y[-1]), np.array(seg.yp[-1])
             watch.check(t)

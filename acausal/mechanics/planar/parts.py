@@ -40,6 +40,8 @@ class Body(PartialOneFrame):
     [rad/s]. Connectors: ``frame`` (at the centre of mass).
     """
 
+    diagnosis_site = "body"   # listed by acausal.diagnose; its loads act through its joints
+
     m = Parameter(1.0, "kg", "mass", min=0.0, min_open=True)
     I = Parameter(1.0, "kg*m^2", "moment of inertia about the centre of mass",  # noqa: E741
                   min=0.0, min_open=True)
