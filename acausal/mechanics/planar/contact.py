@@ -20,9 +20,9 @@ tangent. Sign convention: :mod:`acausal.connectors` (:class:`Frame`)::
   velocity ``v_t`` of the circle's point c over the line's, regularised below
   ``v_reg`` (so a rolling circle creeps by about ``v_reg``).
 """
-from sympy import Eq, sqrt, tanh
+from sympy import sqrt, tanh
 
-from acausal import Parameter, Variable, der
+from acausal import Eq, Parameter, Variable, der
 
 from ..contact import PartialContact
 from .partials import PartialTwoFrames, rotate
