@@ -16,6 +16,7 @@ import scipy.linalg
 import sympy as sp
 from scipy.optimize import least_squares
 
+from .blas import single_threaded
 from .errors import InitializationError
 
 
@@ -31,11 +32,12 @@ def initial_point(cm, p, d, cb, t0, starts=None):
     (``starts``: name -> value overriding declared fixed start values).
     When there is none because of a parameter changed from its default (a
     1e30 N/m spring), the InitializationError names that parameter."""
-    try:
-        return _solve_initial(cm, p, d, cb, t0, starts)
-    except InitializationError as exc:
-        _raise_if_parameter_breaks(cm, t0, p, d, exc)
-        raise
+    with single_threaded(len(cm.dae.y)):
+        try:
+            return _solve_initial(cm, p, d, cb, t0, starts)
+        except InitializationError as exc:
+            _raise_if_parameter_breaks(cm, t0, p, d, exc)
+            raise
 
 
 def _solve_initial(cm, p, d, cb, t0, starts=None):
@@ -322,6 +324,12 @@ def ask_components(model, method, paths, *args):
 
 def reinitialize(cm, cb, t, y, yp):
     """After an event: keep the states, recompute algebraic unknowns and y'."""
+    with single_threaded(len(cm.dae.y)):
+        return _reinitialize(cm, cb, t, y, yp)
+
+
+def _reinitialize(cm, cb, t, y, yp):
+    """reinitialize without the BLAS thread limit."""
     dae = cm.dae
     n, ns = len(dae.y), dae.n_states
     r = np.zeros(n)
