@@ -12,7 +12,7 @@ import sympy as sp
 from .aliases import eliminate_aliases
 from .causalize import build_dae
 from . import cache as _cache
-from .codegen import generate, load as load_generated
+from .codegen import Triplets, generate, load as load_generated
 from .declare import Start
 from .errors import ModelError, ParameterError, UsageError
 from .flatten import flatten
@@ -229,19 +229,20 @@ class CompiledModel:
             return float(fn(p))
         return float(value)
 
-    def fixed_jacobian(self):
+    def fixed_jacobian(self, sparse=False):
         """A function ``(t, *y, *yp, *p, *d)`` -> d(fixed-start variables)/d(y,
-        y'_states) as a dense array: the rows the initialisation adds for
-        fixed starts (generated with the other callbacks, non-zeros only)."""
+        y'_states) as a dense array (a ``scipy.sparse`` CSR matrix with
+        ``sparse``): the rows the initialisation adds for fixed starts
+        (generated with the other callbacks, non-zeros only)."""
         n, ns = len(self.dae.y), self.dae.n_states
         n_fixed = sum(1 for name in self.var_names if self.flat.variables[name].start.fixed)
         npar = len(self.param_syms)
         fill = self._fixjac
 
         def fixed_jac(t, *args):
-            F = np.zeros((n_fixed, n + ns))
+            F = Triplets((n_fixed, n + ns)) if sparse else np.zeros((n_fixed, n + ns))
             fill(t, args[:n], args[n:2 * n], args[2 * n:2 * n + npar], args[2 * n + npar:], F)
-            return F
+            return F.tocsr() if sparse else F
         return fixed_jac
 
     def state_slot_of(self, name):
