@@ -52,6 +52,8 @@ class CompiledModel:
         t0 = _time.perf_counter()
         self.model = model
         flat = self.flat = flatten(model)
+        # wall time of each compile stage [s] (benchmarks/scaling.py prints them)
+        self.stage_s = {"flatten": _time.perf_counter() - t0}
         self.params = [ParamEntry(i.symbol.name, float(i.value), i.decl.unit, i.decl.desc,
                                   i.decl, i.owner)
                        for i in flat.params.values()
@@ -90,7 +92,9 @@ class CompiledModel:
     def _compile(self, flat, key):
         """The compile stages after flattening: an :class:`acausal.cache.Entry`
         and the compiled ``make`` and ``fixjac``."""
+        clock = _Stages(self.stage_s)
         red = self.reduced = eliminate_aliases(flat)
+        clock.lap("aliases")
         check_structure(red.equations, red.unknowns, flat)
         g = self.graph = Graph(red.equations, red.unknowns)
         pantelides(g)
@@ -102,7 +106,9 @@ class CompiledModel:
         fixed = {v.symbol for v in flat.variables.values() if v.start.fixed}
         fixed |= {r for r, st in self._root_starts.items() if st.fixed}
         dummies = dummy_derivatives(g, values, lambda s: base_and_order(s)[0] in fixed)
+        clock.lap("structure")
         self.dae = build_dae(g, dummies, set(self.param_syms), values)
+        clock.lap("causalize")
         if not self.dae.y:
             raise ModelError(_nothing_to_integrate(flat))
         self._subs = dict(red.param_subs)
@@ -113,6 +119,7 @@ class CompiledModel:
         fixed_rows = [k for k, n in enumerate(self.var_names)
                       if flat.variables[n].start.fixed]
         gen = generate(self.dae, self.param_syms, self.disc_syms, roots, observed, fixed_rows)
+        clock.lap("codegen")
         entry = _cache.Entry(key, red, g, self._root_starts, self.dae, gen.source,
                              gen.sparsity, self._root_via, self._propagated)
         return entry, gen.make, gen.fixjac
@@ -371,6 +378,18 @@ class CompiledModel:
         hold this compiled model: see :func:`acausal.batch.simulate_batch`."""
         from .batch import simulate_batch
         return simulate_batch(self, param_sets, **kw)
+
+
+class _Stages:
+    """Records the wall time since the previous lap under each stage name."""
+
+    def __init__(self, out):
+        self.out, self.t = out, _time.perf_counter()
+
+    def lap(self, name):
+        now = _time.perf_counter()
+        self.out[name] = now - self.t
+        self.t = now
 
 
 def _open_across(model, flat, red):
