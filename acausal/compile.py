@@ -15,6 +15,7 @@ from . import cache as _cache
 from .codegen import Triplets, generate, load as load_generated
 from .declare import Start
 from .errors import ModelError, ParameterError, UsageError
+from .fastdiff import diff
 from .flatten import flatten
 from .structure import Graph, check_structure, dummy_derivatives, pantelides
 from .symbols import base_and_order, der, time
@@ -424,7 +425,7 @@ def _propagate_starts(equations, values, open_vars, max_rounds=50):
             if len(left) != 1:
                 continue
             u = left[0]
-            coeff = sp.diff(eq.expr, u)
+            coeff = diff(eq.expr, u)
             if coeff.has(u):
                 continue
             try:
@@ -458,7 +459,7 @@ def _alias_starts(flat, red):
         if len(roots) != 1:
             continue
         r = roots[0]
-        sign = sp.diff(expr, r)
+        sign = diff(expr, r)
         if sign not in (1, -1):
             continue
         groups.setdefault(r, []).append((x, sign, expr - sign * r))

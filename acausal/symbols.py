@@ -8,6 +8,8 @@ substitution and code generation cheap and explicit.
 """
 import sympy as sp
 
+from .fastdiff import diff
+
 time = sp.Symbol("time", real=True)
 
 _PREFIX = "der("
@@ -63,8 +65,7 @@ def total_derivative(expr, is_variable):
     """d/dt of ``expr``: the chain rule over every symbol for which
     ``is_variable(symbol)`` is true; other symbols (parameters, discrete
     values) are constant between events."""
-    out = sp.diff(expr, time) if expr.has(time) else sp.Integer(0)
-    for s in expr.free_symbols:
-        if s != time and is_variable(s):
-            out += sp.diff(expr, s) * der(s)
-    return out
+    terms = [diff(expr, time)] if expr.has(time) else []
+    terms += [diff(expr, s) * der(s) for s in ordered(expr.free_symbols)
+              if s != time and is_variable(s)]
+    return sp.Add(*terms)
