@@ -423,12 +423,8 @@ def _reinitialize(cm, cb, t, y, yp):
         cb[0](t, y, yp, r)
         if not r.any():
             break                     # exact: a further solve only adds round-off
-        Jy, Jyp = _jacobians(cb, t, y, yp, n)
-        J = np.hstack([Jy[:, ns:], Jyp[:, :ns]])
-        try:
-            dz = scipy.linalg.solve(J, -r)
-        except (scipy.linalg.LinAlgError, ValueError):
-            dz = np.linalg.lstsq(J, -r, rcond=None)[0]
+        J, _ = _event_matrix(cb, t, y, yp, ns)
+        dz = _solve_square(J, -r)
         size = float(np.max(np.abs(dz))) if dz.size else 0.0
         if converged and not size < last:
             break                     # refined to the round-off floor
@@ -459,8 +455,7 @@ def _algebraic_rates(cm, cb, t, y, yp):
     if n == ns:
         return yp
     yp = np.array(yp, dtype=float)
-    Jy, Jyp = _jacobians(cb, t, y, yp, n)
-    J = np.hstack([Jy[:, ns:], Jyp[:, :ns]])
+    J, Jy_states = _event_matrix(cb, t, y, yp, ns)
     dt = 1e-6 * max(1.0, abs(t))
     rp, rm = np.zeros(n), np.zeros(n)
     count = cb[5] if len(cb) > 5 else None
@@ -469,11 +464,39 @@ def _algebraic_rates(cm, cb, t, y, yp):
     cb[0](t - dt, y, yp, rm)
     if count is not None:   # these are not solver step attempts
         count[:] = saved
-    rhs = -((rp - rm) / (2 * dt) + Jy[:, :ns] @ yp[:ns])
-    try:
-        sol = scipy.linalg.solve(J, rhs)
-    except (scipy.linalg.LinAlgError, ValueError):
-        sol = np.linalg.lstsq(J, rhs, rcond=None)[0]
+    rhs = -((rp - rm) / (2 * dt) + Jy_states @ yp[:ns])
+    sol = _solve_square(J, rhs)
     if np.all(np.isfinite(sol)):
         yp[ns:] = sol[:n - ns]
     return yp
+
+
+def _event_matrix(cb, t, y, yp, ns):
+    """(J = [dF/dy of the algebraic slots, dF/dy' of the states], dF/dy of
+    the states): the matrix of the re-initialisation, dense, or
+    ``scipy.sparse`` CSC from SPARSE_MIN unknowns."""
+    n = len(y)
+    if n + ns >= SPARSE_MIN:
+        Jy, Jyp = Triplets((n, n)), Triplets((n, n))
+        cb[3](t, y, yp, Jy, Jyp)
+        Jy, Jyp = Jy.tocsr().tocsc(), Jyp.tocsr().tocsc()
+        return sps.hstack([Jy[:, ns:], Jyp[:, :ns]], format="csc"), Jy[:, :ns]
+    Jy, Jyp = _jacobians(cb, t, y, yp, n)
+    return np.hstack([Jy[:, ns:], Jyp[:, :ns]]), Jy[:, :ns]
+
+
+def _solve_square(J, b):
+    """``J x = b`` for a square dense or sparse ``J`` (LU); least squares
+    when the LU finds it singular."""
+    if sps.issparse(J):
+        try:
+            x = scipy.sparse.linalg.splu(J).solve(b)
+            if np.all(np.isfinite(x)):
+                return x
+        except RuntimeError:      # "Factor is exactly singular"
+            pass
+        J = J.toarray()
+    try:
+        return scipy.linalg.solve(J, b)
+    except (scipy.linalg.LinAlgError, ValueError):
+        return np.linalg.lstsq(J, b, rcond=None)[0]
