@@ -20,8 +20,10 @@ and first simulation grow no faster than N^1.3 up to N = 200.
     python benchmarks/scaling.py [--sizes 5 10 20 50 100 200] [--models chain cradle]
                                  [--blas-one-thread]
 
-Every row carries the 1-minute load average when it finished: on a shared
-machine compare rows measured at similar loads. The library limits BLAS to
+Every row carries the 1-minute load average when it finished, and the CPU
+time of the compile and of the first simulation (process time, all
+threads): on a shared machine the wall times grow with the load, the CPU
+times much less. The library limits BLAS to
 one thread in its own solves (acausal/blas.py); ``--blas-one-thread``
 also sets OPENBLAS_NUM_THREADS=1 for the whole process (IDA, numpy
 elsewhere), to compare. The simulation modules are imported before timing,
@@ -55,22 +57,27 @@ RUNS = {
 }
 
 
-def timed(fn):
-    t0 = time.perf_counter()
+def timed(fn, cpu=None):
+    """(fn(), wall time); with a list ``cpu``, appends the process's CPU time
+    (all threads), which a loaded machine inflates far less than wall time."""
+    t0, c0 = time.perf_counter(), time.process_time()
     out = fn()
+    if cpu is not None:
+        cpu.append(time.process_time() - c0)
     return out, time.perf_counter() - t0
 
 
 def measure(name, n):
     build, opts, probe = RUNS[name]
-    cm, t_compile = timed(lambda: compile_model(build(n)))
+    cpu = []
+    cm, t_compile = timed(lambda: compile_model(build(n)), cpu)
     _, t_cached = timed(lambda: compile_model(build(n)))
-    res, t_first = timed(lambda: cm.simulate(**opts))
+    res, t_first = timed(lambda: cm.simulate(**opts), cpu)
     _, t_sim = timed(lambda: cm.simulate(**opts))
     row = dict(model=name, n=n, unknowns=len(cm.dae.y), compile=t_compile, cached=t_cached,
                first=t_first, sim=t_sim, lin=cm.linear_solver().kind,
                events=len(res.events), probe=float(res.final()[probe]),
-               stages=dict(cm.stage_s))
+               stages=dict(cm.stage_s), compile_cpu=cpu[0], first_cpu=cpu[1])
     if name == "chain":
         for kind in ("dense", "band"):
             _, row[kind] = timed(lambda: cm.simulate(linsolver=kind, **opts))
@@ -94,7 +101,8 @@ def report(name, r):
     print(f"  N={r['n']:4d} {r['unknowns']:5d} {r['compile']:8.2f} {r['cached']:7.2f} "
           f"{r['first']:7.2f} {r['sim']:7.2f}{extra}  {r['lin']:5s} {r['events']:4d}"
           f"  ({r['compile'] + r['first']:.2f} s to the first result; load "
-          f"{os.getloadavg()[0]:.1f})\n         stages: {stages}", flush=True)
+          f"{os.getloadavg()[0]:.1f})\n         stages: {stages}; CPU time: compile "
+          f"{r['compile_cpu']:.2f}, first simulate {r['first_cpu']:.2f}", flush=True)
 
 
 def main():
@@ -128,6 +136,8 @@ def main():
             print(f"  growth exponent (N >= 20): compile {exponent(rows, 'compile'):.2f}, "
                   f"first simulate {exponent(rows, 'first'):.2f}, simulate "
                   f"{exponent(rows, 'sim'):.2f}, cached compile {exponent(rows, 'cached'):.2f}"
+                  f"\n    CPU time: compile {exponent(rows, 'compile_cpu'):.2f}, first simulate "
+                  f"{exponent(rows, 'first_cpu'):.2f}"
                   "\n    stages: " + ", ".join(f"{k} {exponent(rows, k):.2f}" for k in STAGES))
 
 
