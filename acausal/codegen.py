@@ -190,6 +190,27 @@ def _unpack(prefix, n, src, indent="        ", array=True):
     return [f"{indent}{names}, = {src}{'.tolist()' if array else ''}"]
 
 
+class Triplets:
+    """Storage the generated Jacobian code can fill instead of a 2-D array
+    (it only assigns ``J[i, j] = v``): collects the entries and gives the
+    ``scipy.sparse`` CSR matrix of ``shape``. The initialisation of a large
+    model uses it, so that no dense matrix is formed."""
+
+    def __init__(self, shape):
+        self.shape = shape
+        self.rows, self.cols, self.vals = [], [], []
+
+    def __setitem__(self, ij, value):
+        self.rows.append(ij[0])
+        self.cols.append(ij[1])
+        self.vals.append(value)
+
+    def tocsr(self):
+        import scipy.sparse as sps
+        return sps.csr_matrix((np.asarray(self.vals, float), (self.rows, self.cols)),
+                              shape=self.shape)
+
+
 @dataclass
 class Sparsity:
     """Structure of the iteration matrix ``J = dF/dy + cj dF/dy'``: its

@@ -69,9 +69,9 @@ from collections import namedtuple
 
 import numpy as np
 import sympy as sp
-from sympy import Eq, Piecewise
+from sympy import Piecewise
 
-from acausal import Component, Discrete, Event, Flange, Model, Parameter, Variable, der
+from acausal import Component, Discrete, Eq, Event, Flange, Model, Parameter, Variable, der
 from acausal.errors import MeasureError, ParameterError
 
 from .partials import PartialCompliant

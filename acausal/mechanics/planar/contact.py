@@ -25,9 +25,9 @@ the profile's normal and Coulomb friction along its tangent. Sign convention:
   velocity ``v_t`` of the circle's point c over the profile's, regularised
   below ``v_reg`` (so a rolling circle creeps by about ``v_reg``).
 """
-from sympy import Eq, sqrt, tanh
+from sympy import sqrt, tanh
 
-from acausal import Parameter, Variable, der
+from acausal import Eq, Parameter, Variable, der
 
 from ..contact import PartialContact
 from .partials import PartialTwoFrames, rotate

@@ -2,9 +2,8 @@
 spring, damper, friction, end stop or drive of the 1-D library). Sign
 convention: :mod:`acausal.connectors` (:class:`Frame`, and the mapping of
 joints to 1-D flanges)."""
-from sympy import Eq
 
-from acausal import Flange, Parameter, ParameterError, RotFlange, Variable, der
+from acausal import Eq, Flange, Parameter, ParameterError, RotFlange, Variable, der
 
 from .partials import PartialJoint, rotate
 

@@ -1,9 +1,9 @@
 """Partial planar models that own the frame equations (Modelica
 PlanarMechanics' PartialTwoFrames idea), so that a leaf is its parameters and
 its law. Sign convention: :mod:`acausal.connectors` (:class:`Frame`)."""
-from sympy import Eq, cos, sin, sqrt
+from sympy import cos, sin, sqrt
 
-from acausal import Component, Discrete, Variable
+from acausal import Component, Discrete, Eq, Variable
 from acausal.connectors import Frame
 
 

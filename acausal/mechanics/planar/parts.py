@@ -1,8 +1,7 @@
 """Fixed frame, rigid body and rigid (massless) link. Sign convention:
 :mod:`acausal.connectors` (:class:`Frame`)."""
-from sympy import Eq
 
-from acausal import Parameter, Variable, der
+from acausal import Eq, Parameter, Variable, der
 
 from .partials import PartialOneFrame, PartialRigidLink, rotate
 
