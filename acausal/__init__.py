@@ -4,7 +4,7 @@ Pipeline, one module per stage: :mod:`.flatten` -> :mod:`.aliases` ->
 :mod:`.structure` -> :mod:`.causalize` -> :mod:`.codegen` (all driven by
 :mod:`.compile`) -> :mod:`.simulate` -> :mod:`.result`.
 """
-from sympy import Eq, Piecewise, cos, exp, sin, sqrt  # noqa: F401  (for model files)
+from sympy import Piecewise, cos, exp, sin, sqrt  # noqa: F401  (for model files)
 
 from .component import Component, Model
 from .compile import CompiledModel, compile_model
@@ -13,7 +13,7 @@ from .declare import Assertion, Discrete, Event, Parameter, Start, Variable, gue
 from .experiment import Experiment, Measure, Stop
 from .errors import (AcausalError, ChatteringError, InitializationError, LimitError, ModelError,
                      ParameterError, SolverError, StructuralError)
-from .symbols import der, time
+from .symbols import Eq, der, time
 
 __all__ = [
     "Component", "Model", "CompiledModel", "compile_model", "Flange", "RotFlange", "Frame", "Port",

@@ -12,7 +12,7 @@ import sympy as sp
 
 from .errors import ModelError, StructuralError
 from .fastdiff import diff
-from .symbols import base_and_order, der, is_der, time
+from .symbols import base_and_order, der, is_der, ordered, time
 
 
 @dataclass
@@ -75,6 +75,14 @@ class _UnionFind:
         self.parent[x] = res
         return res
 
+    def _outranks(self, a, b):
+        """True when root ``a`` should stay rather than ``b``: higher
+        priority, and on a tie the smaller name (a total order, so that the
+        root of each alias class is the same whatever order the equations
+        come in)."""
+        pa, pb = self.priority(a), self.priority(b)
+        return pa > pb if pa != pb else a.name < b.name
+
     def union(self, x, a, y, b):
         """Record x = a*y + b (y may be CONST). Returns None, or 'redundant' /
         'inconsistent' when the equation adds nothing / contradicts."""
@@ -86,7 +94,7 @@ class _UnionFind:
                 return "not-alias"
             return "redundant" if sp.simplify(ox - a * oy - b) == 0 else "inconsistent"
         # rx = (a*sy*ry + a*oy + b - ox)/sx, with sx = ±1
-        if self.priority(ry) >= self.priority(rx):
+        if self._outranks(ry, rx):
             self.parent[rx] = (ry, a * sy / sx, (a * oy + b - ox) / sx)
         else:
             # ry = (sx*rx + ox - a*oy - b)/(a*sy)
@@ -97,7 +105,7 @@ class _UnionFind:
 def _alias_form(expr, unknowns):
     """(x, a, y, b) for expr = 0 <=> x = a*y + b with a = ±1, or
     (x, 0, CONST, b) for x = b; None otherwise."""
-    syms = [s for s in expr.free_symbols if s in unknowns or is_der(s)]
+    syms = [s for s in ordered(expr.free_symbols) if s in unknowns or is_der(s)]
     if any(is_der(s) for s in syms) or expr.has(time) or len(syms) not in (1, 2):
         return None
     if not expr.is_Add and len(syms) == 2:

@@ -9,7 +9,9 @@ positions in the result; :mod:`acausal.connectors` for the frame):
 * ``Revolute``: a small ring at the pin; ``Prismatic``: its guide line and a
   square block at frame_b; ``Fixed``: a triangle (ground);
 * line forces (``Spring``, ``Damper``, ``SpringDamper``): a dashed line;
-* a contact that defines ``drawing_points(result)``: its points.
+* a contact that defines ``drawing_points(result)``: its points; one that
+  defines ``drawing_profile(result)`` (a polyline, a circle on a body): that
+  profile as a line moving with its body.
 """
 from dataclasses import dataclass
 
@@ -48,6 +50,8 @@ def scene_items(model):
                 out.append(Item(kind, comp.path))
                 break
         else:
+            if hasattr(comp, "drawing_profile"):
+                out.append(Item("profile", comp.path))
             if hasattr(comp, "drawing_points"):
                 out.append(Item("contact", comp.path))
     if not out:
@@ -80,7 +84,8 @@ class Scene:
             return np.array([self._xy(f"{p}.frame_a", k)])
         if item.kind == "ground":
             return np.array([self._xy(f"{p}.frame", k)])
-        pts = self.res.model.model.find(p).drawing_points(self.res)
+        comp = self.res.model.model.find(p)
+        pts = (comp.drawing_profile if item.kind == "profile" else comp.drawing_points)(self.res)
         return np.atleast_2d(np.asarray(pts)[k])
 
     @property
@@ -121,6 +126,7 @@ _STYLE = {
     "pin": dict(ls="none", marker="o", ms=7, mfc="white", mec="k", zorder=5),
     "ground": dict(ls="none", marker="^", ms=11, mfc="0.6", mec="k", zorder=0),
     "contact": dict(ls="none", marker="x", ms=8, color="tab:purple", zorder=6),
+    "profile": dict(color="tab:brown", lw=2, zorder=1),
 }
 
 

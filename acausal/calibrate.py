@@ -143,9 +143,10 @@ class Calibration:
     n_sim: int = 0
     validation: dict = field(default_factory=dict)  # held-back experiment -> residuals
     profile_ci95: dict = field(default_factory=dict)  # name -> acausal.profile.Profile
+    jacobian: str = "finite differences"   # or "sensitivities" (see least_squares)
 
     def to_dict(self):
-        return dict(method=self.method, values=self.values,
+        return dict(method=self.method, values=self.values, jacobian=self.jacobian,
                     ci95={k: list(v) for k, v in self.ci95.items()},
                     profile_ci95={k: p.to_dict() for k, p in self.profile_ci95.items()},
                     correlation=None if self.correlation is None else self.correlation.tolist(),
@@ -269,6 +270,72 @@ def residual_vector(path, dataset, params, signals=None, options=None):
     return np.asarray(vec), labels, raw
 
 
+def residual_jacobian(path, dataset, params, names, signals=None, options=None):
+    """(weighted residuals, their Jacobian d r / d x over the parameters
+    ``names``), in the order of :func:`residual_vector`, from one simulation
+    per experiment with forward sensitivities (:mod:`acausal.sensitivity`):
+    a measure's derivative is :meth:`acausal.result.Result.measure_sensitivity`
+    (the measure over the result moved along the sensitivities), a trace
+    sample's ``interp(t_k, res.t, res[var])`` the same interpolation of
+    ``res.sensitivity(var, p)``."""
+    path = resolve(path)
+    mf = path[0]
+    vec, jac = [], []
+    for exp in dataset.experiments:
+        dense = {} if exp.trace is None else mf.experiment.run_options(dense=True)
+        opts = {**dense, **(options or {}), "sensitivities": list(names)}
+        res, meas = simulate_experiment(path, params, exp.conditions, opts)
+        for m, y in exp.measures.items():
+            if signals and m not in signals:
+                continue
+            sigma = _sigma(dataset, m, y)
+            vec.append((meas[m] - y) / sigma)
+            jac.append(np.array([[_measure_derivative(mf, res, m, n) / sigma
+                                  for n in names]]))
+        if exp.trace is None:
+            continue
+        for var, ys in exp.trace.signals.items():
+            if signals and var not in signals:
+                continue
+            sigma = _sigma(dataset, var, ys)
+            sim = np.interp(exp.trace.time, res.t, res[var])
+            vec.extend((sim - ys) / sigma)
+            jac.append(np.column_stack([np.interp(exp.trace.time, res.t,
+                                                  res.sensitivity(var, n)) / sigma
+                                        for n in names]))
+    return np.asarray(vec), np.vstack(jac)
+
+
+class SensitivityJacobian:
+    """``jac`` for ``scipy.optimize.least_squares`` in the fit's variables
+    ``z`` (``x = to_x(z)``, ``dxdz(z)`` = dx/dz) from
+    :func:`residual_jacobian`; where a sensitivity run fails, the finite
+    differences ``fallback`` (a :class:`ForwardDifferences`) answer that
+    call instead, counted in ``fallbacks``."""
+
+    def __init__(self, jac_x, to_x, dxdz, fallback):
+        self.jac_x, self.to_x, self.dxdz, self.fallback = jac_x, to_x, dxdz, fallback
+        self.fallbacks = self.calls = 0
+
+    def jac(self, z):
+        self.calls += 1
+        try:
+            return self.jac_x(self.to_x(z)) * self.dxdz(z)[None, :]
+        except AcausalError:
+            self.fallbacks += 1
+            return self.fallback.jac(z)
+
+
+def _measure_derivative(mf, res, measure, param):
+    try:
+        return float(res.measure_sensitivity(mf.measures[measure], param))
+    except AcausalError:
+        raise
+    except Exception as exc:  # a measure's own failure on the moved result
+        raise ModelFileError(f"{mf.path}: measure {measure!r} failed on the result moved "
+                             f"along d/d{param}: {type(exc).__name__}: {exc}") from None
+
+
 def _sigma(dataset, signal, values):
     inst = dataset.instrument.get(signal)
     s = inst.floor() if inst is not None else 0.0
@@ -277,7 +344,8 @@ def _sigma(dataset, signal, values):
     return s
 
 
-def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, profile="none"):
+def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, profile="none",
+                  jacobian="auto"):
     """Output-error least squares over parameters ``names``.
 
     Bounds come from ``bounds``, else the model file's ``free_parameters``,
@@ -290,35 +358,25 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, prof
     ``profile``: "auto" adds profile-likelihood intervals
     (:mod:`acausal.profile`, ``Calibration.profile_ci95``) for the parameters
     whose linearised interval fails :func:`acausal.profile.linear_check`;
-    "all" for every fitted parameter; "none" (default) for none."""
+    "all" for every fitted parameter; "none" (default) for none.
+
+    ``jacobian``: "sensitivities" (the default, "auto") takes the Jacobian
+    from forward sensitivities (:func:`residual_jacobian`: one simulation per
+    experiment, exact up to the solver tolerance); "differences" from
+    forward differences (absolute step :data:`FD_STEP`, one simulation per
+    parameter and experiment), which also answer any Jacobian the
+    sensitivities cannot give (a run that fails). ``Calibration.jacobian``
+    says which ran."""
     path = resolve(path)
     mf, cm = path
     entries = [cm.params[cm.param_index(n)] for n in names]
     start = np.array([(x0 or {}).get(e.name, e.default) for e in entries], float)
-    lo, hi = np.empty(len(names)), np.empty(len(names))
-    for k, e in enumerate(entries):
-        b = (bounds or {}).get(e.name) or mf.free.get(e.name) or (
-            e.decl.min if e.decl.min is not None else -np.inf,
-            e.decl.max if e.decl.max is not None else np.inf)
-        lo[k], hi[k] = b
-    logp = lo > 0
-    scale = np.where(start != 0, np.abs(start), 1.0)
-    # log-parameters as log(x / ref): z is about 0 at the start, so that the
-    # relative finite-difference step (FD_STEP, of max(1, |z|)) is 1e-3 of
-    # the parameter, not 1e-3 of log(x) ~ 20
-    inside = np.clip(start, lo, hi)
-    ref = np.where(logp, inside, 1.0)
-
-    def to_x(z):
-        return np.where(logp, ref * np.exp(z), z * scale)
-
-    def to_z(x):
-        return np.where(logp, np.log(np.where(logp, x, 1.0) / ref), x / scale)
+    sc = _Scaling.of(start, *_fit_bounds(mf, entries, bounds))
     n_sim = [0]
 
     def fun(z):
         n_sim[0] += len(dataset.experiments)
-        params = dict(zip(names, to_x(z).tolist()))
+        params = dict(zip(names, sc.to_x(z).tolist()))
         try:
             return residual_vector(path, dataset, params, signals)[0]
         except AcausalError:
@@ -328,44 +386,114 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, prof
     if n_res < len(names):
         raise CalibrationError(f"{n_res} measured values cannot determine {len(names)} "
                                "parameters")
-    zlo, zhi = to_z(lo), to_z(hi)
-    zlo = np.where(np.isfinite(lo), zlo, -np.inf)
-    zhi = np.where(np.isfinite(hi), zhi, np.inf)
-    z0 = np.clip(to_z(inside), zlo, zhi)
-    fd = ForwardDifferences(fun, FD_STEP, zhi)
-    sol = optimize.least_squares(fd, z0, jac=fd.jac, bounds=(zlo, zhi),
+    fd = ForwardDifferences(fun, FD_STEP, sc.zhi)
+    jac, exact = _jacobian_choice(jacobian, fd, path, dataset, names, signals, sc, n_sim)
+    sol = optimize.least_squares(fd, sc.z0, jac=jac, bounds=(sc.zlo, sc.zhi),
                                  xtol=1e-12, ftol=1e-12, gtol=1e-12)
-    xs = to_x(sol.x)
+    kind = "finite differences" if exact is None else "sensitivities"
+    if exact is not None and exact.fallbacks:
+        kind += f" ({exact.fallbacks} of {exact.calls} by finite differences)"
+    xs = sc.to_x(sol.x)
     values = dict(zip(names, xs.tolist()))
     dof = max(n_res - len(names), 0)
-    ci, corr = {}, None
-    try:
-        cov = np.linalg.inv(sol.jac.T @ sol.jac)
-        s2 = 2 * sol.cost / dof if dof > 0 else 1.0
-        cov = cov * max(s2, 1.0)
-        sd = np.sqrt(np.diag(cov))
-        tq = stats.t.ppf(0.975, dof) if dof > 0 else stats.norm.ppf(0.975)
-        for k, n in enumerate(names):
-            zk = sol.x[k] + np.array([-1.0, 1.0]) * tq * sd[k]
-            xk = ref[k] * np.exp(zk) if logp[k] else zk * scale[k]
-            ci[n] = (float(xk[0]), float(xk[1]))
-        corr = cov / np.outer(sd, sd)
-    except np.linalg.LinAlgError:
-        ci = {n: (float("nan"), float("nan")) for n in names}
+    ci, corr = _linear_intervals(sol, names, sc, dof)
     raw = residual_vector(path, dataset, values, signals)[2]
     out = Calibration("least_squares", values, ci, corr, raw, float(2 * sol.cost), dof,
-                      n_sim[0])
+                      n_sim[0], jacobian=kind)
     if profile != "none" and names:
         # in the fit's own variables (log for a positive range, value/scale
         # otherwise), so that the profiles' Wald intervals are the ones above
         out.profile_ci95 = profiles(
             _no_evidence_on_failure(path, dataset, names, signals, n_res, n_sim), xs, names,
-            every=profile == "all", bounds=(lo, hi),
-            log=logp, scale=scale, dispersion=max(2 * sol.cost / dof, 1.0) if dof > 0 else 1.0,
+            every=profile == "all", bounds=(sc.lo, sc.hi),
+            log=sc.logp, scale=sc.scale,
+            dispersion=max(2 * sol.cost / dof, 1.0) if dof > 0 else 1.0,
             dof=dof or None, jacobian=sol.jac, fd_step=FD_STEP, inner_max_nfev=20,
             inner_tol=1e-6, crossing_tol=1e-2)
         out.n_sim = n_sim[0]
     return out
+
+
+def _fit_bounds(mf, entries, bounds):
+    """(lo, hi) of each fitted parameter: ``bounds``, else the model file's
+    ``free_parameters``, else the parameter's declared limits."""
+    lo, hi = np.empty(len(entries)), np.empty(len(entries))
+    for k, e in enumerate(entries):
+        lo[k], hi[k] = (bounds or {}).get(e.name) or mf.free.get(e.name) or (
+            e.decl.min if e.decl.min is not None else -np.inf,
+            e.decl.max if e.decl.max is not None else np.inf)
+    return lo, hi
+
+
+@dataclass
+class _Scaling:
+    """The fit's variables z: log(x / ref) for a positive range (so z is
+    about 0 at the start, and the finite-difference step FD_STEP, of
+    max(1, |z|), is 1e-3 of the parameter, not 1e-3 of log(x) ~ 20), else
+    x / scale. ``z0, zlo, zhi``: the start and the bounds in z."""
+    lo: np.ndarray
+    hi: np.ndarray
+    logp: np.ndarray
+    scale: np.ndarray
+    ref: np.ndarray
+    z0: np.ndarray = None
+    zlo: np.ndarray = None
+    zhi: np.ndarray = None
+
+    @classmethod
+    def of(cls, start, lo, hi):
+        logp = lo > 0
+        inside = np.clip(start, lo, hi)
+        sc = cls(lo, hi, logp, np.where(start != 0, np.abs(start), 1.0),
+                 np.where(logp, inside, 1.0))
+        sc.zlo = np.where(np.isfinite(lo), sc.to_z(lo), -np.inf)
+        sc.zhi = np.where(np.isfinite(hi), sc.to_z(hi), np.inf)
+        sc.z0 = np.clip(sc.to_z(inside), sc.zlo, sc.zhi)
+        return sc
+
+    def to_x(self, z):
+        return np.where(self.logp, self.ref * np.exp(z), z * self.scale)
+
+    def to_z(self, x):
+        return np.where(self.logp, np.log(np.where(self.logp, x, 1.0) / self.ref), x / self.scale)
+
+    def dx_dz(self, z):
+        return np.where(self.logp, self.to_x(z), self.scale)
+
+
+def _jacobian_choice(jacobian, fd, path, dataset, names, signals, sc, n_sim):
+    """(the ``jac`` for scipy, the :class:`SensitivityJacobian` or None)."""
+    if jacobian not in ("auto", "sensitivities", "differences"):
+        raise CalibrationError(f"jacobian={jacobian!r}: choose 'auto', 'sensitivities' or "
+                               "'differences'")
+    if jacobian == "differences":
+        return fd.jac, None
+
+    def jac_x(x):
+        n_sim[0] += len(dataset.experiments)
+        return residual_jacobian(path, dataset, dict(zip(names, x.tolist())), names, signals)[1]
+    exact = SensitivityJacobian(jac_x, sc.to_x, sc.dx_dz, fd)
+    return exact.jac, exact
+
+
+def _linear_intervals(sol, names, sc, dof):
+    """(95 % intervals, correlation) from the Jacobian at the optimum, scaled
+    by the reduced chi-square when it exceeds 1, with Student t quantiles;
+    mapped back through the log for positive ranges (so asymmetric)."""
+    try:
+        cov = np.linalg.inv(sol.jac.T @ sol.jac)
+    except np.linalg.LinAlgError:
+        return {n: (float("nan"), float("nan")) for n in names}, None
+    s2 = 2 * sol.cost / dof if dof > 0 else 1.0
+    cov = cov * max(s2, 1.0)
+    sd = np.sqrt(np.diag(cov))
+    tq = stats.t.ppf(0.975, dof) if dof > 0 else stats.norm.ppf(0.975)
+    ci = {}
+    for k, n in enumerate(names):
+        zk = sol.x[k] + np.array([-1.0, 1.0]) * tq * sd[k]
+        xk = sc.ref[k] * np.exp(zk) if sc.logp[k] else zk * sc.scale[k]
+        ci[n] = (float(xk[0]), float(xk[1]))
+    return ci, cov / np.outer(sd, sd)
 
 
 def _no_evidence_on_failure(path, dataset, names, signals, n_res, n_sim):

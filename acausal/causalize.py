@@ -18,6 +18,7 @@ import sympy as sp
 
 from .errors import StructuralError
 from .fastdiff import diff
+from .symbols import ordered
 
 
 @dataclass
@@ -264,7 +265,7 @@ def _blt(eqs, unknowns):
     index = {u: k for k, u in enumerate(unknowns)}
     rows, cols = [], []
     for i, (expr, _) in enumerate(eqs):
-        for s in expr.free_symbols:
+        for s in ordered(expr.free_symbols):
             k = index.get(s)
             if k is not None:
                 rows.append(i)

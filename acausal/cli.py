@@ -42,9 +42,9 @@ def _parse_sets(sets):
 @click.version_option(package_name="acausal")
 @click.option("--backend", "global_backend", type=click.Choice(["sundae", "compiled"]),
               help="integrator backend of every simulation of the command, local worker "
-                   "processes included (default: 'compiled' for calibrate and sweep, "
-                   "which run many simulations of one model; the library's default, "
-                   "'sundae', otherwise)")
+                   "processes included (default: 'compiled' for calibrate, sweep and "
+                   "diagnose, which run many simulations of each model; the library's "
+                   "default, 'sundae', otherwise)")
 @click.pass_context
 def main(ctx, global_backend):
     """Equation-based simulation of mechanisms."""
@@ -54,13 +54,19 @@ def main(ctx, global_backend):
         _set_backend(ctx, choice)
 
 
-# commands that run many simulations of one model: the compiled backend's
-# one-off C build (about 2-3 s, cached on disk) pays for itself there; it
-# falls back to sundae without a C compiler (benchmarks/anchors.py,
-# tests/backends/test_agreement.py). diagnose's fits take the compiled
-# backend themselves (acausal/diagnose/problem.py FIT_BACKEND, measured in
-# docs/diagnosis.md); --backend / ACAUSAL_BACKEND still overrides it.
-MANY_RUNS = {"calibrate", "sweep"}
+# commands that run many simulations of each model: the compiled backend's
+# one-off C build per model (about 1.5-2 s of CPU, cached on disk) pays for
+# itself there; it falls back to sundae without a C compiler
+# (benchmarks/anchors.py, benchmarks/throughput.py, tests/backends/
+# test_agreement.py). diagnose, measured on the latch with three hypotheses
+# (six candidate models, each built in C on a first run): 22 against 39
+# CPU-seconds with the C libraries to build, 13 against 42 with them
+# cached, the same verdict. simulate (one run) keeps the reference: a C
+# build costs more than the run saves (breaker: 5.1 against 3.5 CPU-seconds
+# for the command on a first run, 2.9 against 3.4 once built).
+# diagnose's fits also take it when called from Python (acausal/diagnose/
+# problem.py FIT_BACKEND, measured in docs/diagnosis.md).
+MANY_RUNS = {"calibrate", "sweep", "diagnose"}
 
 
 def _set_backend(ctx, name):
@@ -338,7 +344,8 @@ def calibrate(file, data, fit, method, experiments, profile, as_json):
         click.echo(json.dumps(out.to_dict(), indent=1, default=float))
         return
     click.echo(f"calibration ({out.method}) of {file} against {data} "
-               f"({', '.join(e.name for e in ds.experiments)}): {out.n_sim} simulations")
+               f"({', '.join(e.name for e in ds.experiments)}): {out.n_sim} simulations"
+               + (f", Jacobian from {out.jacobian}" if out.method == "least_squares" else ""))
     for name, v in out.values.items():
         ci = out.ci95.get(name)
         ci_s = f"  95% CI [{ci[0]:.6g}, {ci[1]:.6g}]" if ci else ""
@@ -379,6 +386,22 @@ def _profile_line(prof):
             f"{prof.n_evaluations} evaluations)")
 
 
+def _sweep_units(mf, cm, params, measures):
+    """The SI unit of each swept parameter (or fixed start value) and of each
+    measure that declares one, for the sweep CSV's header."""
+    units = {}
+    for name in params:
+        if name in {e.name for e in cm.params}:
+            units[name] = cm.params[cm.param_index(name)].unit
+        elif name in cm.flat.variables:
+            units[name] = cm.flat.variables[name].unit
+    for m in measures:
+        unit = getattr(mf.measures[m], "unit", None)
+        if unit:
+            units[m] = unit
+    return units
+
+
 @main.command()
 @click.argument("file", type=click.Path(dir_okay=False))
 @click.option("--param", "params", multiple=True, required=True, metavar="NAME=A:B:N",
@@ -414,9 +437,10 @@ def sweep(file, params, measures, out, plot, scheduler, workers, no_progress):
                 raise click.BadParameter(f"--measure {m!r}: the model file defines "
                                          f"{sorted(mf.measures) or 'no measures'}")
         task = functools.partial(sweep_task, os.path.abspath(file))
+        units = _sweep_units(mf, cm, [name for name, _ in specs], measures)
         with terminate_on_sigterm(), _resumable(out), open_executor(scheduler, workers) as ex:
             rows = run_sweep(task, grid(specs), out, executor=ex, measures=measures,
-                             progress=not no_progress, inputs=source_files(file))
+                             progress=not no_progress, inputs=source_files(file), units=units)
         if plot:
             plot_sweep(rows, specs[0][0], measures[0], plot)
     except (AcausalError, click.BadParameter) as exc:

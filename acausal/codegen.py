@@ -7,6 +7,7 @@ and fill the solver's arrays in place (``r[i] = ...``). Parameters and
 discrete values are closure constants: ``make(p, d)`` builds the callbacks
 for one parameter vector and one set of discrete values.
 """
+import functools
 import linecache
 import math
 from dataclasses import dataclass
@@ -136,8 +137,14 @@ def _cse_print(exprs, indent="        ", prefix="c_", symbols=None):
     expressions."""
     repeated = _repeated(exprs)
     names = {e: f"{prefix}{k}" for k, e in enumerate(repeated)}
-    printer = _Printer(names, symbols)
-    lines = [f"{indent}{names[e]} = {printer.definition(e)}" for e in repeated]
+    # a definition may only use the names defined before it: the printer
+    # rebuilds some parts (x**(-1/2) in a product is printed as 1/sqrt(x)),
+    # and such a rebuilt part may be a repeated expression defined later
+    printer = _Printer({}, symbols)
+    lines = []
+    for e in repeated:
+        lines.append(f"{indent}{names[e]} = {printer.definition(e)}")
+        printer.temps[e] = names[e]
     return lines, [printer.code(e) for e in exprs]
 
 
@@ -183,6 +190,27 @@ def _unpack(prefix, n, src, indent="        ", array=True):
     return [f"{indent}{names}, = {src}{'.tolist()' if array else ''}"]
 
 
+class Triplets:
+    """Storage the generated Jacobian code can fill instead of a 2-D array
+    (it only assigns ``J[i, j] = v``): collects the entries and gives the
+    ``scipy.sparse`` CSR matrix of ``shape``. The initialisation of a large
+    model uses it, so that no dense matrix is formed."""
+
+    def __init__(self, shape):
+        self.shape = shape
+        self.rows, self.cols, self.vals = [], [], []
+
+    def __setitem__(self, ij, value):
+        self.rows.append(ij[0])
+        self.cols.append(ij[1])
+        self.vals.append(value)
+
+    def tocsr(self):
+        import scipy.sparse as sps
+        return sps.csr_matrix((np.asarray(self.vals, float), (self.rows, self.cols)),
+                              shape=self.shape)
+
+
 @dataclass
 class Sparsity:
     """Structure of the iteration matrix ``J = dF/dy + cj dF/dy'``: its
@@ -209,7 +237,14 @@ class Sparsity:
 def _jacobian_entries(res, ysyms, ypsyms):
     """Non-zero entries (i, j, dF_i/dy_j, dF_i/dy'_j) of the residuals'
     Jacobians, by differentiating each residual only with respect to the
-    unknowns it contains (work linear in the number of non-zeros)."""
+    unknowns it contains (work linear in the number of non-zeros). The last
+    few are kept: the C generator (:mod:`acausal.codegen_c`) asks again for
+    the same residuals right after this module."""
+    return list(_entries(tuple(res), tuple(ysyms), tuple(ypsyms)))
+
+
+@functools.lru_cache(maxsize=4)
+def _entries(res, ysyms, ypsyms):
     index = {s: ("y", j) for j, s in enumerate(ysyms)}
     index.update({s: ("yp", j) for j, s in enumerate(ypsyms) if s is not None})
     out = []
@@ -224,7 +259,7 @@ def _jacobian_entries(res, ysyms, ypsyms):
             dyp = cols[j].get("yp", sp.S.Zero)
             if dy != 0 or dyp != 0:
                 out.append((i, j, dy, dyp))
-    return out
+    return tuple(out)
 
 
 def _sparsity(n, entries):

@@ -5,19 +5,49 @@ The compiled backend (:mod:`acausal.backends.compiled`) links it with a
 small driver around SUNDIALS IDA, so that IDA calls it with no Python in
 between. Parameters and discrete values are one input array ``pd``
 (parameters first), so that one compiled library serves every mode and
-every parameter set. Sub-expressions are shared through ``sympy.cse``
-(common-subexpression elimination, as in the Python code);
-sympy's C99 printer writes the expressions (Piecewise as ``?:``).
+every parameter set. Sub-expressions are shared by hash-consing, as in the
+Python code (:func:`acausal.codegen._repeated`: every sub-expression met
+twice gets a name; linear work, where ``sympy.cse`` took most of the time on
+a model with its sensitivity equations), and the iteration matrix's entries
+are the Python code's (:func:`acausal.codegen._jacobian_entries`); sympy's
+C99 printer writes the expressions (Piecewise as ``?:``).
 """
 from dataclasses import dataclass
 
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
+from sympy.printing.codeprinter import PrintMethodNotImplementedError
 
-from .codegen import Names
+from .codegen import Names, _fixed_entries, _jacobian_entries, _repeated
 
 
 class _Printer(C99CodePrinter):
+    """C of sympy expressions in which every sub-expression named in
+    ``temps`` is written as that name."""
+
+    def __init__(self, temps=None):
+        super().__init__({"order": "none"})
+        self.temps = temps or {}
+        self._root = None
+        self._not_supported, self._number_symbols = set(), set()
+
+    def _print(self, expr, **kw):
+        if self.temps and expr is not self._root:
+            name = self.temps.get(expr)
+            if name is not None:
+                return name
+        self._root = None
+        return super()._print(expr, **kw)
+
+    def definition(self, expr):
+        """C of ``expr`` itself (not its own name), its parts by name
+        (``doprint`` without its walk of the whole tree for
+        ``UnevaluatedExpr``, which the compiler never creates; the printer
+        is strict: a function with no C form raises
+        ``PrintMethodNotImplementedError``)."""
+        self._root = expr
+        return self._print(expr)
+
     def _print_Heaviside(self, expr):   # the Python code's heaviside: 1/2 at 0
         return f"acs_heaviside({self._print(expr.args[0])})"
 
@@ -38,12 +68,13 @@ def _decls(n, has_yp):
 
 
 def _body(exprs, targets):
-    printer = _Printer()
     if not exprs:
         return []
-    reps, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("c_"), order="none")
-    lines = [f"  const double {v} = {printer.doprint(e)};" for v, e in reps]
-    lines += [f"  {t} = {printer.doprint(e)};" for t, e in zip(targets, reduced)]
+    repeated = _repeated(exprs)
+    names = {e: f"c_{k}" for k, e in enumerate(repeated)}
+    printer = _Printer(names)
+    lines = [f"  const double {names[e]} = {printer.definition(e)};" for e in repeated]
+    lines += [f"  {t} = {printer.definition(e)};" for t, e in zip(targets, exprs)]
     return lines
 
 
@@ -58,10 +89,60 @@ def _function(name, extra_args, decl, body):
     return [head, "{", "  (void)t; (void)y; (void)yp; (void)pd;"] + decl + body + ["}", ""]
 
 
+def _jacs_entries(res, ysyms, ypsyms, n):
+    """(expressions, targets) of ``dF/dy`` and ``dF/dy'`` as two row-major
+    ``n`` x ``n`` arrays (what the Python ``jacs`` callback fills): the
+    initialisation and the re-initialisation at events need them apart."""
+    exprs, targets = [], []
+    for i, r in enumerate(res):
+        fs = r.free_symbols
+        for j in range(n):
+            if ysyms[j] in fs:
+                exprs.append(sp.diff(r, ysyms[j]))
+                targets.append(f"Jy[{i * n + j}]")
+            if ypsyms[j] is not None and ypsyms[j] in fs:
+                exprs.append(sp.diff(r, ypsyms[j]))
+                targets.append(f"Jyp[{i * n + j}]")
+    return exprs, targets
+
+
+def _observe(cm, names, real, decl, ysyms, ypsyms):
+    """``acs_observe`` (every variable of ``cm.var_names``, as the Python
+    ``observe`` callback) and ``acs_has_observe``: 0 when an observed
+    expression has no C form, and the caller keeps the Python one (the
+    residual and root functions decide whether the backend can run)."""
+    obs = [cm.resolve(cm.flat.variables[nm].symbol) for nm in cm.var_names]
+    exprs = [e.xreplace(real) for e in names.rename(obs, "an observed variable")]
+    try:
+        body = _body(exprs, [f"o[{i}]" for i in range(len(exprs))])
+        fixjac = _fixjac(cm, exprs, ysyms, ypsyms)
+        has = 1
+    except PrintMethodNotImplementedError:
+        body, fixjac, has = [], [], 0
+    return _function("acs_observe", ", double* o", decl, body) + \
+        _function("acs_fixjac", ", double* F", decl, fixjac) + \
+        [f"int acs_has_observe(void) {{ return {has}; }}",
+         f"int acs_n_observed(void) {{ return {len(exprs)}; }}", ""]
+
+
+def _fixjac(cm, observed, ysyms, ypsyms):
+    """Body of ``acs_fixjac``: the rows the initialisation adds for the fixed
+    start values (as ``cm.fixed_jacobian()``), row-major over z = (y, y'
+    of the states), every entry written."""
+    ns, n = cm.dae.n_states, len(ysyms)
+    rows = [k for k, nm in enumerate(cm.var_names) if cm.flat.variables[nm].start.fixed]
+    entries = _fixed_entries(dict((k, observed[k]) for k in rows), rows, ysyms, ypsyms, ns)
+    width = n + ns
+    return [f"  memset(F, 0, sizeof(double) * {max(len(rows), 1) * width});"] + \
+        _body([e for _, _, e in entries], [f"F[{a * width + col}]" for a, col, _ in entries])
+
+
 def generate_c(cm):
     """C source of ``acs_res``, ``acs_jac`` (column-major ``J = dF/dy + cj
-    dF/dy'``, every entry written) and ``acs_roots`` for compiled model
-    ``cm`` (events first, then assertions, as in ``cm.callbacks``)."""
+    dF/dy'``, every entry written), ``acs_roots`` for compiled model ``cm``
+    (events first, then assertions, as in ``cm.callbacks``) and ``acs_jacs``
+    (``dF/dy`` and ``dF/dy'`` apart, row-major, as ``cm.callbacks``' jacs)
+    and ``acs_observe`` (every variable, as its observe; see :func:`_observe`)."""
     dae = cm.dae
     n = len(dae.y)
     names = Names(dae.y, dae.yp, cm.param_syms, cm.disc_syms)
@@ -81,15 +162,9 @@ def generate_c(cm):
               for i in range(n)]
     cj = sp.Symbol("cj", real=True)
     jac, targets = [], []
-    for i, r in enumerate(res):
-        fs = r.free_symbols
-        for j in range(n):
-            e = sp.diff(r, ysyms[j]) if ysyms[j] in fs else sp.Integer(0)
-            if ypsyms[j] is not None and ypsyms[j] in fs:
-                e = e + cj * sp.diff(r, ypsyms[j])
-            if e != 0:
-                jac.append(e)
-                targets.append(f"J[{j * n + i}]")
+    for i, j, dy, dyp in _jacobian_entries(res, ysyms, ypsyms):
+        jac.append(dy + cj * dyp)
+        targets.append(f"J[{j * n + i}]")
     decl = _decls(n, has_yp) + _pd_decls(len(cm.param_syms), len(cm.disc_syms))
     L = ["#include <math.h>", "#include <string.h>",
          "static double acs_heaviside(double x) { return x > 0 ? 1.0 : (x == 0 ? 0.5 : 0.0); }",
@@ -99,4 +174,9 @@ def generate_c(cm):
                    [f"  memset(J, 0, sizeof(double) * {n * n});"] + _body(jac, targets))
     L += _function("acs_roots", ", double* g", decl,
                    _body(g, [f"g[{i}]" for i in range(len(g))]))
+    L += _observe(cm, names, real, decl, ysyms, ypsyms)
+    L += _function("acs_jacs", ", double* Jy, double* Jyp", decl,
+                   [f"  memset(Jy, 0, sizeof(double) * {n * n});",
+                    f"  memset(Jyp, 0, sizeof(double) * {n * n});"]
+                   + _body(*_jacs_entries(res, ysyms, ypsyms, n)))
     return CSource("\n".join(L), n, len(g), len(cm.param_syms) + len(cm.disc_syms))

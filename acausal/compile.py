@@ -12,9 +12,10 @@ import sympy as sp
 from .aliases import eliminate_aliases
 from .causalize import build_dae
 from . import cache as _cache
-from .codegen import generate, load as load_generated
+from .codegen import Triplets, generate, load as load_generated
 from .declare import Start
 from .errors import ModelError, ParameterError, UsageError
+from .fastdiff import diff
 from .flatten import flatten
 from .structure import Graph, check_structure, dummy_derivatives, pantelides
 from .symbols import base_and_order, der, time
@@ -52,6 +53,8 @@ class CompiledModel:
         t0 = _time.perf_counter()
         self.model = model
         flat = self.flat = flatten(model)
+        # wall time of each compile stage [s] (benchmarks/scaling.py prints them)
+        self.stage_s = {"flatten": _time.perf_counter() - t0}
         self.params = [ParamEntry(i.symbol.name, float(i.value), i.decl.unit, i.decl.desc,
                                   i.decl, i.owner)
                        for i in flat.params.values()
@@ -90,7 +93,9 @@ class CompiledModel:
     def _compile(self, flat, key):
         """The compile stages after flattening: an :class:`acausal.cache.Entry`
         and the compiled ``make`` and ``fixjac``."""
+        clock = _Stages(self.stage_s)
         red = self.reduced = eliminate_aliases(flat)
+        clock.lap("aliases")
         check_structure(red.equations, red.unknowns, flat)
         g = self.graph = Graph(red.equations, red.unknowns)
         pantelides(g)
@@ -102,7 +107,9 @@ class CompiledModel:
         fixed = {v.symbol for v in flat.variables.values() if v.start.fixed}
         fixed |= {r for r, st in self._root_starts.items() if st.fixed}
         dummies = dummy_derivatives(g, values, lambda s: base_and_order(s)[0] in fixed)
+        clock.lap("structure")
         self.dae = build_dae(g, dummies, set(self.param_syms), values)
+        clock.lap("causalize")
         if not self.dae.y:
             raise ModelError(_nothing_to_integrate(flat))
         self._subs = dict(red.param_subs)
@@ -113,6 +120,7 @@ class CompiledModel:
         fixed_rows = [k for k, n in enumerate(self.var_names)
                       if flat.variables[n].start.fixed]
         gen = generate(self.dae, self.param_syms, self.disc_syms, roots, observed, fixed_rows)
+        clock.lap("codegen")
         entry = _cache.Entry(key, red, g, self._root_starts, self.dae, gen.source,
                              gen.sparsity, self._root_via, self._propagated)
         return entry, gen.make, gen.fixjac
@@ -229,19 +237,20 @@ class CompiledModel:
             return float(fn(p))
         return float(value)
 
-    def fixed_jacobian(self):
+    def fixed_jacobian(self, sparse=False):
         """A function ``(t, *y, *yp, *p, *d)`` -> d(fixed-start variables)/d(y,
-        y'_states) as a dense array: the rows the initialisation adds for
-        fixed starts (generated with the other callbacks, non-zeros only)."""
+        y'_states) as a dense array (a ``scipy.sparse`` CSR matrix with
+        ``sparse``): the rows the initialisation adds for fixed starts
+        (generated with the other callbacks, non-zeros only)."""
         n, ns = len(self.dae.y), self.dae.n_states
         n_fixed = sum(1 for name in self.var_names if self.flat.variables[name].start.fixed)
         npar = len(self.param_syms)
         fill = self._fixjac
 
         def fixed_jac(t, *args):
-            F = np.zeros((n_fixed, n + ns))
+            F = Triplets((n_fixed, n + ns)) if sparse else np.zeros((n_fixed, n + ns))
             fill(t, args[:n], args[n:2 * n], args[2 * n:2 * n + npar], args[2 * n + npar:], F)
-            return F
+            return F.tocsr() if sparse else F
         return fixed_jac
 
     def state_slot_of(self, name):
@@ -324,9 +333,12 @@ class CompiledModel:
     def state_guess_order(self):
         """State slots in the order their guesses are imposed when the fixed
         starts leave degrees of freedom (declared non-zero starts first)."""
-        ns = self.dae.n_states
-        guess = self.guess_vector(self.param_vector())
-        return sorted(range(ns), key=lambda i: (guess[i] == 0.0, i))
+        order = getattr(self, "_guess_order", None)
+        if order is None:   # (of the default values: made once per model)
+            ns = self.dae.n_states
+            guess = self.guess_vector(self.param_vector())
+            order = self._guess_order = sorted(range(ns), key=lambda i: (guess[i] == 0.0, i))
+        return list(order)
 
     def discrete_start(self):
         return [float(d.start.value) for d in self.discretes]
@@ -382,6 +394,18 @@ class CompiledModel:
         return simulate_batch(self, param_sets, **kw)
 
 
+class _Stages:
+    """Records the wall time since the previous lap under each stage name."""
+
+    def __init__(self, out):
+        self.out, self.t = out, _time.perf_counter()
+
+    def lap(self, name):
+        now = _time.perf_counter()
+        self.out[name] = now - self.t
+        self.t = now
+
+
 def _open_across(model, flat, red):
     """Connector across variables left as unknowns with no start of their own
     (a zero guess): the positions and angles of the frames between planar
@@ -414,7 +438,7 @@ def _propagate_starts(equations, values, open_vars, max_rounds=50):
             if len(left) != 1:
                 continue
             u = left[0]
-            coeff = sp.diff(eq.expr, u)
+            coeff = diff(eq.expr, u)
             if coeff.has(u):
                 continue
             try:
@@ -448,7 +472,7 @@ def _alias_starts(flat, red):
         if len(roots) != 1:
             continue
         r = roots[0]
-        sign = sp.diff(expr, r)
+        sign = diff(expr, r)
         if sign not in (1, -1):
             continue
         groups.setdefault(r, []).append((x, sign, expr - sign * r))

@@ -13,9 +13,14 @@ import math
 
 import numpy as np
 import scipy.linalg
+import scipy.sparse as sps
+import scipy.sparse.linalg
 import sympy as sp
 from scipy.optimize import least_squares
+from scipy.sparse.csgraph import structural_rank
 
+from .blas import single_threaded
+from .codegen import Triplets
 from .errors import InitializationError
 
 
@@ -31,11 +36,12 @@ def initial_point(cm, p, d, cb, t0, starts=None):
     (``starts``: name -> value overriding declared fixed start values).
     When there is none because of a parameter changed from its default (a
     1e30 N/m spring), the InitializationError names that parameter."""
-    try:
-        return _solve_initial(cm, p, d, cb, t0, starts)
-    except InitializationError as exc:
-        _raise_if_parameter_breaks(cm, t0, p, d, exc)
-        raise
+    with single_threaded(len(cm.dae.y)):
+        try:
+            return _solve_initial(cm, p, d, cb, t0, starts)
+        except InitializationError as exc:
+            _raise_if_parameter_breaks(cm, t0, p, d, exc)
+            raise
 
 
 def _solve_initial(cm, p, d, cb, t0, starts=None):
@@ -49,7 +55,8 @@ def _solve_initial(cm, p, d, cb, t0, starts=None):
     # steep law near 0 (regularised friction) can stall it far from them
     _snap_fixed_states(cm, y0, fixed)
     res_fn, observe = cb[0], cb[4]
-    fixed_jac = cm.fixed_jacobian()
+    sparse = n + ns >= SPARSE_MIN
+    fixed_jac = cm.fixed_jacobian(sparse=sparse)
     r = np.zeros(n)
 
     def split(z):
@@ -68,18 +75,8 @@ def _solve_initial(cm, p, d, cb, t0, starts=None):
 
     def jac(z, guess_rows):
         y, yp = split(z)
-        Jy, Jyp = _jacobians(cb, t0, y, yp, n)
-        top = np.hstack([Jy, Jyp[:, :ns]])
-        rows = [top]
-        if fixed:
-            rows.append(np.asarray(fixed_jac(t0, *y, *yp, *p, *d), dtype=float)
-                        .reshape(len(fixed), len(z)))
-        if guess_rows:
-            G = np.zeros((len(guess_rows), len(z)))
-            for a, k in enumerate(guess_rows):
-                G[a, k] = 1.0
-            rows.append(G)
-        return np.vstack(rows)
+        F = fixed_jac(t0, *y, *yp, *p, *d) if fixed else None
+        return _initial_jacobian(cb, t0, y, yp, ns, F, guess_rows, sparse)
 
     z0 = np.concatenate([y0, np.zeros(ns)])
     guess_rows = _choose_guesses(jac(z0, []), ns, cm.state_guess_order())
@@ -88,8 +85,12 @@ def _solve_initial(cm, p, d, cb, t0, starts=None):
     # trust-region least squares is the fallback; its long steps (in
     # variables with small Jacobian columns, such as lengths in m) can reach
     # another solution.
-    z = _newton(lambda zz: residual(zz, guess_rows), lambda zz: jac(zz, guess_rows), z0)
-    if z is None or not _consistent(cm, residual(z, []), jac(z, []), z, fixed, n):
+    newton = getattr(cb, "init_newton", None)    # the same Newton in C (compiled backend)
+    z = newton(t0, z0, guess_rows, fixed) if newton is not None else NotImplemented
+    if z is NotImplemented:
+        z = _newton(lambda zz: residual(zz, guess_rows), lambda zz: jac(zz, guess_rows), z0)
+    checked = z is not None and _consistent(cm, residual(z, []), jac(z, []), z, fixed, n)
+    if not checked:
         sol = least_squares(residual, z0, jac=jac, args=(guess_rows,), method="trf",
                             xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=200,
                             x_scale="jac")
@@ -97,7 +98,8 @@ def _solve_initial(cm, p, d, cb, t0, starts=None):
     y, yp = split(z)
     violated = _violated_assertion(cm, cb, t0, y, yp)
     try:
-        _check(cm, residual(z, []), jac(z, []), z, fixed, n)
+        if not checked:   # (Newton's point has just passed this same check)
+            _check(cm, residual(z, []), jac(z, []), z, fixed, n)
     except InitializationError as exc:
         if violated:
             raise InitializationError(f"{violated}; {exc}") from None
@@ -114,7 +116,40 @@ def _solve_initial(cm, p, d, cb, t0, starts=None):
     y, yp = reinitialize(cm, cb, t0, y, yp)
     z = np.concatenate([y, yp[:ns]])
     _check(cm, residual(z, []), jac(z, []), z, fixed, n)
-    return y, _algebraic_rates(cm, cb, t0, y, yp)
+    return y, yp    # reinitialize has filled the algebraic rates
+
+
+# unknowns (y and the states' y') from which the initialisation assembles
+# sparse Jacobians and solves them by sparse LU: the dense least squares grew
+# as n^3 (0.5 s per Newton step for a 200-mass chain, single-threaded)
+SPARSE_MIN = 200
+
+
+def _initial_jacobian(cb, t, y, yp, ns, F, guess_rows, sparse):
+    """The initial system's Jacobian d(residuals, fixed starts ``F`` rows,
+    guess rows)/d(y, y'_states), dense or ``scipy.sparse`` CSR."""
+    n = len(y)
+    if sparse:
+        Jy, Jyp = Triplets((n, n)), Triplets((n, n))
+        cb[3](t, y, yp, Jy, Jyp)
+        blocks = [[Jy.tocsr(), Jyp.tocsr()[:, :ns]]]
+        if F is not None:
+            blocks.append([F[:, :n], F[:, n:]])
+        if guess_rows:
+            G = sps.csr_matrix((np.ones(len(guess_rows)), (range(len(guess_rows)), guess_rows)),
+                               shape=(len(guess_rows), n + ns))
+            blocks.append([G[:, :n], G[:, n:]])
+        return sps.bmat(blocks, format="csr")
+    Jy, Jyp = _jacobians(cb, t, y, yp, n)
+    rows = [np.hstack([Jy, Jyp[:, :ns]])]
+    if F is not None:
+        rows.append(np.asarray(F, dtype=float).reshape(-1, n + ns))
+    if guess_rows:
+        G = np.zeros((len(guess_rows), n + ns))
+        for a, k in enumerate(guess_rows):
+            G[a, k] = 1.0
+        rows.append(G)
+    return np.vstack(rows)
 
 
 def _raise_if_parameter_breaks(cm, t0, p, d, exc):
@@ -231,9 +266,59 @@ def _lstsq_scaled(J, b):
     accelerations and forces whose columns can differ by many orders of
     magnitude (a stiff spring next to a light body), and an unscaled
     solve would cut the small columns off as rank deficiency."""
+    if sps.issparse(J):
+        return _sparse_lstsq_scaled(J, b)
     norms = np.linalg.norm(J, axis=0)
     d = np.where(norms > 0, 1.0 / np.where(norms > 0, norms, 1.0), 1.0)
     return d * np.linalg.lstsq(J * d, b, rcond=None)[0]
+
+
+def _sparse_scaled(J):
+    """(J with unit-norm columns as CSC, the column scale factors)."""
+    norms = np.sqrt(np.asarray(J.multiply(J).sum(axis=0)).ravel())
+    d = np.where(norms > 0, 1.0 / np.where(norms > 0, norms, 1.0), 1.0)
+    return (J @ sps.diags(d)).tocsc(), d
+
+
+def _sparse_lu(Js):
+    """A sparse LU (SuperLU) of ``Js`` when square, else of the augmented
+    system ``[[I, Js], [Js^T, 0]]``, whose solution is the least-squares
+    one (and which is non-singular exactly when Js has full column rank);
+    None when SuperLU finds it singular."""
+    m, k = Js.shape
+    K = Js if m == k else sps.bmat([[sps.identity(m), Js], [Js.T, None]], format="csc")
+    try:
+        return scipy.sparse.linalg.splu(K.tocsc())
+    except RuntimeError:      # "Factor is exactly singular"
+        return None
+
+
+def _sparse_lstsq_scaled(J, b):
+    """:func:`_lstsq_scaled` of a sparse ``J`` by sparse LU; the dense least
+    squares when the LU finds the system singular or gives no finite
+    solution."""
+    Js, d = _sparse_scaled(J)
+    m, k = Js.shape
+    lu = _sparse_lu(Js)
+    if lu is not None:
+        x = lu.solve(b if m == k else np.concatenate([b, np.zeros(k)]))[-k:]
+        if np.all(np.isfinite(x)):
+            return d * x
+    return d * np.linalg.lstsq(Js.toarray(), b, rcond=None)[0]
+
+
+def _sparse_full_rank(J, tol=1e-12):
+    """True when the sparse ``J`` (more rows than columns, or square) has
+    full column rank: structurally, and by its sparse LU, whose smallest
+    pivot must not fall below ``tol`` times the largest (columns scaled to
+    unit norm first)."""
+    if structural_rank(J) < J.shape[1]:
+        return False
+    lu = _sparse_lu(_sparse_scaled(J)[0])
+    if lu is None:
+        return False
+    piv = np.abs(lu.U.diagonal())
+    return bool(piv.min() > tol * piv.max())
 
 
 def _consistent(cm, full, J, z, fixed, n):
@@ -247,6 +332,10 @@ def _consistent(cm, full, J, z, fixed, n):
 def _choose_guesses(J, ns, order):
     """Indices of state slots whose guess must be imposed so that the
     Jacobian has full column rank."""
+    if sps.issparse(J):
+        if J.shape[0] >= J.shape[1] and _sparse_full_rank(J):
+            return []
+        J = J.toarray()
     m = J.shape[1]
     rank = np.linalg.matrix_rank(J) if J.size else 0
     chosen = []
@@ -264,7 +353,7 @@ def _choose_guesses(J, ns, order):
 
 
 def _check(cm, full, J, z, fixed, n):
-    scale = np.abs(J) @ (np.abs(z) + 1e-12) + 1e-12
+    scale = abs(J) @ (np.abs(z) + 1e-12) + 1e-12
     bad = np.abs(full) > 1e-7 * scale + 1e-10
     if not bad.any():
         return
@@ -321,7 +410,21 @@ def ask_components(model, method, paths, *args):
 
 
 def reinitialize(cm, cb, t, y, yp):
-    """After an event: keep the states, recompute algebraic unknowns and y'."""
+    """After an event: keep the states, recompute algebraic unknowns and y'.
+    Callbacks that bring their own implementation of this algorithm
+    (``cb.reinit``, the compiled backend's C) run it instead; it returns
+    None where this one must run (a singular matrix)."""
+    fast = getattr(cb, "reinit", None)
+    if fast is not None:
+        out = fast(t, y, yp)
+        if out is not None:
+            return out
+    with single_threaded(len(cm.dae.y)):
+        return _reinitialize(cm, cb, t, y, yp)
+
+
+def _reinitialize(cm, cb, t, y, yp):
+    """reinitialize without the BLAS thread limit."""
     dae = cm.dae
     n, ns = len(dae.y), dae.n_states
     r = np.zeros(n)
@@ -333,12 +436,8 @@ def reinitialize(cm, cb, t, y, yp):
         cb[0](t, y, yp, r)
         if not r.any():
             break                     # exact: a further solve only adds round-off
-        Jy, Jyp = _jacobians(cb, t, y, yp, n)
-        J = np.hstack([Jy[:, ns:], Jyp[:, :ns]])
-        try:
-            dz = scipy.linalg.solve(J, -r)
-        except (scipy.linalg.LinAlgError, ValueError):
-            dz = np.linalg.lstsq(J, -r, rcond=None)[0]
+        J, _ = _event_matrix(cb, t, y, yp, ns)
+        dz = _solve_square(J, -r)
         size = float(np.max(np.abs(dz))) if dz.size else 0.0
         if converged and not size < last:
             break                     # refined to the round-off floor
@@ -369,8 +468,7 @@ def _algebraic_rates(cm, cb, t, y, yp):
     if n == ns:
         return yp
     yp = np.array(yp, dtype=float)
-    Jy, Jyp = _jacobians(cb, t, y, yp, n)
-    J = np.hstack([Jy[:, ns:], Jyp[:, :ns]])
+    J, Jy_states = _event_matrix(cb, t, y, yp, ns)
     dt = 1e-6 * max(1.0, abs(t))
     rp, rm = np.zeros(n), np.zeros(n)
     count = cb[5] if len(cb) > 5 else None
@@ -379,11 +477,39 @@ def _algebraic_rates(cm, cb, t, y, yp):
     cb[0](t - dt, y, yp, rm)
     if count is not None:   # these are not solver step attempts
         count[:] = saved
-    rhs = -((rp - rm) / (2 * dt) + Jy[:, :ns] @ yp[:ns])
-    try:
-        sol = scipy.linalg.solve(J, rhs)
-    except (scipy.linalg.LinAlgError, ValueError):
-        sol = np.linalg.lstsq(J, rhs, rcond=None)[0]
+    rhs = -((rp - rm) / (2 * dt) + Jy_states @ yp[:ns])
+    sol = _solve_square(J, rhs)
     if np.all(np.isfinite(sol)):
         yp[ns:] = sol[:n - ns]
     return yp
+
+
+def _event_matrix(cb, t, y, yp, ns):
+    """(J = [dF/dy of the algebraic slots, dF/dy' of the states], dF/dy of
+    the states): the matrix of the re-initialisation, dense, or
+    ``scipy.sparse`` CSC from SPARSE_MIN unknowns."""
+    n = len(y)
+    if n + ns >= SPARSE_MIN:
+        Jy, Jyp = Triplets((n, n)), Triplets((n, n))
+        cb[3](t, y, yp, Jy, Jyp)
+        Jy, Jyp = Jy.tocsr().tocsc(), Jyp.tocsr().tocsc()
+        return sps.hstack([Jy[:, ns:], Jyp[:, :ns]], format="csc"), Jy[:, :ns]
+    Jy, Jyp = _jacobians(cb, t, y, yp, n)
+    return np.hstack([Jy[:, ns:], Jyp[:, :ns]]), Jy[:, :ns]
+
+
+def _solve_square(J, b):
+    """``J x = b`` for a square dense or sparse ``J`` (LU); least squares
+    when the LU finds it singular."""
+    if sps.issparse(J):
+        try:
+            x = scipy.sparse.linalg.splu(J).solve(b)
+            if np.all(np.isfinite(x)):
+                return x
+        except RuntimeError:      # "Factor is exactly singular"
+            pass
+        J = J.toarray()
+    try:
+        return scipy.linalg.solve(J, b)
+    except (scipy.linalg.LinAlgError, ValueError):
+        return np.linalg.lstsq(J, b, rcond=None)[0]

@@ -27,6 +27,7 @@ class Result:
         self.status = status
         self.message = message
         self._obs = None
+        self.sensitivities = None   # acausal.sensitivity.Sensitivities of a run that asked
 
     # -- access ----------------------------------------------------------------
     @property
@@ -82,6 +83,33 @@ class Result:
         for j, dsc in enumerate(self.model.discretes):
             out[dsc.symbol.name] = float(self.d[-1, j])
         return out
+
+    def sensitivity(self, name, param):
+        """d(``name``)/d(``param``) at every ``res.t``: the forward sensitivity of
+        a variable (state, algebraic unknown or any observed variable) with
+        respect to a parameter named in ``simulate(sensitivities=[...])``, in
+        the variable's unit per the parameter's unit."""
+        return self._sens().of(name, param)
+
+    def event_sensitivity(self, param, name=None):
+        """d(event time)/d(``param``) of the events called ``name`` (all if
+        None), in the order of :meth:`event_times` (NaN for an event whose
+        time is not differentiable, a grazing root)."""
+        e = self._sens().event(param)
+        return np.array([v for (_, n), v in zip(self.events, e) if name is None or n == name])
+
+    def measure_sensitivity(self, fn, param):
+        """d fn(res) / d(``param``) of a measure ``fn`` (a function of a
+        result, as a model file's measures), from the sensitivities, with no
+        further simulation (:meth:`acausal.sensitivity.Sensitivities.measure`)."""
+        return self._sens().measure(self, fn, param)
+
+    def _sens(self):
+        if self.sensitivities is None:
+            from .errors import UsageError
+            raise UsageError("this result has no sensitivities: simulate with "
+                             "sensitivities=[parameter names]")
+        return self.sensitivities
 
     def event_times(self, name=None):
         """Times of the events called ``name`` (all events if None)."""

@@ -11,7 +11,7 @@ event. A burst of events in a tiny window stops the run with a
 import os
 import sys
 import time as _time
-from collections import Counter
+from collections import Counter, deque
 
 import numpy as np
 
@@ -20,7 +20,7 @@ from .errors import ChatteringError, LimitError, ModelError, SolverError, UsageE
 from .initialize import ask_components, initial_point, reinitialize, suspect_parameters
 from .result import Result
 
-CHATTER_COUNT = 100     # this many events ...
+CHATTER_COUNT = 100     # this many firings of one event (root) ...
 CHATTER_SPAN = 1e-9     # ... within this fraction of the time span is chattering
 MAX_ITER = 20           # event iterations at one instant
 DEFAULT_BACKEND = "sundae"
@@ -133,16 +133,33 @@ class _Run:
         self.t0, self.t_end = t0, t_end
         self.opts = dict(rtol=rtol, atol=atol, max_step=max_step or 0.0,
                          max_num_steps=max_steps, linsolver=linsolver)
-        self.T, self.Y, self.YP, self.D = [], [], [], []
+        self.T, self.Y, self.YP, self.D, self.SD = [], [], [], [], []
         self.events, self.event_log = [], []
+        self.firings = {}    # (owner, event name) -> times of its last CHATTER_COUNT firings
         self.nfev = self.njev = self.steps = self.rows = 0
+        self.sens = None   # acausal.sensitivity.SensRun when sensitivities are asked for
+        self._cbs = {}
 
     def record(self, t, y, yp, d):
         self.T.append(np.atleast_1d(np.asarray(t, float)))
         self.Y.append(np.atleast_2d(np.asarray(y, float)))
         self.YP.append(np.atleast_2d(np.asarray(yp, float)))
         self.D.append(np.tile(np.asarray(d, float), (len(self.T[-1]), 1)))
+        if self.sens is not None:
+            self.SD.append(np.tile(self.sens.sd_all.ravel(), (len(self.T[-1]), 1)))
         self.rows += len(self.T[-1])
+
+    def callbacks(self, d):
+        """Mode ``d``'s generated callbacks, as the backend serves them to
+        the loop (the compiled backend's call C: :meth:`SegmentSolver.callbacks`),
+        made once per mode of the run (contacts switch back and forth)."""
+        if self.sens is not None:   # the augmented model's own callbacks (Python)
+            return self.cm.callbacks(self.p, d)
+        key = tuple(map(float, d))
+        cb = self._cbs.get(key)
+        if cb is None:
+            cb = self._cbs[key] = self.solver().callbacks(self.cm.callbacks(self.p, d), d)
+        return cb
 
     def solver(self):
         """The segment solver of this run (:mod:`acausal.backends`), made once."""
@@ -161,15 +178,23 @@ class _Run:
             stats["backend_fallback"] = solver.fallback
         n = len(self.cm.dae.y)
         cat = (lambda blocks, w: np.concatenate(blocks) if blocks else np.zeros((0, w)))
-        return Result(self.cm, self.p, cat(self.T, 0) if self.T else np.zeros(0),
-                      cat(self.Y, n), cat(self.YP, n), cat(self.D, len(self.cm.discretes)),
-                      list(self.events), stats, status, message)
+        T, Y, YP = cat(self.T, 0) if self.T else np.zeros(0), cat(self.Y, n), cat(self.YP, n)
+        D = cat(self.D, len(self.cm.disc_syms))
+        if self.sens is None:
+            return Result(self.cm, self.p, T, Y, YP, D, list(self.events), stats, status,
+                          message)
+        sm = self.cm   # the augmented model (acausal.sensitivity)
+        res = Result(sm.base, self.p, T, sm.unpack(Y)[0], sm.unpack(YP)[0],
+                     D[:, :len(sm.base.disc_syms)], list(self.events), stats, status, message)
+        SD = cat(self.SD, self.sens.sd_all.size)
+        res.sensitivities = self.sens.result_data(T, Y, YP, D, SD, len(self.events))
+        return res
 
 
 def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_step=None,
              output_times=None, max_step=None, max_steps=100000, atol_algebraic=None,
              backend=None, max_rows=MAX_ROWS, max_wall=None, max_total_steps=None,
-             progress=False, linsolver="auto"):
+             progress=False, linsolver="auto", sensitivities=None):
     """Simulate a :class:`CompiledModel` from ``t0`` to ``t_end`` (or until a
     terminal event). ``params`` overrides parameter values, and the start
     values of variables whose start is fixed, by dotted path (both are
@@ -205,17 +230,33 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
 
     ``linsolver``: IDA's linear solver, see
     :meth:`acausal.compile.CompiledModel.linear_solver` (``"auto"`` chooses
-    band for large models with a narrow band, else dense)."""
+    band for large models with a narrow band, else dense).
+
+    ``sensitivities``: names of free parameters; the run then also integrates
+    the forward sensitivities of every unknown with respect to them, with
+    their jumps at events (:mod:`acausal.sensitivity`), on either backend:
+    ``res.sensitivity("body.x", "spring.c")`` is d(body.x)/d(spring.c) at
+    every ``res.t``, ``res.event_sensitivity("spring.c")`` the derivatives of
+    the event times."""
     wall0 = _time.perf_counter()
     backend = _backend(backend)
     params, starts = cm.split_overrides(params)
     p = cm.param_vector(params)
     d = cm.discrete_start()
-    run = _Run(cm, p, t0, t_end, rtol, _atol_vector(cm, atol, atol_algebraic), max_step,
-               max_steps, backend, linsolver)
-    cb = cm.callbacks(p, d)
+    atol = _atol_vector(cm, atol, atol_algebraic)
+    model = cm
+    if sensitivities:
+        from .sensitivity import SensRun, sensitivity_model
+        model = sensitivity_model(cm, sensitivities)
+        atol = model.atol(atol, p)
+    run = _Run(model, p, t0, t_end, rtol, atol, max_step, max_steps, backend, linsolver)
+    cb = cm.callbacks(p, d) if sensitivities else run.callbacks(d)
     run.cb_d = list(d)
     y, yp = initial_point(cm, p, d, cb, t0, starts)
+    if sensitivities:
+        run.sens = SensRun(model, p, t_end - t0)
+        y, yp, d, cb = run.sens.start(p, d, t0, y, yp, starts)
+        run.cb_d = list(d)
     y, yp, d, cb, stop = _event_iteration(run, cb, t0, y, yp, d, initial=True)
     _check_output_size(cm, t0, t_end, output_step, output_times, max_rows)
     tout = _output_times(t0, t_end, output_step, output_times)
@@ -233,12 +274,13 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
             if len(seg.t) > 1:
                 run.record(seg.t[1:], seg.y[1:], seg.yp[1:], d)
             if seg.status < 0:
-                raise _failure(run, cm, seg, cb)
+                _observers(run, cb, seg, d)   # those located before it (a dead-centre warning)
+                raise _failure(run, run.cm, seg, cb)
             t, y, yp = float(seg.t[-1]), np.array(seg.y[-1]), np.array(seg.yp[-1])
             watch.check(t)
             d, fired = _observers(run, cb, seg, d)
             if d != run.cb_d:
-                cb = cm.callbacks(run.p, d)
+                cb = run.callbacks(d)
             run.cb_d = list(d)
             if seg.status != 2:
                 if tspan[-1] < t_end:   # the end of a window of the watch
@@ -478,7 +520,10 @@ def _observers(run, cb, seg, d):
         te = root.t
         state = EventState(cm, run.p, d, te, cb[4](te, root.y, root.yp))
         before = list(d)
+        taus = run.sens.event_times(te, root.y, root.yp, d, obs) if run.sens else None
         for i in obs:
+            if taus is not None:
+                run.sens.note(len(run.events), taus[i])
             _log_event(run, te, cm.events[i])
             cm.events[i].action(state)
         for j, (a, b) in enumerate(zip(before, d)):
@@ -490,6 +535,10 @@ def _observers(run, cb, seg, d):
                         "make it a regular event", t=te, component=cm.events[obs[0]].owner)
                 rows = run.T[-1] >= te
                 run.D[-1][rows, j] = b
+        if run.sens is not None:
+            run.sens.observer_actions([cm.events[i] for i in obs], te, root.y, root.yp, before,
+                                      state._obs, taus)
+            run.SD[-1][run.T[-1] >= te] = run.sens.sd_all.ravel()
     return d, final
 
 
@@ -497,26 +546,42 @@ def _handle(run, cb, t, y, yp, d, fired):
     cm = run.cm
     n_ev = len(cm.events)
     d = list(d)
+    d_before = list(d)
     obs = cb[4](t, y, yp)
     state = EventState(cm, run.p, d, t, obs)
     stop = False
+    taus = run.sens.event_times(t, y, yp, d, fired, current=True) if run.sens else None
     for i in fired:
         if i >= n_ev:
             a = cm.assertions[i - n_ev]
             raise SolverError(f"{a.owner}: {a.message} (at t = {t:.6g} s)", t=t,
                               component=a.owner, result=run.result("failed", a.message))
         ev = cm.events[i]
+        if taus is not None:
+            run.sens.note(len(run.events), taus[i])
         _log_event(run, t, ev)
         if ev.action is not None:
             ev.action(state)
         if ev.terminal:
             stop = True
     if state.changed:
-        cb = cm.callbacks(run.p, d)
-        y, yp = reinitialize(cm, cb, t, y, yp)
+        d, cb, y, yp = _new_mode(run, [cm.events[i] for i in fired], t, y, yp, d_before, d,
+                                 obs)
         y, yp, d, cb, stop2 = _event_iteration(run, cb, t, y, yp, d)
         stop = stop or stop2
+    if run.sens is not None:
+        run.sens.dtau[:] = 0.0   # the instant is over
     return y, yp, d, cb, stop
+
+
+def _new_mode(run, events, t, y, yp, d_before, d, obs):
+    """(d, callbacks, y, y') of the mode ``d`` that ``events`` set, re-initialised
+    at ``t``; with sensitivities, their jumps (:meth:`acausal.sensitivity.SensRun.mode_change`)."""
+    if run.sens is not None:
+        return run.sens.mode_change(events, t, y, yp, d_before, d, obs)
+    cb = run.callbacks(d)
+    y, yp = reinitialize(run.cm, cb, t, y, yp)
+    return d, cb, y, yp
 
 
 def _event_iteration(run, cb, t, y, yp, d, initial=False):
@@ -530,34 +595,42 @@ def _event_iteration(run, cb, t, y, yp, d, initial=False):
         cb[2](t, y, yp, g)
         obs = cb[4](t, y, yp)
         state = EventState(cm, run.p, list(d), t, obs)
+        fired = []
         for i in checks:
             ev = cm.events[i]
             if (ev.direction < 0 and g[i] < 0) or (ev.direction > 0 and g[i] > 0):
+                if run.sens is not None:
+                    run.sens.note(len(run.events), run.sens.dtau)
                 _log_event(run, t, ev)
+                fired.append(ev)
                 if ev.action is not None:
                     ev.action(state)
         if not state.changed:
             return y, yp, d, cb, False
-        d = state.d
-        cb = cm.callbacks(run.p, d)
-        y, yp = reinitialize(cm, cb, t, y, yp)
+        d, cb, y, yp = _new_mode(run, fired, t, y, yp, d, state.d, obs)
     raise ChatteringError(f"event iteration did not settle at t = {t:.6g} s "
                           f"({MAX_ITER} mode changes at one instant) in "
                           + ", ".join(sorted({cm.events[i].owner for i in checks})), t=t)
 
 
 def _log_event(run, t, ev):
+    """Record an event; a ChatteringError when this same event (one root of
+    one component) has fired CHATTER_COUNT times within CHATTER_SPAN of the
+    run's span: its mode logic toggles without time advancing (Zeno). Many
+    different roots firing at one instant (199 contacts of a Newton's
+    cradle closing at t = 0) are not chattering: each fires once."""
     run.events.append((t, ev.name))
     run.event_log.append((t, ev.owner))
-    if len(run.event_log) >= CHATTER_COUNT:
-        t_first = run.event_log[-CHATTER_COUNT][0]
-        span = CHATTER_SPAN * max(run.t_end - run.t0, 1e-300)
-        if t - t_first <= span:
-            owners = sorted({o for _, o in run.event_log[-CHATTER_COUNT:]})
-            raise ChatteringError(
-                f"chattering: {CHATTER_COUNT} events between t = {t_first:.9g} and "
-                f"{t:.9g} s in {', '.join(owners)}; the mode logic does not settle", t=t,
-                component=owners[0], result=run.result("failed", "chattering"))
+    times = run.firings.get((ev.owner, ev.name))
+    if times is None:
+        times = run.firings[ev.owner, ev.name] = deque(maxlen=CHATTER_COUNT)
+    times.append(t)
+    if len(times) == CHATTER_COUNT and \
+            t - times[0] <= CHATTER_SPAN * max(run.t_end - run.t0, 1e-300):
+        raise ChatteringError(
+            f"chattering: event {ev.name} of {ev.owner} fired {CHATTER_COUNT} times between "
+            f"t = {times[0]:.9g} and {t:.9g} s; the mode logic does not settle", t=t,
+            component=ev.owner, result=run.result("failed", "chattering"))
 
 
 def _failure(run, cm, sol, cb):

@@ -19,7 +19,7 @@ import sympy as sp
 
 from .errors import StructuralError
 from .fastdiff import diff
-from .symbols import base_and_order, der, total_derivative
+from .symbols import base_and_order, der, ordered, total_derivative
 
 
 class Graph:
@@ -60,7 +60,7 @@ class Graph:
         self.eexpr.append(expr)
         self.eder.append(-1)
         self.eorig.append(origin)
-        self.inc.append({self._var(s) for s in expr.free_symbols if self.is_var(s)})
+        self.inc.append({self._var(s) for s in ordered(expr.free_symbols) if self.is_var(s)})
         return i
 
     def differentiate_eq(self, i):
@@ -91,7 +91,7 @@ def check_structure(equations, unknowns, flat):
     index = {x: j for j, x in enumerate(unknowns)}
     rows, cols = [], []
     for i, eq in enumerate(equations):
-        for s in eq.expr.free_symbols:
+        for s in ordered(eq.expr.free_symbols):
             b = base_and_order(s)[0]
             if b in index:
                 rows.append(i)
@@ -163,7 +163,7 @@ def pantelides(g, max_rounds=None):
 
     def augment(i, vcol, ecol):
         ecol.add(i)
-        cands = [j for j in g.inc[i] if g.vder[j] == -1]
+        cands = sorted(j for j in g.inc[i] if g.vder[j] == -1)
         for j in cands:
             if j not in assign:
                 assign[j] = i
@@ -189,11 +189,11 @@ def pantelides(g, max_rounds=None):
                 raise StructuralError(
                     "index reduction did not converge: the model is structurally singular "
                     f"(around {g.eorig[k].describe()})", excess=[g.eorig[k]])
-            for j in vcol:
+            for j in sorted(vcol):
                 g.differentiate_var(j)
-            for l in ecol:
+            for l in sorted(ecol):
                 g.differentiate_eq(l)
-            for j in vcol:
+            for j in sorted(vcol):
                 assign[g.vder[j]] = g.eder[assign[j]]
             i = g.eder[i]
     return assign

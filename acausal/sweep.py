@@ -244,6 +244,28 @@ def _repair_tail(path: Path) -> None:
             warnings.warn(f"{path}: dropped an incomplete last line", RuntimeWarning, stacklevel=3)
 
 
+def column_label(name: str, units: Mapping[str, str] | None) -> str:
+    """The CSV header of column ``name``: ``"name [unit]"`` when its unit is
+    known (the data folders' convention, :mod:`acausal.data`), else ``name``."""
+    unit = (units or {}).get(name)
+    return f"{name} [{unit}]" if unit else name
+
+
+def _column_name(label: str) -> str:
+    """``"thrt [s]"`` -> ``"thrt"``: the column's name without its unit."""
+    m = re.fullmatch(r"(.*\S)\s*\[[^\[\]]*\]", label.strip())
+    return m.group(1) if m else label.strip()
+
+
+def read_rows(path: str | Path) -> list[dict[str, str]]:
+    """A sweep CSV's rows as dicts keyed by column name (units stripped from
+    the ``"name [unit]"`` header), cells as written."""
+    with open(path, newline="", encoding="utf-8") as f:
+        reader = csv.reader(f)
+        names = [_column_name(h) for h in next(reader, [])]
+        return [dict(zip(names, line)) for line in reader]
+
+
 def _check_header(path: Path, header: list[str], columns: Sequence[str]) -> None:
     if len(set(header)) != len(header) or set(header) != set(columns):
         raise UsageError(
@@ -262,6 +284,7 @@ def _load_cells(path: Path, params: Sequence[str], measures: Sequence[str]) -> t
         header = next(reader, None)
         if header is None:
             return None, {}
+        header = [_column_name(h) for h in header]
         _check_header(path, header, [*params, *measures, *RESERVED])
         cells_by_key, bad = {}, 0
         for line in reader:
@@ -279,15 +302,17 @@ def _load_cells(path: Path, params: Sequence[str], measures: Sequence[str]) -> t
     return header, cells_by_key
 
 
-def _write_csv(path: Path, header: Sequence[str], rows: Iterable[Mapping[str, str]]) -> None:
+def _write_csv(path: Path, header: Sequence[str], rows: Iterable[Mapping[str, str]],
+               units: Mapping[str, str] | None = None) -> None:
     """Write the whole CSV to a temporary file, then rename it over ``path``:
-    a reader (or a kill) never sees a half-written file."""
+    a reader (or a kill) never sees a half-written file. The header labels
+    carry ``units`` (:func:`column_label`)."""
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
     with open(tmp, "w", newline="", encoding="utf-8") as f:
-        writer = csv.DictWriter(f, fieldnames=list(header), lineterminator="\n")
-        writer.writeheader()
-        writer.writerows(rows)
+        writer = csv.writer(f, lineterminator="\n")
+        writer.writerow([column_label(c, units) for c in header])
+        writer.writerows([row.get(c, "") for c in header] for row in rows)
     os.replace(tmp, path)
 
 
@@ -298,8 +323,10 @@ class _Journal:
 
     CSV_EVERY_S = 2.0
 
-    def __init__(self, out_csv: Path, store: Checkpoint | None, header: Sequence[str], cells: dict):
+    def __init__(self, out_csv: Path, store: Checkpoint | None, header: Sequence[str], cells: dict,
+                 units: Mapping[str, str] | None = None):
         self.out_csv, self.store, self.header, self.cells = out_csv, store, list(header), cells
+        self.units = dict(units or {})
         self.written = time.monotonic()
 
     def add(self, key: tuple, cells: dict[str, str]) -> None:
@@ -310,11 +337,11 @@ class _Journal:
             self.write_csv()
 
     def write_csv(self) -> None:
-        _write_csv(self.out_csv, self.header, self.cells.values())
+        _write_csv(self.out_csv, self.header, self.cells.values(), self.units)
         self.written = time.monotonic()
 
 
-def _open_journal(out_csv: Path, params, measures, checkpoint, inputs) -> _Journal:
+def _open_journal(out_csv: Path, params, measures, checkpoint, inputs, units=None) -> _Journal:
     """The CSV's rows merged with the checkpoint's (a run killed before its
     last CSV write left points only there)."""
     header, cells = _load_cells(out_csv, params, measures)
@@ -330,7 +357,7 @@ def _open_journal(out_csv: Path, params, measures, checkpoint, inputs) -> _Journ
         if store.ignored:
             warnings.warn(f"{store.path}: ignored {store.ignored} damaged record(s); those points "
                           "will be recomputed", RuntimeWarning, stacklevel=3)
-    return _Journal(out_csv, store, header or [*params, *measures, *RESERVED], cells)
+    return _Journal(out_csv, store, header or [*params, *measures, *RESERVED], cells, units)
 
 
 def _parse_cells(saved: Any, params: Sequence[str], measures: Sequence[str]) -> dict[str, str]:
@@ -427,6 +454,7 @@ def run_sweep(
     progress: bool = True,
     checkpoint: str | Path | None | bool = None,
     inputs: Sequence[Any] = (),
+    units: Mapping[str, str] | None = None,
 ) -> SweepRows:
     """Run ``task(point)`` for every point not already in ``out_csv``.
 
@@ -451,6 +479,9 @@ def run_sweep(
         inputs: what else the points' results depend on (e.g. the model
             file as a :class:`~pathlib.Path`, options), hashed into the
             checkpoint's name: a checkpoint of other inputs is not reused.
+        units: column name -> unit, written into the header as
+            ``"name [unit]"``. A resumed file's
+            header is read with or without units.
 
     Returns:
         :class:`SweepRows` (a list) with one row per point, in ``points`` order:
@@ -466,7 +497,7 @@ def run_sweep(
     params = _param_names(points)
     measures = _check_measures(measures, params)
     out_csv = Path(out_csv)
-    journal = _open_journal(out_csv, params, measures, checkpoint, inputs)
+    journal = _open_journal(out_csv, params, measures, checkpoint, inputs, units)
     todo = list({_key(p, params): p for p in points if _key(p, params) not in journal.cells}.values())
     if todo and executor.needs_pickle:
         _check_picklable(task)

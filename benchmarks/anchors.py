@@ -19,7 +19,11 @@ from sympy to CasADi SX (F(t, y, y') = 0 in semi-explicit form: x' = w,
 parameters, so one integrator serves every mode. It starts from acausal's
 consistent initial point (computed once, outside the timing).
 
-    python benchmarks/anchors.py [--repeat N] [--no-jit]
+    python benchmarks/anchors.py [--repeat N] [--no-jit] [--cpu]
+
+``--cpu`` times CPU seconds of this process instead of wall time (every
+engine here is single-threaded): steadier on a shared machine. The load
+average is printed with the table.
 """
 import argparse
 import os
@@ -267,6 +271,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--repeat", type=int, default=10)
     ap.add_argument("--no-jit", action="store_true")
+    ap.add_argument("--cpu", action="store_true", help="CPU time instead of wall time")
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
     mf, cm = compile_file(os.path.join(ROOT, "models", "breaker_24kv.py"))
@@ -302,13 +307,16 @@ def main(argv=None):
                      _thrt(events)))
         runs.append((label + ", events given", lambda c=cas, e=events:
                      c.replay(p, d, 0.0, y, yp, e), _thrt(events)))
-    times = best_interleaved([fn for _, fn, _ in runs], args.repeat)
+    load0 = os.getloadavg()[0]
+    times = best_interleaved([fn for _, fn, _ in runs], args.repeat,
+                             time.process_time if args.cpu else time.perf_counter)
     anchor = min(tm for (lab, _, _), tm in zip(runs, times)
                  if lab.startswith("CasADi") and "given" not in lab)
     bound = min(tm for (lab, _, _), tm in zip(runs, times) if "given" in lab)
     ref = runs[0][2]
-    print(f"\nbest of {args.repeat}, interleaved; THRT difference against acausal sundae "
-          "(benchmark options)")
+    print(f"\nbest of {args.repeat}, interleaved, {'CPU' if args.cpu else 'wall'} time (load "
+          f"{load0:.1f} before, {os.getloadavg()[0]:.1f} after); THRT difference against "
+          "acausal sundae (benchmark options)")
     print(f"{'engine':58s} {'ms/sim':>8s} {'x CasADi':>9s} {'THRT [ms]':>12s} {'dTHRT [s]':>10s}")
     for (lab, _, thrt), tm in zip(runs, times):
         print(f"{lab:58s} {tm * 1e3:8.2f} {tm / anchor:9.2f} {thrt * 1e3:12.7f} "

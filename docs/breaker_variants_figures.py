@@ -5,12 +5,13 @@
 
 Prints the markdown tables and writes docs/breaker_variants_sweep.png.
 """
-import csv
 import math
 import sys
 from pathlib import Path
 
 import numpy as np
+
+from acausal.sweep import read_rows
 
 DESIGNS = [  # (csv stem, label)
     ("breaker_24kv", "base (plunger armature, one hook)"),
@@ -23,8 +24,7 @@ MA, MEFF_ROT = 0.22, 1.0e-4 / 0.025**2   # [kg] plunger mass, clapper Ja/la^2
 
 def load(folder, stem):
     """Rows of one sweep sorted by v_impact, as dicts of floats (ok rows only)."""
-    with open(Path(folder, f"{stem}.csv"), newline="") as f:
-        rows = [r for r in csv.DictReader(f)]
+    rows = read_rows(Path(folder, f"{stem}.csv"))
     bad = [r for r in rows if r["status"] != "ok"]
     if bad:
         print(f"warning: {stem}: {len(bad)} failed point(s)", file=sys.stderr)

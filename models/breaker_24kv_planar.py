@@ -10,8 +10,10 @@ and theta3 (main shaft) are the counter-clockwise joint angles of the
 revolutes (acausal.connectors: angles counter-clockwise positive)::
 
     A (main shaft, origin) ----- f ----- O (hook shaft, frame turned by pi)
-     shaft_pin: theta3                    hook_pin: theta1
-       rocker r1 -> C  roller_pin  coupler r2 + r3  cam_pin  D <- crank e
+     cam.pin_b: theta3                    cam.pin_a: theta1
+       rocker r1 -> C  cam.pin_c  coupler r2 + r3  cam.pin_d  D <- crank e
+
+(the shared sub-assembly :class:`acausal.mechanics.planar.linkages.FourBarLinkage`).
 
 The links are massless (as the closed form): the hook and main-shaft
 inertias stay on the 1-D side. Same run and measures as the base file.
@@ -19,49 +21,30 @@ inertias stay on the 1-D side. Same run and measures as the base file.
 from breaker_24kv import (BH_CAL, FREE_PARAMETERS, K_CAL, MEASURES, THETA1_0, Armature,
                           MainShaft, TriggerHook, release_experiment)
 
-from acausal import Model, guess
-from acausal.mechanics.contact import Contact
-from acausal.mechanics.fourbar import fourbar_angles
-from acausal.mechanics.planar.joints import Revolute
-from acausal.mechanics.planar.parts import Fixed, FixedTranslation
-
 import math
 
+from acausal import Model
+from acausal.mechanics.contact import Contact
+from acausal.mechanics.fourbar import fourbar_angles
+from acausal.mechanics.planar.linkages import FourBarLinkage
 
-class PlanarCamRoller(Model):
-    """The report's cam-and-roller four-bar (Table 1: e, f, r1, r2 + r3) from
-    planar parts. Connectors: ``flange_a`` (hook shaft, theta1),
-    ``flange_b`` (main shaft, theta3), both rotational, absolute angles
-    (their joints' frame_a are fixed)."""
 
-    def __init__(self, theta1=0.0, **kw):
-        super().__init__(**kw)
-        e = self.parameter("e", 0.0002, "m", "cam eccentricity (crank)", min=0.0, min_open=True)
-        f = self.parameter("f", 0.125, "m", "hook shaft - main shaft distance", min=0.0,
-                           min_open=True)
-        r1 = self.parameter("r1", 0.116, "m", "roller lever (rocker)", min=0.0, min_open=True)
-        r2 = self.parameter("r2", 0.036, "m", "roller radius", min=0.0)
-        r3 = self.parameter("r3", 0.0533, "m", "cam-circle radius", min=0.0)
-        th2, th3 = fourbar_angles(theta1)          # start guesses (Table 1 geometry)
-        self.ground_A = Fixed()
-        self.ground_O = Fixed(x0=f, phi0=math.pi)
-        self.hook_pin = Revolute(phi=guess(theta1))
-        self.crank = FixedTranslation(rx=e, ry=0.0)
-        self.shaft_pin = Revolute(phi=guess(th3))
-        self.rocker = FixedTranslation(rx=r1, ry=0.0)
-        self.roller_pin = Revolute(phi=guess(-th2 - th3))
-        self.coupler = FixedTranslation(rx=r2 + r3, ry=0.0)
-        self.cam_pin = Revolute(phi=guess(-th2 - math.pi - theta1))
-        self.connect(self.ground_O.frame, self.hook_pin.frame_a)
-        self.connect(self.hook_pin.frame_b, self.crank.frame_a)
-        self.connect(self.ground_A.frame, self.shaft_pin.frame_a)
-        self.connect(self.shaft_pin.frame_b, self.rocker.frame_a)
-        self.connect(self.rocker.frame_b, self.roller_pin.frame_a)
-        self.connect(self.roller_pin.frame_b, self.coupler.frame_a)
-        self.connect(self.coupler.frame_b, self.cam_pin.frame_b)
-        self.connect(self.crank.frame_b, self.cam_pin.frame_a)
-        self.flange_a = self.hook_pin.axis
-        self.flange_b = self.shaft_pin.axis
+TABLE1 = dict(e=0.0002, f=0.125, r1=0.116, r2=0.036, r3=0.0533)   # [m] the report's
+
+
+class PlanarCamRoller(FourBarLinkage):
+    """The report's cam-and-roller four-bar (Table 1: e, f, r1, r2 + r3) as
+    a :class:`~acausal.mechanics.planar.linkages.FourBarLinkage`: crank
+    ``a = e`` on the hook shaft O at (f, 0) with its zero direction towards
+    A (``phia = pi``), rocker ``b = r1`` on the main shaft A at the origin,
+    coupler ``c = r2 + r3`` (roller centre C to cam-circle centre D).
+    Connectors: ``flange_a`` (hook shaft, theta1), ``flange_b`` (main shaft,
+    theta3), both rotational, absolute angles."""
+
+    def __init__(self, theta1=0.0, geometry=TABLE1):
+        g = geometry
+        super().__init__(theta_a0=theta1, mode=1, xa=g["f"], ya=0.0, phia=math.pi, xb=0.0,
+                         yb=0.0, phib=0.0, a=g["e"], b=g["r1"], c=g["r2"] + g["r3"])
 
 
 def build(v_impact=3.8, K=8.3e9, bh=0.219):

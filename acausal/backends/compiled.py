@@ -37,7 +37,9 @@ from sympy.printing.codeprinter import PrintMethodNotImplementedError
 from ..codegen_c import generate_c
 from . import Root, Segment, SegmentSolver
 
-_DRIVER = os.path.join(os.path.dirname(os.path.abspath(__file__)), "ida_driver.c")
+_HERE = os.path.dirname(os.path.abspath(__file__))
+_DRIVER = os.path.join(_HERE, "ida_driver.c")
+_REINIT = os.path.join(_HERE, "reinit.c")     # the re-initialisation Newton in C
 _LIBS = ("sundials_core", "sundials_nvecserial", "sundials_sunmatrixdense",
          "sundials_sunlinsoldense", "sundials_ida")
 _ROOT, _FULL = 2, 99
@@ -102,7 +104,7 @@ def _key(cm, cc, libs):
     without generating C again."""
     import acausal.codegen_c as gen
     parts = [cm.source, cc] + libs
-    for path in (_DRIVER, gen.__file__):
+    for path in (_DRIVER, _REINIT, gen.__file__):
         with open(path) as fh:
             parts.append(fh.read())
     return hashlib.sha256("\0".join(parts).encode()).hexdigest()[:24]
@@ -143,7 +145,7 @@ def _compile(cm, cc, libs, out):
             fh.write(csrc.text)
         tmp_so = os.path.join(tmpdir, "lib.so")
         libdir = os.path.dirname(libs[0])
-        cmd = cc.split() + ["-O1", "-shared", "-fPIC", "-o", tmp_so, _DRIVER, model_c] + \
+        cmd = cc.split() + ["-O1", "-shared", "-fPIC", "-o", tmp_so, _DRIVER, _REINIT, model_c] + \
             libs + [f"-Wl,-rpath,{libdir}", "-lm"]
         proc = subprocess.run(cmd, capture_output=True, text=True)
         if proc.returncode != 0:
@@ -167,14 +169,51 @@ class _Library:
         lib.acs_new.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_int, ctypes.c_double, dp,
                                 dp, ip, ctypes.c_double, ctypes.c_long]
         lib.acs_free.argtypes = [vp]
-        lib.acs_start.argtypes = [vp, ctypes.c_double, dp, dp, dp, ctypes.c_double]
-        lib.acs_advance.argtypes = [vp, dp, ctypes.c_int, ip, ctypes.c_int, dp, dp, dp,
-                                    ctypes.c_int, ip, dp, dp, dp, ip]
-        lib.acs_counters.argtypes = [vp, ctypes.POINTER(ctypes.c_long)]
+        # arrays go in as raw addresses (``a.ctypes.data``: cheaper per call)
+        lib.acs_start.argtypes = [vp, ctypes.c_double, vp, vp, vp, ctypes.c_double]
+        lib.acs_advance.argtypes = [vp, vp, ctypes.c_int, ip, ctypes.c_int, vp, vp, vp,
+                                    ctypes.c_int, ip, vp, vp, vp, vp]
+        lib.acs_counters.argtypes = [vp, vp]
         lib.acs_flag_name.restype = ctypes.c_char_p
         lib.acs_flag_name.argtypes = [ctypes.c_long]
         lib.acs_eval.argtypes = [ctypes.c_int, ctypes.c_double, dp, dp, dp, ctypes.c_double,
                                  dp]
+        # the generated functions and the re-initialisation, called from
+        # Python with raw addresses (see CCallbacks)
+        lib.acs_res.argtypes = [ctypes.c_double, vp, vp, vp, vp]
+        lib.acs_roots.argtypes = [ctypes.c_double, vp, vp, vp, vp]
+        lib.acs_jacs.argtypes = [ctypes.c_double, vp, vp, vp, vp, vp]
+        lib.acs_reinit.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_double, vp, vp, vp]
+        lib.acs_observe.argtypes = [ctypes.c_double, vp, vp, vp, vp]
+        lib.acs_init_newton.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_double, vp, vp,
+                                        ctypes.c_int, vp, vp, ctypes.c_int, vp, ctypes.c_int]
+        self.n_fixed = sum(1 for nm in cm.var_names if cm.flat.variables[nm].start.fixed)
+        self.n_obs = len(cm.var_names) if lib.acs_has_observe() else None
+        self.idle = {}
+        weakref.finalize(self, _free_idle, lib, self.idle)
+
+
+    # IDA handles of finished runs, by settings: every segment starts with
+    # IDAReInit (acs_start), so a later run of the model takes one over
+    # instead of creating SUNDIALS objects again
+    IDLE = 2   # kept per setting
+
+    def take(self, key):
+        idle = self.idle.get(key)
+        return idle.pop() if idle else None
+
+    def give(self, key, h):
+        idle = self.idle.setdefault(key, [])
+        if len(idle) < self.IDLE:
+            idle.append(h)
+        else:
+            self.lib.acs_free(ctypes.c_void_p(h))
+
+
+def _free_idle(lib, idle):
+    for handles in idle.values():
+        for h in handles:
+            lib.acs_free(ctypes.c_void_p(h))
 
 
 def library(cm):
@@ -209,12 +248,13 @@ class CompiledSolver(SegmentSolver):
         self.dirs = np.array([e.direction for e in cm.events] + [-1] * len(cm.assertions)
                              or [0], dtype=np.intc)
         self.terminal = [not e.observer for e in cm.events] + [True] * len(cm.assertions)
-        self.h = L.lib.acs_new(n, self.nr, L.n_pd, float(opts["rtol"]), _ptr(atol),
-                               _ptr(ident), _ptr(self.dirs, ctypes.c_int),
-                               float(opts.get("max_step") or 0.0), int(opts["max_num_steps"]))
+        rtol, hmax = float(opts["rtol"]), float(opts.get("max_step") or 0.0)
+        key = (rtol, atol.tobytes(), hmax, int(opts["max_num_steps"]))
+        self.h = L.take(key) or L.lib.acs_new(n, self.nr, L.n_pd, rtol, _ptr(atol), _ptr(ident),
+                                              _ptr(self.dirs, ctypes.c_int), hmax, key[3])
         if not self.h:
             raise Unavailable("SUNDIALS refused the solver settings")
-        self._free = weakref.finalize(self, L.lib.acs_free, ctypes.c_void_p(self.h))
+        self._free = weakref.finalize(self, L.give, key, self.h)
         self.troot = np.zeros(1)
         self.yroot, self.yproot = np.zeros(n), np.zeros(n)
         self.rootinfo = np.zeros(max(self.nr, 1), dtype=np.intc)
@@ -223,23 +263,25 @@ class CompiledSolver(SegmentSolver):
     def solve(self, cb, d, t, y, yp, tout, every_step):
         L, n = self.L.lib, self.n
         tout = np.ascontiguousarray(tout, dtype=float)
-        y0, yp0 = np.ascontiguousarray(y, float), np.ascontiguousarray(yp, float)
-        pd = np.ascontiguousarray(np.concatenate([self.p, np.asarray(d, float)]))
-        flag = L.acs_start(self.h, float(t), _ptr(y0), _ptr(yp0), _ptr(pd), float(tout[-1]))
+        y0, yp0 = np.array(y, float), np.array(yp, float)
+        pd = np.concatenate([self.p, np.asarray(d, float)])
+        flag = L.acs_start(self.h, float(t), y0.ctypes.data, yp0.ctypes.data, pd.ctypes.data,
+                           float(tout[-1]))
         if flag < 0:
             return Segment(np.array([t]), y0[None], yp0[None], flag, self._message(flag))
         cap = 1024 if every_step else len(tout) + 1
         T, Y, YP = [np.array([t])], [y0[None]], [yp0[None]]
         roots, iout, nrows = [], ctypes.c_int(0), ctypes.c_int(0)
+        bt, by, byp = np.empty(cap), np.empty((cap, n)), np.empty((cap, n))
+        ptrs = (bt.ctypes.data, by.ctypes.data, byp.ctypes.data, cap, ctypes.byref(nrows),
+                self.troot.ctypes.data, self.yroot.ctypes.data, self.yproot.ctypes.data,
+                self.rootinfo.ctypes.data)
         while True:
-            bt, by, byp = np.empty(cap), np.empty((cap, n)), np.empty((cap, n))
-            flag = L.acs_advance(self.h, _ptr(tout), len(tout), ctypes.byref(iout),
-                                 int(bool(every_step)), _ptr(bt), _ptr(by), _ptr(byp), cap,
-                                 ctypes.byref(nrows), _ptr(self.troot), _ptr(self.yroot),
-                                 _ptr(self.yproot), _ptr(self.rootinfo, ctypes.c_int))
+            flag = L.acs_advance(self.h, tout.ctypes.data, len(tout), ctypes.byref(iout),
+                                 int(bool(every_step)), *ptrs)
             k = nrows.value
             if k:
-                T.append(bt[:k]), Y.append(by[:k]), YP.append(byp[:k])
+                T.append(bt[:k].copy()), Y.append(by[:k].copy()), YP.append(byp[:k].copy())
             if flag == _FULL:
                 continue
             if flag != _ROOT:
@@ -251,7 +293,7 @@ class CompiledSolver(SegmentSolver):
                 T.append(self.troot.copy()), Y.append(self.yroot[None].copy())
                 YP.append(self.yproot[None].copy())
                 break
-        L.acs_counters(self.h, self.counters.ctypes.data_as(ctypes.POINTER(ctypes.c_long)))
+        L.acs_counters(self.h, self.counters.ctypes.data)
         steps, nfev, njev = (int(c) for c in self.counters)
         return Segment(np.concatenate(T), np.concatenate(Y), np.concatenate(YP),
                        int(flag) if flag < 0 else (_ROOT if flag == _ROOT else 0),
@@ -262,3 +304,88 @@ class CompiledSolver(SegmentSolver):
             return "ok"
         name = self.L.lib.acs_flag_name(flag)
         return _MESSAGES.get(flag, "IDA failed") + (f" ({name.decode()})" if name else "")
+
+    def callbacks(self, cb, d):
+        """``cb`` (mode ``d``'s generated callbacks) calling the compiled
+        library where it can: see :class:`CCallbacks`."""
+        return CCallbacks(self.L, self.cm, self.p, d, cb)
+
+
+def _f64(a):
+    """``a`` as a C-contiguous float64 array (``a`` itself when it is one)."""
+    if type(a) is np.ndarray and a.dtype == np.float64 and a.flags.c_contiguous:
+        return a
+    return np.ascontiguousarray(a, dtype=float)
+
+
+def _into(fn, out, *args):
+    """Call ``fn(*args, address of out)``, through a temporary when ``out``
+    is not a C-contiguous float64 array."""
+    buf = _f64(out)
+    fn(*args, buf.ctypes.data)
+    if buf is not out:
+        out[...] = buf.reshape(np.shape(out))
+
+
+class CCallbacks(tuple):
+    """The callbacks tuple of one mode (``cm.callbacks(p, d)``, same order
+    and signatures) with the residual, the root functions and the two
+    Jacobians ``jacs`` calling the compiled C instead of the generated
+    Python (the same expressions), for what the hybrid loop computes in
+    Python between segments: the initialisation, event actions and
+    re-initialisation. ``reinit(t, y, yp)`` is the re-initialisation in C
+    (``reinit.c``; :func:`acausal.initialize.reinitialize` calls it), or
+    None where the Python version must run; ``init_newton(t, z0,
+    guess_rows, fixed)`` the initialisation's Gauss-Newton in C (the same
+    return as :func:`acausal.initialize._newton`, or NotImplemented where the
+    Python version must run). The observed variables (``cb[4]``, an array
+    here) are C too unless one has no C form."""
+
+    def __new__(cls, L, cm, p, d, cb):
+        lib, n, ns = L.lib, len(cm.dae.y), cm.dae.n_states
+        pd = np.ascontiguousarray(np.concatenate([np.asarray(p, float),
+                                                  np.asarray(d, float)]))
+        pdp = pd.ctypes.data or 0
+
+        def res(t, y, yp, r):
+            y, yp = _f64(y), _f64(yp)
+            _into(lib.acs_res, r, t, y.ctypes.data, yp.ctypes.data, pdp)
+
+        def roots(t, y, yp, g):
+            y, yp = _f64(y), _f64(yp)
+            _into(lib.acs_roots, g, t, y.ctypes.data, yp.ctypes.data, pdp)
+
+        def jacs(t, y, yp, Jy, Jyp):
+            y, yp = _f64(y), _f64(yp)
+            jy = _f64(Jy)
+            _into(lib.acs_jacs, Jyp, t, y.ctypes.data, yp.ctypes.data, pdp, jy.ctypes.data)
+            if jy is not Jy:
+                Jy[...] = jy.reshape(np.shape(Jy))
+
+        def observe(t, y, yp):
+            y, yp = _f64(y), _f64(yp)
+            o = np.empty(L.n_obs)
+            lib.acs_observe(t, y.ctypes.data, yp.ctypes.data, pdp, o.ctypes.data)
+            return o
+
+        def init_newton(t, z0, guess_rows, fixed, max_iter=50):
+            if L.n_obs is None or len(fixed) != L.n_fixed:
+                return NotImplemented
+            z = np.array(z0, dtype=float)
+            fk = np.array([k for k, _, _ in fixed] or [0], dtype=np.intc)
+            fv = np.array([v for _, v, _ in fixed] or [0.0], dtype=float)
+            gk = np.array(list(guess_rows) or [0], dtype=np.intc)
+            flag = lib.acs_init_newton(n, ns, float(t), z.ctypes.data, pdp, len(fixed),
+                                       fk.ctypes.data, fv.ctypes.data, len(guess_rows),
+                                       gk.ctypes.data, max_iter)
+            return z if flag == 0 else (None if flag == 1 else NotImplemented)
+
+        def reinit(t, y, yp):
+            y2, yp2 = np.array(y, dtype=float), np.array(yp, dtype=float)
+            flag = lib.acs_reinit(n, ns, float(t), y2.ctypes.data, yp2.ctypes.data, pdp)
+            return (y2, yp2) if flag == 0 else None
+
+        obs = cb[4] if L.n_obs is None else observe
+        self = super().__new__(cls, (res, cb[1], roots, jacs, obs) + tuple(cb[5:]))
+        self.pd, self.reinit, self.init_newton = pd, reinit, init_newton
+        return self

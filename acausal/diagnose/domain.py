@@ -81,7 +81,11 @@ DOMAINS = {d.name: d for d in (TRANSLATIONAL, ROTATIONAL)}
 
 def domain_name(comp) -> str:
     """'translational', 'rotational' (the first connector's domain; a lever
-    mixes both) or 'generic' for a component without connectors."""
+    mixes both; a planar joint's 1-D axis, its ``diagnosis_flange``) or
+    'generic' for a component without connectors."""
+    flange = getattr(type(comp), "diagnosis_flange", None)
+    if flange is not None:
+        return type(comp.connectors()[flange]).domain
     for c in comp.connectors().values():
         return type(c).domain
     return "generic"

@@ -7,9 +7,9 @@ have (sign convention: :mod:`acausal.connectors`).
 * :class:`VelocityRestitution`: a mixin that makes a contact's coefficient
   of restitution fall linearly with the impact velocity.
 """
-from sympy import Eq, Max, Min, Piecewise
+from sympy import Max, Min, Piecewise
 
-from .. import Component, Discrete, Event, Flange, Parameter, RotFlange, Variable
+from .. import Component, Discrete, Eq, Event, Flange, Parameter, RotFlange, Variable
 
 E_MIN = 0.01   # smallest restitution VelocityRestitution lets the law reach
 

@@ -100,6 +100,39 @@ def weighted_residuals(model, dataset, params, backend=None):
     return np.asarray(vec, float), groups, signals
 
 
+def weighted_jacobian(model, dataset, params, names):
+    """(vector, d vector / d params over ``names``) as
+    :func:`weighted_residuals`, the Jacobian from one simulation per
+    experiment with forward sensitivities (:mod:`acausal.sensitivity`; a
+    measure's derivative from :meth:`acausal.result.Result.measure_sensitivity`,
+    a trace sample's from the interpolated sensitivity). Raises the
+    simulation's AcausalError when a run fails."""
+    from ..calibrate import _measure_derivative, _sigma
+    from ..modelfile import evaluate_measures
+    mf, cm = resolve(model)
+    vec, rows = [], []
+    for e in dataset.experiments:
+        opts = {**mf.experiment.run_options(dense=e.trace is not None), "max_steps": MAX_STEPS,
+                "sensitivities": list(names)}
+        if not e.measures and e.trace is not None and e.trace.time.size:
+            opts["t_end"] = min(opts["t_end"], float(e.trace.time[-1]) * (1 + 1e-9) + 1e-12)
+        res = cm.simulate(params={**params, **e.conditions}, **opts)
+        if e.measures:
+            meas = evaluate_measures(mf, res)
+            for m, y in e.measures.items():
+                sigma = _sigma(dataset, m, y)
+                vec.append((meas[m] - y) / sigma)
+                rows.append([_measure_derivative(mf, res, m, n) / sigma for n in names])
+        if e.trace is not None:
+            for var, ys in e.trace.signals.items():
+                sigma = _sigma(dataset, var, ys)
+                vec.extend((np.interp(e.trace.time, res.t, res[var]) - ys) / sigma)
+                rows.extend(np.column_stack([np.interp(e.trace.time, res.t,
+                                                       res.sensitivity(var, n)) / sigma
+                                             for n in names]))
+    return np.asarray(vec, float), np.asarray(rows, float).reshape(len(vec), len(names))
+
+
 class _OutOfTime(Exception):
     """The fit's time budget is spent (raised inside the optimiser)."""
 
@@ -113,8 +146,9 @@ class Objective:
     """
 
     def __init__(self, model, dataset, names, fixed=None, budget_s=None, max_evals=None,
-                 penalty=None, backend=None):
+                 penalty=None, jacobian="differences", backend=None):
         self.pair = resolve(model)
+        self.jacobian = jacobian      # "differences" or "sensitivities" (see refine)
         self.backend = backend
         self.penalty = penalty        # (rows P, scales) on the last P.shape[1] parameters
         self.dataset = dataset
@@ -161,6 +195,23 @@ class Objective:
         return vec
 
 
+    def jac_x(self, x):
+        """d residuals / d x from forward sensitivities (:func:`weighted_jacobian`),
+        penalty rows included; a failed run raises its AcausalError."""
+        self._check()
+        self.n_sim += len(self.dataset.experiments)
+        J = weighted_jacobian(self.pair, self.dataset, self.params(x), self.names)[1]
+        if not np.all(np.isfinite(J)):
+            from ..errors import SolverError
+            raise SolverError("non-finite sensitivities")
+        if self.penalty is not None:
+            P, sc = self.penalty
+            Jp = np.zeros((P.shape[0], len(self.names)))
+            Jp[:, len(self.names) - P.shape[1]:] = P / sc
+            J = np.vstack([J, Jp])
+        return J
+
+
 def score_starts(obj, starts, lo, hi, absorb=None):
     """Evaluate each start (an array over ``obj.names``) once; with
     ``absorb`` = (names, jacobian) of parameters calibrated beforehand, each
@@ -197,13 +248,20 @@ def score_starts(obj, starts, lo, hi, absorb=None):
 
 def refine(obj, x_start, lo, hi, sc, max_nfev, tol):
     """Trust-region least squares (scipy, bounded, on value/scale) from
-    ``x_start`` with forward differences of a step FD_STEP of each scale.
+    ``x_start`` with forward differences of a step FD_STEP of each scale,
+    or with the Jacobian from forward sensitivities when ``obj.jacobian`` is
+    "sensitivities" (:class:`acausal.calibrate.SensitivityJacobian`: the
+    differences answer where a sensitivity run fails).
     Returns (x, jacobian in parameter units, ok, message); when the budget
     runs out the best point seen is kept and the Jacobian taken there."""
     fd = ForwardDifferences(lambda z: obj(z * sc), FD_STEP, hi / sc)
+    jac = fd.jac
+    if getattr(obj, "jacobian", "differences") == "sensitivities":
+        from ..calibrate import SensitivityJacobian
+        jac = SensitivityJacobian(obj.jac_x, lambda z: z * sc, lambda z: sc, fd).jac
     obj.best_cost, obj.best_x = np.inf, None
     try:
-        sol = optimize.least_squares(fd, x_start / sc, jac=fd.jac, bounds=(lo / sc, hi / sc),
+        sol = optimize.least_squares(fd, x_start / sc, jac=jac, bounds=(lo / sc, hi / sc),
                                      x_scale=1.0, xtol=tol, ftol=tol, gtol=tol,
                                      max_nfev=max_nfev)
         return sol.x * sc, sol.jac / sc, sol.status >= 0, str(sol.message)
@@ -220,7 +278,8 @@ def _arrays(names, *dicts):
 
 
 def fit(model, dataset, names, x0, low, high, scale, *, fixed=None, starts=None,
-        max_nfev=60, tol=1e-8, budget_s=None, absorb=None, max_evals=None) -> Fit:
+        max_nfev=60, tol=1e-8, budget_s=None, absorb=None, max_evals=None,
+        jacobian="differences") -> Fit:
     """Weighted output-error least squares over ``names`` from the best of
     the starting points.
 
@@ -230,11 +289,12 @@ def fit(model, dataset, names, x0, low, high, scale, *, fixed=None, starts=None,
     value, merged into ``x0``), scored by :func:`score_starts` (with
     ``absorb``); the best is refined by :func:`refine`. ``budget_s`` /
     ``max_evals``: a wall-time / evaluation budget (the best point is kept).
+    ``jacobian``: "differences" (default) or "sensitivities" (see :func:`refine`).
     """
     names = list(names)
     x0, lo, hi = _arrays(names, x0, low, high)
     sc = np.array([abs(float(scale[n])) or 1.0 for n in names])
-    obj = Objective(model, dataset, names, fixed, budget_s, max_evals)
+    obj = Objective(model, dataset, names, fixed, budget_s, max_evals, jacobian=jacobian)
     cands = [x0]
     for st in starts or []:
         cands.append(np.array([float(st.get(n, v)) for n, v in zip(names, x0)]))

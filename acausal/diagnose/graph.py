@@ -69,6 +69,11 @@ def has_role(comp, *roles):
     return role(comp) in roles
 
 
+def _planar(comp):
+    """Whether a component has a planar frame (acausal.mechanics.planar)."""
+    return any(type(c).domain == "planar" for c in comp.connectors().values())
+
+
 def domain_of(comp):
     """'translational' or 'rotational' from the component's connectors
     (the first one for a mixed component such as a lever)."""
@@ -139,15 +144,17 @@ class ModelGraph:
                 if isinstance(d, Parameter) and not d.structural:
                     self._params[sym] = (c, c.value(name))
             for name in c.connectors():
-                port = c.port(name)
-                self.known |= {port.across.name, port.through.name}
+                for a, t in c.port(name).pairs():     # a planar frame has three pairs
+                    self.known |= {a.name, t.name}
         self._values = None
 
     def _classify(self):
         self.bodies, self.joints, self.springs, self.contacts, self.sources = [], [], [], [], []
         for path, c in self.components.items():
             dom = domain_of(c)
-            if has_role(c, "body"):
+            if _planar(c):
+                self._classify_planar(path, c)
+            elif has_role(c, "body"):
                 self.bodies.append(Site("body", path, dom, c, self._body_note(c)))
                 fixed = [o.path for o in self.at_node(c.flange)
                          if has_role(o, "ground", "driver")]
@@ -168,6 +175,25 @@ class ModelGraph:
                 self.sources.append(Site("source", path, dom, c, f"{type(c).__name__} on "
                                          + (body.path if body else "a massless node")))
 
+    def _classify_planar(self, path, c):
+        """Planar parts (acausal.mechanics.planar): a Body is a body site
+        (its loads act through its joints); a joint is a joint site whose
+        effects act across it on its 1-D ``axis`` (the ``diagnosis_flange``:
+        friction, drag, a load torque), unless a 1-D body already sits on
+        that axis (its bearing site is then the same place); a contact from
+        geometry is a contact site."""
+        if has_role(c, "body"):
+            self.bodies.append(Site("body", path, "planar", c, f"{type(c).__name__} m = "
+                                    f"{self._fmt(c, 'm')} kg, I = {self._fmt(c, 'I')} kg*m^2"))
+        elif has_role(c, "joint"):
+            if self.body_at(c.flange) is None:
+                self.joints.append(Site("joint", path, domain_of(c), c,
+                                        f"{type(c).__name__} between "
+                                        + ", ".join(self.describe_ports(c)[:2])))
+        elif has_role(c, "contact"):
+            self.contacts.append(Site("contact", path, "planar", c, f"{type(c).__name__} "
+                                      "between " + ", ".join(self.describe_ports(c))))
+
     def _fmt(self, comp, name):
         try:
             return f"{self.number(comp.value(name), comp):.4g}"
@@ -183,8 +209,10 @@ class ModelGraph:
         what = "guide of" if domain_of(c) == "translational" else "bearing of"
         others = [f"{o.path} ({type(o).__name__})" for o in self.at_node(c.flange)
                   if o is not c and self._to_frame(o, c.flange)]
-        return f"{what} {c.path}" + (f"; elements to the frame here: {', '.join(others)}"
-                                     if others else "")
+        axes = [o.path for o in self.at_node(c.flange) if _planar(o) and has_role(o, "joint")]
+        return (f"{what} {c.path}" + (f"; elements to the frame here: {', '.join(others)}"
+                                      if others else "")
+                + (f"; the axis of the planar joint {', '.join(axes)}" if axes else ""))
 
     def _to_frame(self, comp, port):
         """A one-flange element (ground friction, end stop) or a two-flange
@@ -350,7 +378,7 @@ class ModelGraph:
         body = self.components[path]
         rot = domain_of(body) == "rotational"
         xn, vn = ("phi", "w") if rot else ("s", "v")
-        m = self.param(body, self.mass_param(body))
+        m = self.param(body, self.mass_param(body)) if has_role(body, "body") else 0.0
         x = self._series(f"{path}.{xn}")
         v = self._series(f"{path}.{vn}")
         out = dict(mass=m, time=self._duration())
@@ -372,8 +400,20 @@ class ModelGraph:
                 forces.append(np.abs(f))
         f_med = float(np.median(np.max(forces, axis=0))) if forces else 0.0
         f_energy = m * out["speed"] ** 2 / (2 * out["travel"])
-        out["force"] = max(f_med, f_energy)
+        out["force"] = max(f_med, f_energy, self._joint_load(body))
         return out
+
+    def _joint_load(self, comp):
+        """A planar joint's typical friction-sized load: the largest reaction
+        force it carries times 0.01 m (a revolute: a pin radius) or 0.1 (a
+        prismatic: a friction coefficient); 0 for other components."""
+        if not has_role(comp, "joint") or not _planar(comp):
+            return 0.0
+        fx, fy = (self._series(f"{comp.path}.frame_b.{k}") for k in ("fx", "fy"))
+        if fx is None or fy is None:
+            return 0.0
+        reaction = float(np.max(np.hypot(fx, fy)))
+        return reaction * (0.01 if domain_of(comp) == "rotational" else 0.1)
 
     def _duration(self):
         if self.result is not None and len(self.result.t) > 1:

@@ -69,9 +69,9 @@ from collections import namedtuple
 
 import numpy as np
 import sympy as sp
-from sympy import Eq, Piecewise
+from sympy import Piecewise
 
-from acausal import Component, Discrete, Event, Flange, Model, Parameter, Variable, der
+from acausal import Component, Discrete, Eq, Event, Flange, Model, Parameter, Variable, der
 from acausal.errors import MeasureError, ParameterError
 
 from .partials import PartialCompliant
@@ -93,7 +93,10 @@ class PosPow(sp.Function):
         if argindex == 1:
             return g * PosPow(x, g - 1)
         if argindex == 2:
-            return sp.Piecewise((sp.log(x) * PosPow(x, g), x > 0), (0, True))
+            # log of max(x, tiny): the generated code computes shared
+            # sub-expressions ahead of the branches, so log(x) itself would be
+            # evaluated out of contact (x <= 0) as well; there PosPow is 0
+            return PosPow(x, g) * sp.log(sp.Max(x, sp.Float(1e-300)))
         raise sp.ArgumentIndexError(self, argindex)
 
     @classmethod

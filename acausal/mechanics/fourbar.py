@@ -32,9 +32,9 @@ closing. Along a closed linkage
 import math
 
 import sympy as sp
-from sympy import Eq, Max, Min, cos, sin, sqrt
+from sympy import Max, Min, cos, sin, sqrt
 
-from acausal import Assertion, Component, Parameter, RotFlange, Start, Variable
+from acausal import Assertion, Component, Eq, Parameter, RotFlange, Start, Variable
 from acausal.errors import ParameterError
 
 

@@ -52,9 +52,9 @@ velocity reached at the ``slide_stop`` root, which IDA locates to about
 starts at rest stays exactly at rest while stuck.
 """
 import sympy as sp
-from sympy import Eq, Ne, Piecewise
+from sympy import Ne, Piecewise
 
-from acausal import Component, Discrete, Event, Flange, Parameter, RotFlange, Variable, der
+from acausal import Component, Discrete, Eq, Event, Flange, Parameter, RotFlange, Variable, der
 from acausal.errors import ParameterError
 
 from .partials import PartialCompliant, PartialRotCompliant

@@ -6,9 +6,9 @@ mass or inertia of a lever in an :class:`~acausal.mechanics.rotational.Inertia`
 or :class:`~acausal.mechanics.translational.Mass` on one of its flanges.
 Sign convention: :mod:`acausal.connectors`.
 """
-from sympy import Eq, cos, sin
+from sympy import cos, sin
 
-from acausal import Component, Flange, Parameter, ParameterError, RotFlange, Variable
+from acausal import Component, Eq, Flange, Parameter, ParameterError, RotFlange, Variable
 
 __all__ = ["IdealLever", "TwoArmLever", "IdealGear"]
 

@@ -5,9 +5,8 @@ import inspect
 import numbers
 
 import sympy as sp
-from sympy import Eq
 
-from acausal import Component, Flange, Parameter, ParameterError, RotFlange, Variable, der
+from acausal import Component, Eq, Flange, Parameter, ParameterError, RotFlange, Variable, der
 
 
 class PartialCompliant(Component):

@@ -9,9 +9,9 @@ positively, ``phi_rel > phi_rel0`` for a spring) and
 Several components may be connected to one flange (an inertia has a single
 flange; the torques of everything connected to it add up there).
 """
-from sympy import Basic, Eq, SympifyError, sympify
+from sympy import Basic, SympifyError, sympify
 
-from acausal import Component, Parameter, ParameterError, RotFlange, Variable, der
+from acausal import Component, Eq, Parameter, ParameterError, RotFlange, Variable, der
 
 from .partials import (PartialRotAbsoluteSensor, PartialRotCompliant,
                        PartialRotRelativeSensor, PartialRotRigid, PartialSource)

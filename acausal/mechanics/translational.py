@@ -8,9 +8,9 @@ apart), and ``s_rel = flange_b.s - flange_a.s``.
 Several components may be connected to one flange (a mass has a single
 flange; the forces of everything connected to it add up there).
 """
-from sympy import Basic, Eq, SympifyError, sympify
+from sympy import Basic, SympifyError, sympify
 
-from acausal import Component, Flange, Parameter, ParameterError, Variable, der
+from acausal import Component, Eq, Flange, Parameter, ParameterError, Variable, der
 
 from .partials import (PartialAbsoluteSensor, PartialCompliant, PartialRelativeSensor,
                        PartialRigid, PartialSource)

@@ -12,17 +12,20 @@ World frame = the report's: A (main shaft) at the origin, O (hook shaft) at
     A   o  main shaft (Js, spring)        O    o  hook shaft (Jh)
     (0, 0)                                 (f, 0)
 
-* hook: Revolute at O (``hook_pin``), angle psi1 = pi - theta1 (theta1 the
-  report's crank angle, clockwise), a Body with the hook inertia Jh on it and
-  the crank e (FixedTranslation) to D;
-* main shaft: Revolute at A (``shaft_pin``), angle psi3 = -theta3, a Body
-  with Js, the rocker r1 (FixedTranslation) to C;
-* coupler: a Revolute at C (``roller_pin``, angle theta2 + theta3), the
-  link r2 + r3 (FixedTranslation) and a Revolute at D (``cam_pin``, angle
+The loop is the shared sub-assembly
+:class:`~acausal.mechanics.planar.linkages.FourBarLinkage` (``linkage``):
+
+* hook: its Revolute at O (``linkage.pin_a``), angle psi1 = pi - theta1
+  (theta1 the report's crank angle, clockwise), a Body with the hook
+  inertia Jh on it and the crank e to D;
+* main shaft: its Revolute at A (``linkage.pin_b``), angle psi3 = -theta3,
+  a Body with Js, the rocker r1 to C;
+* coupler: a Revolute at C (``linkage.pin_c``, angle theta2 + theta3), the
+  link r2 + r3 and a Revolute at D (``linkage.pin_d``, angle
   theta1 + theta2 - pi) that closes the loop.
 
 The main shaft carries the open and wipe springs as one preloaded torsion
-spring on ``shaft_pin.axis`` (as models/examples/fourbar.py). Geometry and
+spring on ``linkage.pin_b.axis`` (as models/examples/fourbar.py). Geometry and
 starts are model parameters (``e``, ``f``, ``r1``, ``r2``, ``r3``,
 ``theta1_0``, ``w1_0``); the joint angles' start guesses follow them.
 """
@@ -32,8 +35,8 @@ import sympy as sp
 
 from acausal import Experiment, Model, Start, Stop
 from acausal.mechanics import rotational as rot
-from acausal.mechanics.planar.joints import Revolute
-from acausal.mechanics.planar.parts import Body, Fixed, FixedTranslation
+from acausal.mechanics.planar.linkages import FourBarLinkage
+from acausal.mechanics.planar.parts import Body
 
 TABLE1 = dict(e=0.0002, f=0.125, r1=0.116, r2=0.036, r3=0.0533)   # [m]
 JH, JS = 0.00044, 0.02              # hook (Table 1), main shaft (assumption) [kg m^2]
@@ -68,45 +71,35 @@ def build(geometry=TABLE1, theta1_0=0.0, w1_0=W_HOOK, jh=JH, js=JS, c=C_SHAFT,
     th1 = m.parameter("theta1_0", theta1_0, "rad", "hook (crank) start angle")
     w1 = m.parameter("w1_0", w1_0, "rad/s", "hook start speed (theta1 sense)")
     L = g["r2"] + g["r3"]
-    th2, th3 = loop_angles(th1, g["e"], g["f"], g["r1"], L, mode)
     th3_latched = loop_angles(0.0, *(geometry[k] for k in ("e", "f", "r1")),
                               geometry["r2"] + geometry["r3"], mode, math)[1]
-    m.ground_A = Fixed()
-    m.ground_O = Fixed(x0=g["f"])
-    m.hook_pin = Revolute(phi=sp.pi - th1, w=-w1)
+    # the shared sub-assembly: crank e at O = (f, 0), rocker r1 at A, its
+    # assembly mode -mode in its own convention (C on the other side of B-D)
+    m.linkage = FourBarLinkage(theta_a0=sp.pi - th1, mode=-mode, xa=g["f"], ya=0.0,
+                               phia=0.0, xb=0.0, yb=0.0, phib=0.0, a=g["e"], b=g["r1"], c=L)
+    m.linkage.pin_a.set(phi=sp.pi - th1, w=-w1)
     m.hook = Body(m=1.0, I=jh, phi=Start(sp.pi - th1, False))
-    m.crank = FixedTranslation(rx=g["e"], ry=0.0)
-    m.shaft_pin = Revolute(phi=Start(-th3, False))
+    th3 = loop_angles(th1, g["e"], g["f"], g["r1"], L, mode)[1]
     m.shaft = Body(m=1.0, I=js, phi=Start(-th3, False))
-    m.rocker = FixedTranslation(rx=g["r1"], ry=0.0)
-    m.roller_pin = Revolute(phi=Start(th2 + th3, False))
-    m.coupler = FixedTranslation(rx=L, ry=0.0)
-    m.cam_pin = Revolute(phi=Start(th1 + th2 - sp.pi, False))
     m.spring = rot.TorsionSpring(c=c, phi_rel0=-th3_latched + preload)
     m.spring_support = rot.Fixed()
-    m.connect(m.ground_O.frame, m.hook_pin.frame_a)
-    m.connect(m.hook_pin.frame_b, m.hook.frame, m.crank.frame_a)
-    m.connect(m.ground_A.frame, m.shaft_pin.frame_a)
-    m.connect(m.shaft_pin.frame_b, m.shaft.frame, m.rocker.frame_a)
-    m.connect(m.rocker.frame_b, m.roller_pin.frame_a)
-    m.connect(m.roller_pin.frame_b, m.coupler.frame_a)
-    m.connect(m.coupler.frame_b, m.cam_pin.frame_b)
-    m.connect(m.crank.frame_b, m.cam_pin.frame_a)
+    m.connect(m.linkage.crank, m.hook.frame)
+    m.connect(m.linkage.rocker, m.shaft.frame)
     m.connect(m.spring_support.flange, m.spring.flange_a)
-    m.connect(m.spring.flange_b, m.shaft_pin.axis)
+    m.connect(m.spring.flange_b, m.linkage.flange_b)
     return m
 
 
 def report_angles(res):
     """theta1, theta2, theta3 [rad] (the report's) along a result."""
-    th1 = math.pi - res["hook_pin.phi"]
-    th3 = -res["shaft_pin.phi"]
-    return th1, res["roller_pin.phi"] - th3, th3
+    th1 = math.pi - res["linkage.pin_a.phi"]
+    th3 = -res["linkage.pin_b.phi"]
+    return th1, res["linkage.pin_c.phi"] - th3, th3
 
 
 model = build()
 experiment = Experiment(t_end=0.1, rtol=1e-10, atol=1e-12, output_step=1e-4,
-                        stop=Stop("hook_pin.phi", "<=", math.pi - RA, name="released"))
+                        stop=Stop("linkage.pin_a.phi", "<=", math.pi - RA, name="released"))
 
 
 def _released_at(res):

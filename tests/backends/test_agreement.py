@@ -1,18 +1,34 @@
-"""The compiled backend against the reference (scikit-sundae): every
-simulation-test model, run with its file's options on both, must give the
-same events in the same order, event times and measures within the solver
-tolerance, and the same traces at the requested output times.
+"""The compiled backend against the reference (scikit-sundae): every model
+in ``models/``, run with its file's options on both, must give the same
+events in the same order, and event times, measures and traces within the
+solver tolerance.
 
 Both backends run the same IDA algorithm with the same settings; they differ
 only in the round-off of the generated residual (C against Python), which
 can change a Newton iteration or a step and so moves the solution by at most
-IDA's global error: a multiple of the local tolerance. On the examples the
-two agree to round-off or within ``AGREE = 20`` times ``rtol`` (relative to
-each trace's largest value, or to the event time). The breaker's THRT
-carries a global error of up to ~40 rtol on either backend (measured against
-rtol 1e-11 over 41 impact speeds), so there the event times and measures are
-checked for equal accuracy against a high-accuracy solution instead. Which backend ran is asserted, not assumed: without
-a C compiler the compiled backend must say it fell back.
+IDA's global error: a multiple of the local tolerance ``rtol |x| + atol``.
+
+* Small examples (:func:`_check_agreement`): event times, measures and the
+  states' traces at the requested output times agree within ``AGREE = 20``
+  times the local tolerance. A file whose output is the solver's own steps
+  (``output_step=0``: the two backends step differently) is compared on its
+  dense grid (``dense_step``). Measures that quantify the simulation's own
+  error (a drift, a constraint residual, :data:`ERROR_MEASURES`) are noise
+  at the level of rtol times their scale, so they are compared absolutely
+  at that scale.
+* The breaker family and the latch (:func:`_check_equally_accurate`):
+  stiff contacts carry a global error of tens to ~140 local tolerances on
+  either backend (the breaker's THRT up to ~40 rtol against rtol 1e-11 over
+  41 impact speeds; a variant's event time 50 rtol on one backend and 8 on
+  the other at the same point; the light hook's hook velocity 140 rtol
+  apart), which round-off moves from one backend to the other. Each backend
+  is compared with an independent high-accuracy solution (the reference
+  backend at 1e-3 of the file's tolerances): neither may be more than twice
+  as far from it as the other plus ``GLOBAL = 150`` local tolerances, i.e.
+  both carry the method's global error, neither more.
+
+Which backend ran is asserted, not assumed: without a C compiler the
+compiled backend must say it fell back.
 """
 import os
 
@@ -24,6 +40,11 @@ from acausal.modelfile import compile_file, evaluate_measures
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 AGREE = 20.0
+GLOBAL = 150.0
+# measures of a simulation's own error: the scale they are relative to (a
+# variable whose largest value is the scale, or 1 for a relative error)
+ERROR_MEASURES = {"momentum_error": None, "energy_error": None, "energy_drift": None,
+                  "max_slider_x_error_m": "slider.x"}
 _cache = {}
 
 
@@ -33,10 +54,7 @@ def _compiled(path):
     return _cache[path]
 
 
-def _check_agreement(path, params=None, times=True):
-    mf, cm = _compiled(path)
-    opts = mf.experiment.run_options()
-    rtol = opts.get("rtol", 1e-6)
+def _both(cm, params, opts):
     a = cm.simulate(params=params, backend="sundae", **opts)
     b = cm.simulate(params=params, backend="compiled", **opts)
     assert a.stats["backend"] == "sundae"
@@ -46,24 +64,89 @@ def _check_agreement(path, params=None, times=True):
     else:   # the fallback must be visible; the agreement then holds trivially
         assert b.stats["backend"] == "sundae" and why in b.stats["backend_fallback"]
     assert [n for _, n in a.events] == [n for _, n in b.events]
+    return a, b
+
+
+def _trace_options(mf):
+    """The file's options, on its dense grid when it outputs the solver's steps."""
+    opts = mf.experiment.run_options()
+    return mf.experiment.run_options(dense=True) if opts["output_step"] == 0 else opts
+
+
+def _rows(a, b):
+    """Rows at the requested output times (rows at events sit at slightly
+    different instants on the two backends)."""
+    events = {t for t, _ in a.events} | {t for t, _ in b.events}
+    assert len(a.t) == len(b.t)
+    rows = np.array([t not in events for t in a.t])
     span = a.t[-1] - a.t[0]
+    np.testing.assert_allclose(a.t[rows], b.t[rows], rtol=0, atol=1e-12 * max(span, 1.0))
+    return rows
+
+
+def _measure_scale(name, value, res):
+    if name not in ERROR_MEASURES:
+        return abs(value)
+    var = ERROR_MEASURES[name]
+    return 1.0 if var is None else float(np.max(np.abs(res[var])))
+
+
+def _check_agreement(path, params=None):
+    mf, cm = _compiled(path)
+    opts = mf.experiment.run_options()
+    rtol, atol = opts.get("rtol", 1e-6), float(np.max(opts.get("atol", 1e-8)))
+    a, b = _both(cm, params, opts)
+    span = a.t[-1] - a.t[0]
+    for (ta, name), (tb, _) in zip(a.events, b.events):
+        assert abs(ta - tb) <= AGREE * rtol * max(abs(ta), span), (name, ta, tb)
     ma, mb = evaluate_measures(mf, a), evaluate_measures(mf, b)
     assert ma.keys() == mb.keys()
-    for (ta, name), (tb, _) in zip(a.events, b.events):
-        assert not times or abs(ta - tb) <= AGREE * rtol * max(abs(ta), span), (name, ta, tb)
     for k in ma:
-        assert not times or mb[k] == pytest.approx(ma[k], rel=AGREE * rtol, abs=1e-300), k
-    # traces at the requested output times (rows at events sit at slightly
-    # different instants on the two backends)
-    events = {t for t, _ in a.events} | {t for t, _ in b.events}
-    rows = np.array([t not in events for t in a.t])
-    assert len(a.t) == len(b.t)
-    np.testing.assert_allclose(a.t[rows], b.t[rows], rtol=0, atol=1e-12 * max(span, 1.0))
+        tol = AGREE * rtol * max(_measure_scale(k, ma[k], a), 1e-300)
+        assert abs(mb[k] - ma[k]) <= tol, (k, ma[k], mb[k])
+    if _trace_options(mf) is not opts:
+        a, b = _both(cm, params, _trace_options(mf))
+    rows = _rows(a, b)
     for names in cm.slot_names()[:cm.dae.n_states]:
         xa, xb = a[names[-1]][rows], b[names[-1]][rows]
         scale = np.max(np.abs(a[names[-1]]))
-        assert np.max(np.abs(xa - xb)) <= AGREE * rtol * scale + 1e-300, names[-1]
+        assert np.max(np.abs(xa - xb)) <= AGREE * (rtol * scale + atol), names[-1]
     return a, b
+
+
+def _no_worse(err, tol, what):
+    """Neither error more than twice the other's, plus ``tol``."""
+    assert err["compiled"] <= 2 * err["sundae"] + tol, (what, err, tol)
+    assert err["sundae"] <= 2 * err["compiled"] + tol, (what, err, tol)
+
+
+def _check_equally_accurate(path, params=None):
+    """Both backends against the reference backend at 1e-3 of the file's
+    tolerances: event times, measures and traces (on the dense grid) no less
+    accurate on one backend than on the other (see the module doc)."""
+    mf, cm = _compiled(path)
+    opts = _trace_options(mf)
+    rtol, atol = opts.get("rtol", 1e-6), float(np.max(opts.get("atol", 1e-8)))
+    tight = dict(opts, rtol=rtol * 1e-3, atol=atol * 1e-3)
+    tol = GLOBAL * rtol
+    ref = cm.simulate(params=params, backend="sundae", **tight)
+    runs = dict(zip(("sundae", "compiled"), _both(cm, params, opts)))
+    assert [n for _, n in ref.events] == [n for _, n in runs["sundae"].events]
+    span = ref.t[-1] - ref.t[0]
+    for k, (te, name) in enumerate(ref.events):
+        err = {b: abs(r.events[k][0] - te) for b, r in runs.items()}
+        _no_worse(err, tol * max(abs(te), span), name)
+    mref = evaluate_measures(mf, ref)
+    meas = {b: evaluate_measures(mf, r) for b, r in runs.items()}
+    for k, v in mref.items():
+        err = {b: abs(m[k] - v) for b, m in meas.items()}
+        _no_worse(err, tol * max(_measure_scale(k, v, ref), 1e-300), k)
+    rows = _rows(runs["sundae"], ref) & _rows(runs["compiled"], ref)
+    for names in cm.slot_names()[:cm.dae.n_states]:
+        x = ref[names[-1]]
+        err = {b: float(np.max(np.abs(r[names[-1]][rows] - x[rows]))) for b, r in runs.items()}
+        _no_worse(err, GLOBAL * (rtol * np.max(np.abs(x)) + atol), names[-1])
+    return runs
 
 
 @pytest.mark.parametrize("model", ["oscillator", "hertz_impact", "stick_slip"])
@@ -71,21 +154,33 @@ def test_examples_agree(model):
     _check_agreement(f"models/examples/{model}.py")
 
 
+EXAMPLES = sorted(f[:-3] for f in os.listdir(os.path.join(ROOT, "models", "examples"))
+                  if f.endswith(".py") and not f.startswith("_"))
+MODELS = sorted(f[:-3] for f in os.listdir(os.path.join(ROOT, "models"))
+                if f.endswith(".py") and not f.startswith("_"))
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("model", ["newtons_cradle", "fourbar", "lever_masses"])
+@pytest.mark.parametrize("model", [m for m in EXAMPLES
+                                   if m not in ("oscillator", "hertz_impact", "stick_slip")])
 def test_larger_examples_agree(model):
     _check_agreement(f"models/examples/{model}.py")
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("v", [3.3, 3.8, 4.2, 4.5])
-def test_breaker_agrees_at_several_impact_speeds(v):
-    """Events in the same order and traces within 20 rtol; event times and
-    measures: see the next test (the breaker's THRT carries a global error
-    of up to ~40 rtol on either backend, so a fixed multiple of rtol between
-    the two is no criterion)."""
-    a, b = _check_agreement("models/breaker_24kv.py", {"v_impact": v}, times=False)
-    assert a.event_times("release") and b.event_times("release")
+@pytest.mark.parametrize("model", MODELS)
+def test_models_are_equally_accurate_on_both_backends(model):
+    """Every top-level model (the breaker and its variants, the latch):
+    event times, measures and traces as accurate on one backend as on the
+    other, against a high-accuracy solution."""
+    runs = _check_equally_accurate(f"models/{model}.py")
+    assert all(r.status == "ok" for r in runs.values())
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("v", [3.3, 4.5])
+def test_breaker_equally_accurate_at_other_impact_speeds(v):
+    _check_equally_accurate("models/breaker_24kv.py", {"v_impact": v})
 
 
 @pytest.mark.slow

@@ -42,3 +42,24 @@ def test_cli_backend_choice_and_per_command_default(monkeypatch):
     compiled = "compiled" if compiled_available() is None else "sundae"
     assert ran == {"simulate": "sundae", "simulate --backend compiled": compiled,
                    "--backend compiled simulate": compiled}
+
+
+def test_commands_of_many_runs_default_to_compiled(monkeypatch, tmp_path):
+    """calibrate, sweep and diagnose run many simulations of each model and
+    default to the compiled backend (measured faster, agreement tested),
+    which their simulations see through ACAUSAL_BACKEND; simulate keeps the
+    reference (test above)."""
+    from click.testing import CliRunner
+
+    import acausal.diagnose.run as run
+    from acausal.cli import MANY_RUNS, main
+    monkeypatch.delenv("ACAUSAL_BACKEND", raising=False)
+    seen = []
+
+    def fake(*a, **k):
+        seen.append(os.environ.get("ACAUSAL_BACKEND"))
+        raise KeyboardInterrupt
+    monkeypatch.setattr(run, "diagnose", fake)
+    CliRunner().invoke(main, ["diagnose", OSC, str(tmp_path)])
+    assert seen == ["compiled"] and "ACAUSAL_BACKEND" not in os.environ
+    assert MANY_RUNS == {"calibrate", "sweep", "diagnose"}

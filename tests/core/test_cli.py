@@ -152,11 +152,17 @@ def test_sweep_takes_a_fixed_start_value(tmp_path):
             "--out", out, "--no-progress")
     assert r.exit_code == 0, r.output
     # rows are written as points finish (two workers): compare as a set
-    rows = sorted(__import__("csv").DictReader(open(out)), key=lambda r: float(r["mass.v"]))
-    assert [float(row["mass.v"]) for row in rows] == [0.5, 1.0]
+    # the header carries the SI units, as the data folders do
+    assert out.read_text().splitlines()[0] == "mass.v [m/s],contact_period [s],status,error,wall_s"
+    rows = sorted(__import__("csv").DictReader(open(out)), key=lambda r: float(r["mass.v [m/s]"]))
+    assert [float(row["mass.v [m/s]"]) for row in rows] == [0.5, 1.0]
     for row in rows:   # the sweep may run the compiled backend: agreement within tolerance
-        _, meas = run_file(path, params={"mass.v": float(row["mass.v"])})
-        assert float(row["contact_period"]) == pytest.approx(meas["contact_period"], rel=1e-7)
+        _, meas = run_file(path, params={"mass.v": float(row["mass.v [m/s]"])})
+        assert float(row["contact_period [s]"]) == pytest.approx(meas["contact_period"], rel=1e-7)
+    # a rerun resumes from the file with units in its header: nothing recomputed
+    again = run("sweep", path, "--param", "mass.v=0.5:1.0:2", "--measure", "contact_period",
+                "--out", out, "--no-progress")
+    assert again.exit_code == 0 and out.read_text().count("\n") == 3
     bad = run("sweep", path, "--param", "mass.q=0:1:2", "--measure", "contact_period",
               "--out", tmp_path / "bad.csv")
     assert bad.exit_code == 2 and "mass.q" in bad.output

@@ -226,7 +226,7 @@ def test_sweep_measure_takes_a_list(tmp_path):
                                   "--no-progress"])
     assert r.exit_code == 0, r.output
     rows = out.read_text().splitlines()
-    assert rows[0] == "body.m,s_end,v_end,status,error,wall_s"
+    assert rows[0] == "body.m [kg],s_end,v_end,status,error,wall_s"   # plain functions: no unit
     for line in rows[1:]:
         m, s, v = map(float, line.split(",")[:3])
         w = math.sqrt(100.0 / m)

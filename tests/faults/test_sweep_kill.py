@@ -25,8 +25,8 @@ def sweep_args(model, out):
 
 
 def read_rows(path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
+    with open(path, newline="") as f:   # header "name [unit]": keyed by name
+        return [{k.split(" [")[0]: v for k, v in r.items()} for r in csv.DictReader(f)]
 
 
 def finished_after_kill(out):

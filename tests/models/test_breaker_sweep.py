@@ -54,8 +54,11 @@ def sweep(out, scheduler, *params):
 
 
 def rows(out):
+    """The CSV's rows keyed by column name (the header is ``name [unit]``)."""
     with open(out, newline="") as f:
-        return list(csv.DictReader(f))
+        reader = csv.DictReader(f)
+        assert reader.fieldnames[0] == "v_impact [m/s]"
+        return [{k.split(" [")[0]: v for k, v in r.items()} for r in reader]
 
 
 def test_sweep_on_dask_equals_sequential_runs_and_resumes(cluster, submissions, tmp_path):

@@ -5,5 +5,7 @@ adaptors to the 1-D flanges. Sign convention and the picture of a frame:
 One small module per kind: :mod:`.partials` (connector equations),
 :mod:`.parts` (Fixed, Body, FixedTranslation), :mod:`.joints` (Revolute,
 Prismatic), :mod:`.forces` (Spring, Damper, SpringDamper between frames),
-:mod:`.adaptors` (frame <-> rotational / translational flange).
+:mod:`.adaptors` (frame <-> rotational / translational flange),
+:mod:`.contact` (a circle against a line or a circle) and :mod:`.polyline`
+(a circle against a polyline profile).
 """

@@ -1,9 +1,8 @@
 """Adaptors from a planar frame to the 1-D flanges (the mapping is written
 in :mod:`acausal.connectors`). Each is massless and lossless: the power
 into the frame side equals the power out of the flange side."""
-from sympy import Eq
 
-from acausal import Flange, Parameter, ParameterError, RotFlange
+from acausal import Eq, Flange, Parameter, ParameterError, RotFlange
 
 from .partials import PartialOneFrame
 

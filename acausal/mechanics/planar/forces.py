@@ -1,9 +1,8 @@
 """Spring and damper between two frames, along the line joining their
 origins. Sign convention: :mod:`acausal.connectors` (:class:`Frame`);
 force law: :class:`.partials.PartialLineForce` (tension positive)."""
-from sympy import Eq
 
-from acausal import Parameter, der
+from acausal import Eq, Parameter, der
 
 from .partials import PartialLineForce
 

@@ -2,16 +2,15 @@
 spring, damper, friction, end stop or drive of the 1-D library). Sign
 convention: :mod:`acausal.connectors` (:class:`Frame`, and the mapping of
 joints to 1-D flanges)."""
-from sympy import Eq
 
-from acausal import Flange, Parameter, ParameterError, RotFlange, Variable, der
+from acausal import Eq, Flange, Parameter, ParameterError, RotFlange, Variable, der
 
-from .partials import PartialRigidLink, rotate
+from .partials import PartialJoint, rotate
 
 __all__ = ["Revolute", "Prismatic"]
 
 
-class Revolute(PartialRigidLink):
+class Revolute(PartialJoint):
     """A pin joint: frame_b turns about frame_a's origin by ``phi``::
 
         r_b = r_a,  frame_b.phi = frame_a.phi + phi,  axis.phi = phi,
@@ -27,11 +26,13 @@ class Revolute(PartialRigidLink):
     free pin).
 
     Parameters: none. States: ``phi`` [rad] joint angle, ``w`` [rad/s] its
-    rate (give their starts to choose the states of a loop).
+    rate (give their starts to choose the states of a loop). Discrete:
+    ``drives`` (see :class:`~.partials.PartialJoint`: its loop's dead
+    centres are watched and warned of, :mod:`.deadcentre`).
     Connectors: ``frame_a``, ``frame_b``, ``axis`` (optional, RotFlange).
     """
 
-    loop_role = "joint"   # named when its loop cannot close
+    coordinate = "phi"    # watched for dead centres (acausal.mechanics.planar.deadcentre)
 
     axis = RotFlange("joint angle and the torque across the joint", optional=True)
     phi = Variable(0.0, "rad", "joint angle frame_b.phi - frame_a.phi")
@@ -44,7 +45,7 @@ class Revolute(PartialRigidLink):
                 Eq(a.tau, self.axis.tau)]
 
 
-class Prismatic(PartialRigidLink):
+class Prismatic(PartialJoint):
     """A slider: frame_b moves by ``s`` along the unit axis ``(ex, ey)``
     fixed in frame_a's axes, with frame_a's angle::
 
@@ -58,11 +59,12 @@ class Prismatic(PartialRigidLink):
     it carries no force along the axis (a free slider).
 
     Parameters: ``ex``, ``ey`` [1] axis direction in frame_a's axes (made
-    unit length). States: ``s`` [m] stroke, ``v`` [m/s] its rate.
+    unit length). States: ``s`` [m] stroke, ``v`` [m/s] its rate. Discrete:
+    ``drives`` (see :class:`~.partials.PartialJoint`).
     Connectors: ``frame_a``, ``frame_b``, ``axis`` (optional, Flange).
     """
 
-    loop_role = "joint"   # named when its loop cannot close
+    coordinate = "s"      # watched for dead centres (acausal.mechanics.planar.deadcentre)
 
     axis = Flange("stroke and the force along the axis", optional=True)
     ex = Parameter(1.0, "1", "axis direction, x in frame_a's axes")

@@ -1,9 +1,9 @@
 """Partial planar models that own the frame equations (Modelica
 PlanarMechanics' PartialTwoFrames idea), so that a leaf is its parameters and
 its law. Sign convention: :mod:`acausal.connectors` (:class:`Frame`)."""
-from sympy import Eq, cos, sin, sqrt
+from sympy import cos, sin, sqrt
 
-from acausal import Component, Variable
+from acausal import Component, Discrete, Eq, Variable
 from acausal.connectors import Frame
 
 
@@ -54,6 +54,31 @@ class PartialRigidLink(PartialTwoFrames):
         a component of a kinematic loop (see :func:`acausal.simulate`)."""
         from .loops import singularity_error
         return singularity_error(model, paths, message, t, result)
+
+
+class PartialJoint(PartialRigidLink):
+    """A joint (an edge of the kinematic graph with a coordinate of its own,
+    named by the leaf's ``coordinate``: "phi" or "s"). Its loops' dead
+    centres are watched (:mod:`.deadcentre`): discrete ``drives`` (1 when
+    the joint's coordinate is a state of the run, 0 when it follows the
+    others; -1 until the start has decided)."""
+
+    loop_role = "joint"   # named when its loop cannot close
+    coordinate = None
+    diagnosis_site = "joint"      # what acausal.diagnose may extend here: across the joint,
+    diagnosis_flange = "axis"     # on its 1-D axis flange (relative coordinates)
+
+    @property
+    def flange(self):
+        """The joint's 1-D ``axis`` under the name the diagnosis uses for the
+        flange of a joint site (acausal.diagnose.graph)."""
+        return self.port("axis")
+
+    drives = Discrete(-1, "1", "1: the coordinate drives its loop (a state), 0: it follows")
+
+    def events(self):
+        from .deadcentre import arm_event, monitor_events
+        return [arm_event(self)] + monitor_events(self)
 
 
 class PartialLineForce(PartialTwoFrames):

@@ -1,8 +1,7 @@
 """Fixed frame, rigid body and rigid (massless) link. Sign convention:
 :mod:`acausal.connectors` (:class:`Frame`)."""
-from sympy import Eq
 
-from acausal import Parameter, Variable, der
+from acausal import Eq, Parameter, Variable, der
 
 from .partials import PartialOneFrame, PartialRigidLink, rotate
 
@@ -39,6 +38,8 @@ class Body(PartialOneFrame):
     States: ``x``, ``y`` [m], ``phi`` [rad], ``vx``, ``vy`` [m/s], ``w``
     [rad/s]. Connectors: ``frame`` (at the centre of mass).
     """
+
+    diagnosis_site = "body"   # listed by acausal.diagnose; its loads act through its joints
 
     m = Parameter(1.0, "kg", "mass", min=0.0, min_open=True)
     I = Parameter(1.0, "kg*m^2", "moment of inertia about the centre of mass",  # noqa: E741

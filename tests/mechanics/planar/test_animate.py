@@ -4,6 +4,7 @@ checked on the artists' data, not on pixels."""
 import os
 
 import numpy as np
+import pytest
 from click.testing import CliRunner
 from PIL import Image
 
@@ -43,3 +44,33 @@ def test_animate_command_writes_gif_and_slider_follows_crank(tmp_path):
     png = tmp_path / "frame.png"
     draw_frame(res, png, k=3)
     assert png.stat().st_size > 0
+
+
+@pytest.mark.slow   # compiling a polyline contact takes several seconds
+def test_a_polyline_profile_is_drawn_moving_with_its_body():
+    """A polyline on a turning body: the drawn profile is its vertices in the
+    body's frame at each output time."""
+    from acausal import Model, compile_model
+    from acausal.mechanics.planar.parts import Body, Fixed
+    from acausal.mechanics.planar.joints import Revolute
+    from acausal.mechanics.planar.polyline import CirclePolylineContact
+    pts = ((-0.05, 0.01), (0.0, 0.0), (0.05, 0.02))
+    m = Model()
+    m.ground = Fixed()
+    m.pin = Revolute(phi=0.0, w=2.0)
+    m.cam = Body(m=1.0, I=1e-3)
+    m.ball = Body(m=0.1, I=1e-5, x=0.0, y=0.2, vx=0.0, vy=0.0, phi=0.0, w=0.0)
+    m.c = CirclePolylineContact(R=0.01, points=pts)
+    m.connect(m.ground.frame, m.pin.frame_a)
+    m.connect(m.pin.frame_b, m.cam.frame, m.c.frame_a)
+    m.connect(m.c.frame_b, m.ball.frame)
+    res = compile_model(m).simulate(t_end=0.5, rtol=1e-8, atol=1e-10, output_step=0.05)
+    anim = Animator(res)
+    prof = next(it for it in anim.scene.items if it.kind == "profile")
+    for k in (0, 5, 10):
+        anim.update(k)
+        x, y = prof.artist.get_data()
+        a = 2.0 * res.t[k]
+        want = [(np.cos(a) * px - np.sin(a) * py, np.sin(a) * px + np.cos(a) * py)
+                for px, py in pts]
+        assert np.max(np.abs(np.column_stack([x, y]) - np.array(want))) < 1e-9

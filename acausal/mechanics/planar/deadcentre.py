@@ -1,0 +1,140 @@
+"""Early warning of a dead centre: a kinematic loop nearing a configuration
+where its joints cannot follow the joint that drives it.
+
+A planar loop closes when the joint rates ``q_i'`` make the twists ``c_i``
+sum to zero, ``sum_i q_i' c_i = 0``, with ``c = (1, y, -x)`` for a revolute
+at (x, y) and ``c = (0, u_x, u_y)`` for a prismatic along the unit axis u
+(world). In a loop of N joints, N - 3 of them drive it (their coordinates
+are states of the run: the index reduction chose them) and the other three
+follow: their rates are the solution of a 3x3 system whose determinant is
+the *minor* of those three columns (Cramer's rule). Where it vanishes the
+followers' rates are infinite -- a dead centre: the loop locks, or switches
+assembly mode, and the solver fails there (:class:`.loops.LoopSingularityError`).
+
+Taking the first revolute of the three as origin, the minor is the 2x2
+determinant of the other two columns' ``(Δy, -Δx)`` (a revolute, Δ its offset
+from the origin joint) or ``u`` (a prismatic). Normalised (:func:`minor_sine`)
+it is a sine in [-1, 1]: of the bend at the middle one of three revolutes,
+or of the angle between a link turned by 90 deg and a slider's axis; three
+revolutes in line, or a link at right angles to the axis in the
+slider-crank's dead centre, give 0. The first joint of each loop declares one observer root per choice
+of three followers, ``sine^2 - DEAD_CENTRE_SIN^2`` falling through 0, armed
+only when the other joints of the loop are the ones that drive it (each
+joint's ``drives`` discrete, decided at the start from the compiled model's
+states). It warns (:class:`DeadCentreWarning`, one line naming the loop,
+its joints and the followers) and the run goes on; IDA does not stop for it.
+"""
+import itertools
+import math
+import warnings
+
+import sympy as sp
+from sympy import Eq, Piecewise, sqrt
+
+from acausal import Event
+
+from .partials import rotate
+
+DEAD_CENTRE_SIN = 0.05   # warn within about 2.9 deg of a dead centre
+
+
+class DeadCentreWarning(UserWarning):
+    """A kinematic loop came within :data:`DEAD_CENTRE_SIN` (about 2.9 deg)
+    of a dead centre for the joints that drive it."""
+
+
+def column(joint):
+    """('r', x, y) of a revolute's pin or ('p', ux, uy) of a prismatic's
+    world axis, as expressions of the joint's frame_a."""
+    a = joint.frame_a
+    if joint.coordinate == "phi":
+        return "r", a.x, a.y
+    n = sqrt(joint.ex**2 + joint.ey**2)
+    ux, uy = rotate(a.phi, joint.ex / n, joint.ey / n)
+    return "p", ux, uy
+
+
+def minor_sine(cols):
+    """The normalised minor of three joint columns, or None when it has no
+    revolute (three sliders: singular whatever the configuration).
+
+    Three revolutes: twice the area of their triangle over the product of
+    its two shorter sides (all three over the longest), the sine of the bend
+    at the middle joint (0 in line). A slider among them: the sine of the
+    angle between the revolutes' offset turned by 90 deg and the axis (or
+    between two axes)."""
+    revs = [c for c in cols if c[0] == "r"]
+    if not revs:
+        return None
+    o = revs[0]
+    vecs = []
+    for c in cols:
+        if c is o:
+            continue
+        vecs.append((c[2] - o[2], -(c[1] - o[1])) if c[0] == "r" else (c[1], c[2]))
+    (a1, a2), (b1, b2) = vecs
+    det = a1 * b2 - a2 * b1
+    la, lb = sqrt(a1**2 + a2**2), sqrt(b1**2 + b2**2)
+    if len(revs) < 3:
+        return det / (la * lb)
+    lc = sqrt((a1 - b1)**2 + (a2 - b2)**2)
+    return det * sp.Max(la, lb, lc) / (la * lb * lc)
+
+
+def _root(comp):
+    while comp._parent is not None:
+        comp = comp._parent
+    return comp
+
+
+def drives(cm, joint_path, coordinate):
+    """Whether the joint's coordinate is a state of the compiled model ``cm``
+    (or a function of states only): the index reduction chose it to drive."""
+    e = cm.resolve(sp.Symbol(f"{joint_path}.{coordinate}"))
+    ys = set(cm.dae.y)
+    return (e.free_symbols & ys) <= set(cm.dae.y[:cm.dae.n_states])
+
+
+def monitor_events(joint):
+    """The observer roots of every loop whose first joint is ``joint``."""
+    from .loops import kinematic_loops
+    root = _root(joint)
+    evs = []
+    for loop in kinematic_loops(root):
+        if not loop.joints or loop.joints[0] != joint.path or len(loop.joints) < 4:
+            continue
+        comps = {p: root.find(p) for p in loop.joints}
+        for k, trio in enumerate(itertools.combinations(loop.joints, 3)):
+            sine = minor_sine([column(comps[p]) for p in trio])
+            if sine is None:
+                continue
+            drivers = [p for p in loop.joints if p not in trio]
+            armed = sp.And(*[Eq(comps[p].drives, 1) for p in drivers])
+            g = Piecewise((sine**2 - DEAD_CENTRE_SIN**2, armed), (1, True))
+            evs.append(Event(f"{joint.path}.dead_centre{k}", g, -1,
+                             _warner(loop, trio, drivers), observer=True))
+    return evs
+
+
+def _warner(loop, trio, drivers):
+    def warn(s):
+        warnings.warn(DeadCentreWarning(
+            f"kinematic {loop.name} (joints: {', '.join(loop.joints)}) is within "
+            f"{math.degrees(math.asin(DEAD_CENTRE_SIN)):.1f} deg of a dead centre at "
+            f"t = {s.t:.9g} s: "
+            f"{', '.join(trio)} are nearly in line for the driving joint "
+            f"{', '.join(drivers)}; the solver fails at the dead centre if the motion "
+            f"goes on"), stacklevel=2)
+    return warn
+
+
+def arm_event(joint):
+    """At the start, set the joint's ``drives`` discrete (1: its coordinate
+    is a state of the run, 0: it follows)."""
+    path, coord, flag = joint.path, joint.coordinate, joint.drives
+
+    def decide(s):
+        s[flag] = 1 if drives(s.cm, path, coord) else 0
+
+    return Event(f"{path}.decide_drives", Piecewise((1, Eq(flag, -1)), (-1, True)), +1,
+                 decide, recheck=True)
