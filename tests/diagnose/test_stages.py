@@ -115,8 +115,8 @@ def test_generic_basis_and_penalty():
     lin = np.concatenate([np.linspace(0, 1, N_X), 2 - np.linspace(0, 3, N_V)])
     assert np.allclose(P @ lin, 0.0)         # a linear term is not penalised
     vals = {f"gen.a{i}": 2.0 * i for i in range(N_X)} | {f"gen.b{j}": 0.0 for j in range(N_V)}
-    sh = shape(vals, "gen", (0.0, 6.0, -1.0, 1.0))
-    assert np.allclose(sh["f_x"], 2.0 * sh["x"])   # knots at 0..6: weight 2i at x = i
+    sh = shape(vals, "gen", (0.0, N_X - 1.0, -1.0, 1.0))
+    assert np.allclose(sh["f_x"], 2.0 * sh["x"])   # knots at 0..N_X-1: weight 2i at x = i
 
 
 def test_task_and_result_types_pickle():
