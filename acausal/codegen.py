@@ -21,27 +21,16 @@ from .fastdiff import diff
 _counter = [0]
 
 
-class _Printer(PythonCodePrinter):
-    """Python code of sympy expressions in which every sub-expression that
-    has a name in ``temps`` (common sub-expressions, see :func:`_cse_print`)
-    is written as that name, without rebuilding any expression."""
+class NamedTemps:
+    """Printer mixin (for the Python and the C printer alike): every
+    sub-expression that has a name in ``temps`` (common sub-expressions, see
+    :func:`_cse_print`) is written as that name, without rebuilding any
+    expression; :meth:`definition` writes a named expression itself."""
 
-    def __init__(self, temps=None, symbols=None):
-        super().__init__({"fully_qualified_modules": False, "standard": "python3",
-                          "order": "none"})
+    def _setup_temps(self, temps):
         self.temps = temps or {}
-        self.symbols = symbols or {}
         self._root = None
         self._not_supported, self._number_symbols = set(), set()
-
-    def code(self, expr):
-        """Code of ``expr`` (``doprint`` without its walk of the whole tree
-        for ``UnevaluatedExpr``, which the compiler never creates)."""
-        return self._print(expr)
-
-    def _print_Symbol(self, expr):
-        name = self.symbols.get(expr)
-        return name if name is not None else super()._print_Symbol(expr)
 
     def _print(self, expr, **kw):
         if self.temps and expr is not self._root:
@@ -52,9 +41,31 @@ class _Printer(PythonCodePrinter):
         return super()._print(expr, **kw)
 
     def definition(self, expr):
-        """Code of ``expr`` itself (not its own name), its parts by name."""
+        """Code of ``expr`` itself (not its own name), its parts by name
+        (``doprint`` without its walk of the whole tree for
+        ``UnevaluatedExpr``, which the compiler never creates)."""
         self._root = expr
         return self._print(expr)
+
+
+class _Printer(NamedTemps, PythonCodePrinter):
+    """Python code of sympy expressions, common sub-expressions by name
+    (:class:`NamedTemps`)."""
+
+    def __init__(self, temps=None, symbols=None):
+        super().__init__({"fully_qualified_modules": False, "standard": "python3",
+                          "order": "none"})
+        self._setup_temps(temps)
+        self.symbols = symbols or {}
+
+    def code(self, expr):
+        """Code of ``expr`` (``doprint`` without its walk of the whole tree
+        for ``UnevaluatedExpr``, which the compiler never creates)."""
+        return self._print(expr)
+
+    def _print_Symbol(self, expr):
+        name = self.symbols.get(expr)
+        return name if name is not None else super()._print_Symbol(expr)
 
     def _print_Heaviside(self, expr):
         return f"heaviside({self._print(expr.args[0])})"

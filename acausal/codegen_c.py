@@ -18,35 +18,17 @@ import sympy as sp
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.codeprinter import PrintMethodNotImplementedError
 
-from .codegen import Names, _fixed_entries, _jacobian_entries, _repeated
+from .codegen import NamedTemps, Names, _fixed_entries, _jacobian_entries, _repeated
 
 
-class _Printer(C99CodePrinter):
-    """C of sympy expressions in which every sub-expression named in
-    ``temps`` is written as that name."""
+class _Printer(NamedTemps, C99CodePrinter):
+    """C of sympy expressions, common sub-expressions by name
+    (:class:`~acausal.codegen.NamedTemps`). The printer is strict: a
+    function with no C form raises ``PrintMethodNotImplementedError``."""
 
     def __init__(self, temps=None):
         super().__init__({"order": "none"})
-        self.temps = temps or {}
-        self._root = None
-        self._not_supported, self._number_symbols = set(), set()
-
-    def _print(self, expr, **kw):
-        if self.temps and expr is not self._root:
-            name = self.temps.get(expr)
-            if name is not None:
-                return name
-        self._root = None
-        return super()._print(expr, **kw)
-
-    def definition(self, expr):
-        """C of ``expr`` itself (not its own name), its parts by name
-        (``doprint`` without its walk of the whole tree for
-        ``UnevaluatedExpr``, which the compiler never creates; the printer
-        is strict: a function with no C form raises
-        ``PrintMethodNotImplementedError``)."""
-        self._root = expr
-        return self._print(expr)
+        self._setup_temps(temps)
 
     def _print_Heaviside(self, expr):   # the Python code's heaviside: 1/2 at 0
         return f"acs_heaviside({self._print(expr.args[0])})"
