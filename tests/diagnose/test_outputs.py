@@ -1,0 +1,115 @@
+"""The diagnosis's issue-11 outputs filled by the pipeline, on a slider
+whose data come from an independent scipy simulator (not the project's
+model code): a Coulomb friction the data so far cannot tell from a
+constant load (the slider never reverses). Checked: the JSON keys
+``causes`` (with family and member), ``unexplained``, ``next_experiment``
+(computed: the class's members split by a start on the other side) and
+``profile_ci95`` (checked or profiled intervals), the family stage, and that
+the report draws the next experiment without simulating."""
+import json
+import os
+import pickle
+import time
+
+import numpy as np
+import pytest
+from scipy import integrate
+
+from acausal.compile import CompiledModel
+from acausal.data import Dataset, Experiment, Instrument, Trace, write_dataset
+from acausal.diagnose.problem import FitSettings
+from acausal.diagnose.report import write_report
+from acausal.diagnose.result import summary
+from acausal.diagnose.run import run_stages
+
+HERE = os.path.dirname(__file__)
+SLIDER = os.path.join(HERE, "slider_model.py")
+MASS, STIFF, FRICTION = 1.0, 100.0, 2.0      # the truth
+FLOOR = 1e-4                                  # position noise [m]
+TIMES = np.arange(0.0, 0.25 + 1e-12, 5e-3)
+LIGHT = FitSettings(max_nfev=20, lhs=1, refine=1, windows=(1.0,))
+
+
+def true_slider(s0, v0, times):
+    """m x'' = -k x + F while the slider moves along -s (friction along +s);
+    the truth is only used where it never reverses (checked)."""
+    sol = integrate.solve_ivp(lambda _, y: [y[1], (-STIFF * y[0] + FRICTION) / MASS],
+                              (0.0, times[-1]), [s0, v0], t_eval=times, rtol=1e-11,
+                              atol=1e-13)
+    assert np.all(sol.y[1][1:] < 0), "the truth reverses: the generator does not apply"
+    return sol.y[0]
+
+
+@pytest.fixture(scope="module")
+def slider(tmp_path_factory):
+    d = tmp_path_factory.mktemp("slider")
+    rng = np.random.default_rng(5)
+    exps = [Experiment(name, dict(s0=s0, v0=v0), {},
+                       Trace(TIMES, {"mass.s": true_slider(s0, v0, TIMES)
+                                     + FLOOR * rng.standard_normal(TIMES.size)}))
+            for name, s0, v0 in (("a", 0.1, 0.0), ("b", 0.08, -0.1))]
+    write_dataset(d / "data", Dataset(str(d / "data"), exps,
+                                      {"mass.s": Instrument("mass.s", 0.0, FLOOR)}))
+    t0 = time.perf_counter()
+    res = run_stages(SLIDER, d / "data", out_dir=d / "out", scheduler="serial",
+                     progress=False, hypotheses=["coulomb_friction", "constant_load"],
+                     settings=LIGHT, generic=False, pairs=False, exact_cv=False)
+    res = pickle.loads(pickle.dumps(res))
+    print(f"\nslider diagnosis: {time.perf_counter() - t0:.1f} s")
+    return res, d
+
+
+def test_json_has_the_issue_11_keys_filled(slider):
+    res, _ = slider
+    out = json.loads(json.dumps(summary(res)))
+    assert out["discrepancy"] is True
+    # the family stage fitted the friction family's other members at the mass
+    fitted = {r["cause"] for r in out["ranking"]}
+    assert {"coulomb_viscous_friction", "stribeck_friction"} <= fitted
+    assert out["cause"] in ("coulomb_friction", "constant_load")
+    (c,) = out["causes"]
+    assert c["cause"] == out["cause"] and c["location"] == "mass"
+    assert c["family"] == ("friction" if out["cause"] == "coulomb_friction" else
+                           "constant_load") and c["member"] == out["cause"]
+    F = [v["value"] for k, v in c["parameters"].items()]
+    assert F[0] == pytest.approx(FRICTION, rel=0.05)
+    assert out["unexplained"]["value"] is False
+    cls = out["cause_class"]
+    assert cls["location"] == "mass" and cls["within_floor"] is True
+    assert cls["leftover_floors"] < 1.3
+    # the profile stage: every fitted parameter of the named cause, checked first
+    prof = out["profile_ci95"]
+    assert set(prof) == {"spring.c", c["cause"] and next(iter(c["parameters"]))}
+    for name, p in prof.items():
+        assert p["method"] in ("linear (checked)", "profile")
+        lo, hi = p["ci95"]
+        assert lo < p["value"] < hi
+    assert prof["spring.c"]["ci95"][0] < STIFF < prof["spring.c"]["ci95"][1]
+
+
+def test_next_experiment_splits_the_class(slider):
+    res, _ = slider
+    nxt = json.loads(json.dumps(summary(res)))["next_experiment"]
+    assert nxt["computed"] is True
+    assert {m.split(" at ")[0] for m in nxt["members"]} == {"coulomb_friction",
+                                                           "constant_load"}
+    assert nxt["baseline_floors"] < 3.0       # the experiments run: within the noise
+    assert nxt["separation_floors"] > 30.0 and nxt["decisive"]
+    assert nxt["signal"] == "mass.s" and set(nxt["conditions"]) == {"s0", "v0"}
+    # the friction force reverses with the motion, the load does not: the new
+    # start makes the slider move along +s at some time
+    y = np.array(nxt["predictions"][nxt["members"][0]])
+    assert len(y) == TIMES.size and np.ptp(y) > 0
+
+
+def test_report_shows_the_next_experiment_without_simulating(slider, monkeypatch):
+    res, d = slider
+
+    def no_simulation(*a, **k):
+        raise AssertionError("the report simulated")
+    monkeypatch.setattr(CompiledModel, "simulate", no_simulation)
+    write_report(d / "out", res)
+    text = (d / "out" / "report.md").read_text()
+    assert "## 7. The next experiment" in text and "next_experiment.png" in text
+    assert (d / "out" / "next_experiment.png").stat().st_size > 5000
+    assert "## 8. Profile-likelihood intervals" in text
