@@ -4,7 +4,7 @@ model code): a Coulomb friction the data so far cannot tell from a
 constant load (the slider never reverses). Checked: the JSON keys
 ``causes`` (with family and member), ``unexplained``, ``next_experiment``
 (computed: the class's members split by a start on the other side) and
-``profile_ci95`` (checked or profiled intervals), the family stage, and that
+``profile_ci95`` (checked or profiled intervals), and that
 the report draws the next experiment without simulating."""
 import json
 import os
@@ -27,7 +27,7 @@ SLIDER = os.path.join(HERE, "slider_model.py")
 MASS, STIFF, FRICTION = 1.0, 100.0, 2.0      # the truth
 FLOOR = 1e-4                                  # position noise [m]
 TIMES = np.arange(0.0, 0.25 + 1e-12, 5e-3)
-LIGHT = FitSettings(max_nfev=20, lhs=1, refine=1, windows=(1.0,))
+LIGHT = FitSettings(max_nfev=10, lhs=1, refine=1, windows=(1.0,), evals_per_param=8)
 
 
 def true_slider(s0, v0, times):
@@ -53,7 +53,8 @@ def slider(tmp_path_factory):
     t0 = time.perf_counter()
     res = run_stages(SLIDER, d / "data", out_dir=d / "out", scheduler="serial",
                      progress=False, hypotheses=["coulomb_friction", "constant_load"],
-                     settings=LIGHT, generic=False, pairs=False, exact_cv=False)
+                     settings=LIGHT, generic=False, pairs=False, exact_cv=False,
+                     families=False)
     res = pickle.loads(pickle.dumps(res))
     print(f"\nslider diagnosis: {time.perf_counter() - t0:.1f} s")
     return res, d
@@ -63,9 +64,6 @@ def test_json_has_the_issue_11_keys_filled(slider):
     res, _ = slider
     out = json.loads(json.dumps(summary(res)))
     assert out["discrepancy"] is True
-    # the family stage fitted the friction family's other members at the mass
-    fitted = {r["cause"] for r in out["ranking"]}
-    assert {"coulomb_viscous_friction", "stribeck_friction"} <= fitted
     assert out["cause"] in ("coulomb_friction", "constant_load")
     (c,) = out["causes"]
     assert c["cause"] == out["cause"] and c["location"] == "mass"

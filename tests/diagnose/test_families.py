@@ -1,0 +1,140 @@
+"""Hypotheses as families: each member's law against an independent scipy
+simulation of the same law (not the project's model code), the members
+seeded from their head's fit at the head's site only, and a pair of one
+hypothesis at two sites (its second sub-model renamed)."""
+import os
+
+import numpy as np
+import pytest
+from scipy import integrate
+
+from acausal.diagnose.families import family_index, heads, member_candidates
+from acausal.diagnose.hypotheses import FAMILIES, HYPOTHESES, build_extended, build_pair
+from acausal.diagnose.fitting import Fit
+from acausal.diagnose.problem import Candidate, Param, Problem
+from acausal.diagnose.stages import Row, _heads, pair_candidates
+from acausal.diagnose.tasks import Starts
+from acausal.diagnose.library import load_library
+
+HERE = os.path.dirname(__file__)
+SLIDER = os.path.join(HERE, "slider_model.py")     # 1 kg on a 90 N/m spring, s0 = 0.1 m
+M, C = 1.0, 90.0
+T = np.linspace(0.0, 0.25, 126)
+
+
+def _clip(u, w):
+    return np.clip(u, -w, w)
+
+
+# member -> (values, force on the mass f(s, v) besides the spring's -C s), written
+# here from each law's textbook form
+LAWS = {
+    "coulomb_viscous_friction": (
+        {"hyp_cvf.F": 3.0, "hyp_cvf.b": 4.0, "hyp_cvf.v_eps": 1e-2},
+        lambda s, v: -3.0 * np.tanh(v / 1e-2) - 4.0 * v),
+    "stribeck_friction": (
+        {"hyp_sf.F": 2.0, "hyp_sf.dF": 3.0, "hyp_sf.v_s": 0.2, "hyp_sf.v_eps": 1e-2},
+        lambda s, v: -(2.0 + 3.0 * np.exp(-(v / 0.2) ** 2)) * np.tanh(v / 1e-2)),
+    "power_drag": (
+        {"hyp_pd.c": 5.0, "hyp_pd.n": 1.5, "hyp_pd.v_ref": 0.5, "hyp_pd.v_eps": 1e-3},
+        lambda s, v: -5.0 * v * (v ** 2 + 1e-6) ** 0.25 / 0.5 ** -0.5),
+    "bilinear_spring": (
+        {"hyp_bs.k2": 200.0, "hyp_bs.d": 0.04},
+        lambda s, v: -200.0 * (s - _clip(s, 0.04))),
+    "dead_band_spring": (
+        {"hyp_db.b": 0.03},
+        lambda s, v: C * _clip(s, 0.03)),
+}
+SITE = {"coulomb_viscous_friction": "mass", "stribeck_friction": "mass", "power_drag": "mass",
+        "bilinear_spring": "spring", "dead_band_spring": "spring"}
+
+
+@pytest.mark.parametrize("hid", list(LAWS))
+def test_member_law_matches_an_independent_simulation(hid):
+    values, force = LAWS[hid]
+    mf, cm = build_extended(SLIDER, hid, SITE[hid], values)
+    res = cm.simulate(**mf.experiment.run_options(dense=True))
+    sol = integrate.solve_ivp(lambda _, y: [y[1], (-C * y[0] + force(y[0], y[1])) / M],
+                              (0.0, T[-1]), [0.1, 0.0], t_eval=T, method="LSODA",
+                              rtol=1e-10, atol=1e-12)
+    sim = np.interp(T, res.t, res["mass.s"])
+    assert np.max(np.abs(sim - sol.y[0])) < 2e-5 * 0.1, hid
+    # and the member does something: 1 mm away from the nominal run somewhere
+    nominal = 0.1 * np.cos(np.sqrt(C / M) * T)
+    assert np.max(np.abs(sol.y[0] - nominal)) > 1e-3
+
+
+def test_families_are_declared_once_and_heads_fitted_first():
+    idx = family_index(None)
+    assert idx.family("stribeck_friction") == "friction" and idx.is_head("coulomb_friction")
+    assert idx.family("constant_load") == "constant_load"      # no family: its own class
+    heads_only = _heads(load_library())
+    assert "coulomb_friction" in heads_only and "stribeck_friction" not in heads_only
+    assert all(m in HYPOTHESES for ms in FAMILIES.values() for m in ms)
+
+
+def _row(hid, loc, values, tested=True):
+    cand = Candidate(hid, loc, tuple(Param(k, 0.0, 0.0, 10.0, 1.0, 0.0)
+                                     for k in values if k.startswith("hyp")))
+    names = list(values)
+    fit = Fit(names, dict(values), 1.0, np.zeros(3), np.zeros((3, len(names))), [], [])
+    return Row(cand, fit, Starts(tested=tested), {}, 0.0, 1.0, 1.0)
+
+
+class _Dec:
+    def __init__(self, rows):
+        self.rows, self.failed = tuple(rows), ()
+
+
+def test_members_are_seeded_from_the_head_at_its_site_only():
+    prob = Problem(SLIDER, "", "acausal.diagnose.hypotheses", ())
+    dec = _Dec([_row("coulomb_friction", "mass", {"spring.c": 95.0, "hyp_cf.F": 2.5}),
+                _row("constant_load", "mass", {"spring.c": 95.0, "hyp_cl.F": 2.4})])
+    idx = family_index(prob.library)
+    assert [r.candidate.hypothesis for r in heads(dec, idx)] == ["coulomb_friction"]
+    got = {c.hypothesis: (c, head) for c, head in member_candidates(prob, dec, idx)}
+    assert set(got) == {"coulomb_viscous_friction", "stribeck_friction"}
+    cvf = {p.name: p for p in got["coulomb_viscous_friction"][0].params}
+    assert cvf["hyp_cvf.F"].start == 2.5 and cvf["hyp_cvf.F"].prior == 0.0   # seeded
+    assert cvf["hyp_cvf.b"].start == 0.0
+    assert got["stribeck_friction"][0].location == "mass"
+    # an untested head spends no member fits
+    dec2 = _Dec([_row("coulomb_friction", "mass", {"hyp_cf.F": 0.0}, tested=False)])
+    assert member_candidates(prob, dec2, idx) == []
+
+
+def test_a_pair_uses_one_hypothesis_at_two_sites(tmp_path):
+    f = tmp_path / "two.py"
+    f.write_text(TWO_MASSES)
+    dec = _Dec([_row("constant_load", "m1", {"k.c": 50.0, "hyp_cl.F": 1.0}),
+                _row("constant_load", "m2", {"k.c": 50.0, "hyp_cl.F": 2.0})])
+    (pair,) = pair_candidates(Problem(str(f), "", "acausal.diagnose.hypotheses", ()), dec)
+    assert pair.hypothesis == "constant_load+constant_load" and pair.location == "m1+m2"
+    assert [p.name for p in pair.params] == ["hyp_cl.F", "hyp_cl2.F"]
+    assert [p.start for p in pair.params] == [1.0, 2.0]
+    assert [m[2] for m in pair.members()] == [["hyp_cl.F"], ["hyp_cl2.F"]]
+    mf, cm = build_pair(str(f), (("constant_load", "m1"), ("constant_load", "m2")))
+    res = cm.simulate(params={"hyp_cl.F": 1.0, "hyp_cl2.F": 2.0},
+                      **mf.experiment.run_options(dense=True))
+    # two uncoupled unit masses on 50 N/m springs from rest: s = F/c (1 - cos(w t))
+    w = np.sqrt(50.0)
+    for body, F in (("m1", 1.0), ("m2", 2.0)):
+        np.testing.assert_allclose(res[f"{body}.s"], F / 50.0 * (1 - np.cos(w * res.t)),
+                                   atol=1e-6)
+
+
+TWO_MASSES = '''
+from acausal import Experiment, Model
+from acausal.mechanics.translational import Fixed, Mass, Spring
+
+model = Model()
+model.frame = Fixed()
+model.m1 = Mass(m=1.0, s=0.0, v=0.0)
+model.m2 = Mass(m=1.0, s=0.0, v=0.0)
+model.k1 = Spring(c=50.0)
+model.k2 = Spring(c=50.0)
+model.connect(model.frame.flange, model.k1.flange_a, model.k2.flange_a)
+model.connect(model.k1.flange_b, model.m1.flange)
+model.connect(model.k2.flange_b, model.m2.flange)
+experiment = Experiment(t_end=0.5, rtol=1e-9, atol=1e-12, output_step=1e-2)
+'''
