@@ -92,7 +92,11 @@ def member_candidates(problem, dec, index: FamilyIndex, done=()) -> list:
 
 def fit_members(problem, cal, dec, ex, progress=True, collect=None) -> tuple:
     """Stage: the other members of each competitive family, fitted at the
-    head's site with the free parameters starting from the head's fit."""
+    head's site with the free parameters starting from the head's fit (only
+    when a discrepancy is found: on data the model explains there is no
+    cause class to refine)."""
+    if not dec.discrepancy:
+        return ()
     index = family_index(problem.library)
     done = {r.candidate.key for r in dec.rows} | {r.candidate.key for r in dec.failed}
     pairs = member_candidates(problem, dec, index, done)

@@ -291,7 +291,10 @@ def _section_cost(d):
     t = d.timing
     return ("## Method and cost\n\n"
             f"{t['n_candidates']} candidate fits + the nominal fit in {t['fit_s']:.1f} s, "
-            f"leave-one-out in {t['cv_s']:.1f} s; {t['n_sim']} simulations for the fits. "
+            f"then {t['cv_s']:.1f} s for the later stages (leave-one-out, located term, "
+            f"profiles {t.get('profile_s', 0.0):.1f} s, next experiment "
+            f"{t.get('design_s', 0.0):.1f} s; family members "
+            f"{t.get('families_s', 0.0):.1f} s); {t['n_sim']} simulations for the fits. "
             f"Hypothesis library: `{d.problem.library}`.\n")
 
 

@@ -48,7 +48,7 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
     ``profile``: profile-likelihood intervals where the linearised ones fail
     the check (:mod:`.intervals`); ``design``: the next experiment that
     splits the best candidate's class (:mod:`.nextexp`)."""
-    t0 = time.perf_counter()
+    t0, clock = time.perf_counter(), {}
     problem, ds = stages.load_problem(model_path, data_folder, library, settings)
     cands = stages.candidates(problem, hypotheses, locations)
     with open_executor(scheduler, workers) as ex:
@@ -56,7 +56,8 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
         fits = stages.fit(problem, cal, cands, ex, progress, collect)
         t_fit = time.perf_counter() - t0
         dec = stages.decide(ds, cal, fits, alpha)
-        members = fit_members(problem, cal, dec, ex, progress, collect) if families else ()
+        members = _timed(clock, "families_s", fit_members, problem, cal, dec, ex, progress,
+                         collect) if families else ()
         if members:
             fits += members
             dec = stages.decide(ds, cal, fits, alpha)
@@ -68,11 +69,13 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
         rk = stages.rank(ds, cal, dec, cv)
         where = locate(problem, cal, dec, rk, ex, progress, collect) if generic else Location(
             skipped="not run (generic=False)")
-        ivs = intervals(problem, cal, rk, ex, progress) if profile else None
+        ivs = _timed(clock, "profile_s", intervals, problem, cal, rk, ex,
+                     progress) if profile else None
     Path(out_dir).mkdir(parents=True, exist_ok=True)
     extended = stages.extend(problem, rk, out_dir)
     index = family_index(problem.library)
-    nxt = next_experiment(problem, ds, dec, rk, index) if design else None
+    nxt = _timed(clock, "design_s", next_experiment, problem, ds, dec, rk,
+                 index) if design else None
     t_cv = time.perf_counter() - t0 - t_fit
     shown = None
     if views:
@@ -80,9 +83,17 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
         shown = make_views(problem, cal, rk)
     n_sim = cal.fit.n_sim + sum(r.fit.n_sim for r in fits if r.fit is not None)
     timing = dict(fit_s=t_fit, cv_s=t_cv, n_candidates=len(cands), n_sim=n_sim,
-                  total_s=time.perf_counter() - t0)
+                  total_s=time.perf_counter() - t0, **clock)
     return Diagnosis(problem, ds, cal, len(cands), dec, cv, rk, extended, shown,
                      nxt, timing, where, ivs, index)
+
+
+def _timed(clock, key, fn, *args):
+    """``fn(*args)``, its wall time [s] kept in ``clock[key]``."""
+    t = time.perf_counter()
+    out = fn(*args)
+    clock[key] = time.perf_counter() - t
+    return out
 
 
 def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,

@@ -138,3 +138,61 @@ model.connect(model.k1.flange_b, model.m1.flange)
 model.connect(model.k2.flange_b, model.m2.flange)
 experiment = Experiment(t_end=0.5, rtol=1e-9, atol=1e-12, output_step=1e-2)
 '''
+
+
+BOUNCE = '''
+from acausal import Experiment, Model
+from acausal.mechanics.contact import EndStop
+from acausal.mechanics.translational import Mass
+
+model = Model()
+model.mass = Mass(m=0.1, s=0.0, v=1.0)
+model.stop = EndStop(s_limit=0.01, K=1e7, gamma=1.5, e=0.8, law="lankarani_nikravesh")
+model.connect(model.mass.flange, model.stop.flange)
+experiment = Experiment(t_end=0.03, rtol=1e-10, atol=1e-13, output_step=2e-4)
+'''
+
+
+def _bounce(chi_of_v):
+    """0.1 kg at 1 m/s onto a Hertz stop at 0.01 m (K = 1e7, exponent 1.5):
+    F = K d^1.5 (1 + chi d'/v_i) during the impact, v_i = 1 m/s."""
+    t1 = 0.01
+    chi = chi_of_v(1.0)
+
+    def rhs(_, y):
+        d = max(y[0] - 0.01, 0.0)
+        return [y[1], -1e7 * d ** 1.5 * (1 + chi * y[1] / 1.0) / 0.1]
+
+    def out(_, y):
+        return y[0] - 0.01 + 1e-15
+    out.terminal, out.direction = True, -1
+    sol = integrate.solve_ivp(rhs, (t1, 0.03), [0.01, 1.0], events=out, rtol=1e-11,
+                              atol=1e-14, dense_output=True)
+    t2, v2 = sol.t[-1], sol.y[1, -1]
+
+    def s(t):
+        t = np.asarray(t, float)
+        inside = (t > t1) & (t < t2)
+        after = 0.01 + v2 * (t - t2)
+        return np.where(t <= t1, t, np.where(inside, sol.sol(np.clip(t, t1, t2))[0], after))
+    return s, v2
+
+
+@pytest.mark.parametrize("hid,values,chi", [
+    ("contact_law_hunt_crossley", {"hyp_hc.de": 0.05}, lambda v: 1.5 * (1 - 0.85)),
+    ("contact_law_flores", {"hyp_fo.de": -0.1}, lambda v: 8 * (1 - 0.7) / (5 * 0.7)),
+    ("restitution_power_law", {"hyp_rp.p": 0.3, "hyp_rp.v_ref": 0.5},
+     lambda v: 0.75 * (1 - (0.8 * (v / 0.5) ** -0.3) ** 2)),
+])
+def test_contact_member_law_matches_an_independent_simulation(tmp_path, hid, values, chi):
+    f = tmp_path / "bounce.py"
+    f.write_text(BOUNCE)
+    mf, cm = build_extended(str(f), hid, "stop", values)
+    res = cm.simulate(**mf.experiment.run_options(dense=True))
+    s, v2 = _bounce(chi)
+    # after the impact: the rebound velocity and the free flight (linear in t,
+    # so the comparison does not depend on the output grid)
+    assert res["mass.v"][-1] == pytest.approx(v2, rel=1e-7)
+    assert res["mass.s"][-1] == pytest.approx(float(s(0.03)), abs=1e-9)
+    nominal_v2 = _bounce(lambda v: 0.75 * (1 - 0.8 ** 2))[1]
+    assert abs(v2 - nominal_v2) > 0.02          # the member changes the rebound
