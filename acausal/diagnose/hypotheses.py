@@ -39,6 +39,17 @@ contact_damping_law       contact         e(v_i) = e - a v_i (clipped to [0.01, 
                                           a >= 0: restitution falls with impact speed
 ========================  ==============  =============================================
 
+Families (``FAMILIES``: cause class -> members, the head first; the other
+members are fitted where the head is competitive, :mod:`.families`):
+friction (``coulomb_viscous_friction``: + b v; ``stribeck_friction``:
+(F + dF exp(-(v/v_s)^2)) tanh(v/v_eps)), drag (``power_drag``: c v
+(v^2 + v_eps^2)^((n-1)/2) / v_ref^(n-2)), spring_nonlinearity
+(``bilinear_spring``: k2 (u - clip(u, -d, d)); ``dead_band_spring``: the
+spring's force c (u - clip(u, -b, b))), contact_damping
+(``restitution_power_law``: e (v_i/v_ref)^(-p); ``contact_law_<law>``: the
+contact's damping follows the Hunt-Crossley, Lankarani-Nikravesh or Flores
+law with restitution e + de).
+
 Model files: :meth:`Hypothesis.code` gives the statements that apply a
 hypothesis to ``model`` (a call of :meth:`Hypothesis.apply` with the values
 written out), :func:`write_extended_model` a complete model file that

@@ -2,8 +2,10 @@
 dataclasses to a new one (none mutates its input):
 
 calibrate -> candidates -> fit -> decide -> cross-validate -> rank ->
-extend -> views (the simulated traces and fingerprints the report shows)
--> next experiment (not computed yet: ``None``).
+extend -> views (the simulated traces and fingerprints the report shows);
+the family members (:mod:`.families`), the located term (:mod:`.locate`),
+the intervals (:mod:`.intervals`) and the next experiment
+(:mod:`.nextexp`) are stages of their own modules.
 
 The worker-side units of work are in :mod:`.tasks`; the statistics in
 :mod:`.stats`; :mod:`.run` chains the stages and :mod:`.report` renders

@@ -196,3 +196,59 @@ def test_contact_member_law_matches_an_independent_simulation(tmp_path, hid, val
     assert res["mass.s"][-1] == pytest.approx(float(s(0.03)), abs=1e-9)
     nominal_v2 = _bounce(lambda v: 0.75 * (1 - 0.8 ** 2))[1]
     assert abs(v2 - nominal_v2) > 0.02          # the member changes the rebound
+
+
+RIG = '''
+from acausal import Experiment, Model
+from acausal.mechanics.translational import Fixed, Mass, Spring
+
+model = Model()
+s0 = model.parameter("s0", 0.1, "m", "start position")
+model.frame = Fixed()
+model.mass = Mass(m=1.0, s=s0, v=0.0)
+model.spring = Spring(c=90.0, s_rel0=0.0)
+model.connect(model.frame.flange, model.spring.flange_a)
+model.connect(model.spring.flange_b, model.mass.flange)
+experiment = Experiment(t_end=1.5, rtol=1e-8, atol=1e-11, output_step=5e-3)
+free_parameters = {"spring.c": (50.0, 200.0)}
+'''
+
+
+@pytest.mark.slow
+def test_blind_drag_with_another_exponent_is_named_by_its_family(tmp_path):
+    """Drag f = -3 v |v|^0.4 (exponent 1.4, not the head's 2) on a ringing
+    slider, truth by scipy: the quadratic drag is competitive but leaves
+    misfit, the family's power law is fitted there and named."""
+    import time
+    from acausal.data import Dataset, Experiment, Instrument, Trace, write_dataset
+    from acausal.diagnose.problem import FitSettings
+    from acausal.diagnose.result import summary
+    from acausal.diagnose.run import run_stages
+    (tmp_path / "rig.py").write_text(RIG)
+    times = np.arange(0.0, 1.5 + 1e-12, 5e-3)
+    rng = np.random.default_rng(3)
+    exps = []
+    for name, s0 in (("a", 0.1), ("b", 0.06), ("c", 0.03)):
+        sol = integrate.solve_ivp(
+            lambda _, y: [y[1], (-100.0 * y[0] - 3.0 * y[1] * abs(y[1]) ** 0.4) / 1.0],
+            (0.0, times[-1]), [s0, 0.0], t_eval=times, rtol=1e-11, atol=1e-13)
+        exps.append(Experiment(name, {"s0": s0}, {}, Trace(
+            times, {"mass.s": sol.y[0] + 1e-4 * rng.standard_normal(times.size)})))
+    write_dataset(tmp_path / "data", Dataset(str(tmp_path / "data"), exps,
+                                            {"mass.s": Instrument("mass.s", 0.0, 1e-4)}))
+    t0 = time.perf_counter()
+    res = run_stages(str(tmp_path / "rig.py"), tmp_path / "data", out_dir=tmp_path / "out",
+                     workers=2, progress=False, settings=FitSettings(lhs=2, refine=1))
+    out = summary(res)
+    cc = out["cause_class"]
+    print(f"\n{time.perf_counter() - t0:.0f} s; cause {out['cause']} at {out['location']}, "
+          f"class {cc['family']} members "
+          f"{[(m['member'], round(m['daicc'], 1), m['values']) for m in cc['members']]}, "
+          f"leftover {cc['leftover_floors']:.3f}, held-out {out['gain']['after']['heldout']:.3f}"
+          f"; ranking {[(r['cause'], r['location'], round(r['aicc'], 1)) for r in out['ranking'][:6]]}")
+    assert out["cause"] == "power_drag" and out["location"] == "mass"
+    assert out["causes"][0]["family"] == "drag"
+    assert {m["member"] for m in cc["members"]} == {"quadratic_damping", "power_drag"}
+    assert out["parameters"]["hyp_pd.n"]["value"] == pytest.approx(1.4, rel=0.05)
+    assert out["parameters"]["spring.c"]["value"] == pytest.approx(100.0, rel=0.01)
+    assert out["gain"]["after"]["heldout"] <= 1.5

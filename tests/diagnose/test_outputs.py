@@ -111,3 +111,72 @@ def test_report_shows_the_next_experiment_without_simulating(slider, monkeypatch
     assert "## 7. The next experiment" in text and "next_experiment.png" in text
     assert (d / "out" / "next_experiment.png").stat().st_size > 5000
     assert "## 8. Profile-likelihood intervals" in text
+
+
+def stick_slip(s0, v0, times):
+    """The truth where the slider may reverse: m x'' = -k x - F sign(x'),
+    sticking for good when it stops with |k x| <= F (one solve_ivp per
+    sliding phase, each ended by the event v = 0)."""
+    out = np.full(times.size, np.nan)
+    t, x, v = 0.0, s0, v0
+    mode = np.sign(v) if v != 0 else (0.0 if abs(STIFF * x) <= FRICTION else -np.sign(x))
+    while t < times[-1]:
+        if mode == 0:
+            out[times >= t] = x
+            break
+
+        def stop(_, y):
+            return y[1]
+        stop.terminal, stop.direction = True, -mode
+        sol = integrate.solve_ivp(
+            lambda _, y, m=mode: [y[1], (-STIFF * y[0] - FRICTION * m) / MASS],
+            (t, times[-1]), [x, v], rtol=1e-11, atol=1e-13, events=stop, dense_output=True)
+        seg = (times >= t) & (times <= sol.t[-1])
+        out[seg] = sol.sol(times[seg])[0]
+        t, x, v = sol.t[-1], sol.y[0, -1], 0.0
+        mode = 0.0 if abs(STIFF * x) <= FRICTION else -np.sign(x)
+    return out
+
+
+@pytest.mark.slow
+def test_blind_next_experiment_then_the_second_run_names_one_cause(tmp_path):
+    """Item 4 of issue 11 end to end: the first run cannot tell Coulomb friction
+    from a constant load; data generated under the truth at the computed
+    experiment are added, and the second run names Coulomb friction alone."""
+    rng = np.random.default_rng(7)
+    runs = [("a", 0.1, 0.0), ("b", 0.08, -0.1)]
+    exps = [Experiment(n, dict(s0=s0, v0=v0), {}, Trace(
+        TIMES, {"mass.s": true_slider(s0, v0, TIMES) + FLOOR * rng.standard_normal(TIMES.size)}))
+        for n, s0, v0 in runs]
+    inst = {"mass.s": Instrument("mass.s", 0.0, FLOOR)}
+    write_dataset(tmp_path / "d1", Dataset(str(tmp_path / "d1"), exps, inst))
+    kw = dict(scheduler="serial", progress=False, generic=False,
+              hypotheses=["coulomb_friction", "constant_load"],
+              settings=FitSettings(lhs=2, refine=1))
+    t0 = time.perf_counter()
+    first = summary(run_stages(SLIDER, tmp_path / "d1", out_dir=tmp_path / "o1", **kw))
+    t1 = time.perf_counter() - t0
+    nxt = first["next_experiment"]
+    print(f"\nfirst run: cause {first['cause']}, class {first['equivalent_causes']}, "
+          f"rivals {nxt['members']}")
+    assert first["discrepancy"] and nxt["computed"] and nxt["decisive"]
+    # the class the data cannot split: a friction law and the constant load
+    assert sorted(m.split(" at ")[0] for m in nxt["members"]) in (
+        ["constant_load", m] for m in ("coulomb_friction", "coulomb_viscous_friction",
+                                       "stribeck_friction"))
+    c = nxt["conditions"]
+    y = stick_slip(c["s0"], c["v0"], TIMES) + FLOOR * rng.standard_normal(TIMES.size)
+    exps.append(Experiment("next", dict(c), {}, Trace(TIMES, {"mass.s": y})))
+    write_dataset(tmp_path / "d2", Dataset(str(tmp_path / "d2"), exps, inst))
+    second = summary(run_stages(SLIDER, tmp_path / "d2", out_dir=tmp_path / "o2", **kw))
+    assert second["cause"] == "coulomb_friction" and second["location"] == "mass"
+    assert "constant_load" not in {e["cause"] for e in second["equivalent_causes"]}
+    F = second["parameters"]["hyp_cf.F"]["value"]
+    assert F == pytest.approx(FRICTION, rel=0.05)
+    assert second["gain"]["after"]["heldout"] <= 1.5
+    print(f"\nfirst run ({t1:.0f} s): class {first['cause']} + "
+          f"{first['equivalent_causes']}, next experiment {c} on {nxt['signal']}: "
+          f"{nxt['separation_floors']:.0f} floors (baseline {nxt['baseline_floors']:.2f}); "
+          f"second run: {second['cause']} F = {F:.4f} N, held-out "
+          f"{second['gain']['after']['heldout']:.3f}, ranking "
+          f"{[(r['cause'], round(r['aicc'], 1)) for r in second['ranking']]}")
