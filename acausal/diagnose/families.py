@@ -108,3 +108,33 @@ def fit_members(problem, cal, dec, ex, progress=True, collect=None) -> tuple:
              for t, (_, head) in zip(tasks, pairs)]
     return tuple(run_tasks(ex, fit_candidate, tasks, "fitting family members", progress,
                            collect))
+
+
+PARSIMONY = 2.0       # AICc units: an extra parameter that gains less is uninformative
+
+
+def prefer_simplest(rk, index: FamilyIndex):
+    """The ranking with the named (and best) row moved to the member of the
+    same family at the same site with the fewest parameters whose AICc is
+    within PARSIMONY units of it: a law with an extra parameter that gains
+    less than 2 AICc units is not supported by the data (Arnold, "Uninformative
+    parameters and model selection using Akaike's Information Criterion",
+    J. Wildlife Management 74 (2010) 1175-1178; Burnham and Anderson 2002,
+    sec. 2.6). Coulomb friction is then named rather than Coulomb + viscous
+    with a viscous term the data cannot see. Rows and classes are unchanged."""
+    if rk.after is None:
+        return rk
+    best = rk.rows[rk.after]
+    hid, loc = best.candidate.key
+    if "+" in hid:
+        return rk
+    fam = index.family(hid)
+    mates = [i for i, r in enumerate(rk.rows) if r.candidate.location == loc
+             and "+" not in r.candidate.hypothesis
+             and index.family(r.candidate.hypothesis) == fam
+             and r.aicc <= best.aicc + PARSIMONY and r.starts.tested]
+    pick = min(mates, key=lambda i: (rk.rows[i].k, rk.rows[i].aicc), default=rk.after)
+    if pick == rk.after:
+        return rk
+    return dataclasses.replace(rk, after=pick,
+                               cause=pick if rk.cause is not None else None)

@@ -62,7 +62,7 @@ def class_rows(dec, rk, index=None) -> list:
         return []
     first = next((c for c in rk.classes if rk.after in c), rk.classes[0])
     out, seen = [], set()
-    for i in sorted(first):
+    for i in [rk.after] + sorted(i for i in first if i != rk.after):
         c = rk.rows[i].candidate
         key = (index.family(c.hypothesis) if index is not None else c.hypothesis, c.location)
         if key not in seen:

@@ -21,7 +21,7 @@ from pathlib import Path
 from ..executor import open_executor
 from . import stages
 from . import stats as st
-from .families import family_index, fit_members
+from .families import family_index, fit_members, prefer_simplest
 from .intervals import intervals
 from .locate import Location, locate
 from .nextexp import next_experiment
@@ -67,6 +67,8 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
             dec = stages.decide(ds, cal, fits, alpha)
         cv = stages.cross_validate(problem, ds, cal, dec, ex, exact_cv, progress)
         rk = stages.rank(ds, cal, dec, cv)
+        if families:
+            rk = prefer_simplest(rk, family_index(problem.library))
         where = locate(problem, cal, dec, rk, ex, progress, collect) if generic else Location(
             skipped="not run (generic=False)")
         ivs = _timed(clock, "profile_s", intervals, problem, cal, rk, ex,

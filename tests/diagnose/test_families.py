@@ -252,3 +252,25 @@ def test_blind_drag_with_another_exponent_is_named_by_its_family(tmp_path):
     assert out["parameters"]["hyp_pd.n"]["value"] == pytest.approx(1.4, rel=0.05)
     assert out["parameters"]["spring.c"]["value"] == pytest.approx(100.0, rel=0.01)
     assert out["gain"]["after"]["heldout"] <= 1.5
+
+
+def test_an_uninformative_extra_parameter_does_not_take_the_name():
+    """Within a family at a site, the member with fewer parameters is named
+    when the richer one gains less than 2 AICc units (Arnold 2010)."""
+    from acausal.diagnose.families import prefer_simplest
+    from acausal.diagnose.stages import Ranking
+    rows = (_row("coulomb_viscous_friction", "mass", {"hyp_cvf.F": 2.0, "hyp_cvf.b": 0.01}),
+            _row("coulomb_friction", "mass", {"hyp_cf.F": 2.0}),
+            _row("constant_load", "mass", {"hyp_cl.F": 2.0}))
+    import dataclasses
+    rows = tuple(dataclasses.replace(r, aicc=a) for r, a in zip(rows, (10.0, 11.5, 11.9)))
+    rk = Ranking(rows, [[0, 1, 2]], 0, 0, None, [], (), 1.0)
+    got = prefer_simplest(rk, family_index(None))
+    assert got.named.candidate.hypothesis == "coulomb_friction" and got.after == 1
+    # 2.5 units: the viscous term earns its place
+    rows2 = (rows[0], dataclasses.replace(rows[1], aicc=12.5), rows[2])
+    assert prefer_simplest(Ranking(rows2, [[0, 1, 2]], 0, 0, None, [], (), 1.0),
+                           family_index(None)).after == 0
+    # the constant load is another class of cause: never swapped in
+    assert prefer_simplest(Ranking(rows[2:] + rows[:2], [[0]], 0, 0, None, [], (), 1.0),
+                           family_index(None)).after == 0
