@@ -178,6 +178,7 @@ def _bounce(chi_of_v):
     return s, v2
 
 
+@pytest.mark.slow      # 3 x ~0.7 s on a quiet machine: kept out of the default tier's budget
 @pytest.mark.parametrize("hid,values,chi", [
     ("contact_law_hunt_crossley", {"hyp_hc.de": 0.05}, lambda v: 1.5 * (1 - 0.85)),
     ("contact_law_flores", {"hyp_fo.de": -0.1}, lambda v: 8 * (1 - 0.7) / (5 * 0.7)),
