@@ -180,3 +180,44 @@ def test_blind_next_experiment_then_the_second_run_names_one_cause(tmp_path):
           f"second run: {second['cause']} F = {F:.4f} N, held-out "
           f"{second['gain']['after']['heldout']:.3f}, ranking "
           f"{[(r['cause'], round(r['aicc'], 1)) for r in second['ranking']]}")
+
+
+def test_without_declared_conditions_the_separation_is_stated():
+    """No condition to search: the rivals' separation at the experiment run
+    (in floors) and why, not a null."""
+    from acausal.design import Signal
+    from acausal.diagnose.nextexp import _fixed_only
+    t = np.linspace(0.0, 1.0, 11)
+    rivals = {"a": lambda c: {"y": c["k"] * t}, "b": lambda c: {"y": c["k"] * t + 0.02}}
+    ref = Experiment("e1", {"k": 2.0}, {}, Trace(t, {"y": 2.0 * t}))
+    got = _fixed_only(rivals, [Signal("y", 0.01)], ref, t).to_dict()
+    assert got["conditions"] == {} and got["decisive"] is False
+    assert got["separation_floors"] == pytest.approx(2.0 * np.sqrt(11))
+    assert got["baseline_floors"] == got["separation_floors"]
+    assert "declares no conditions" in got["message"] and "e1" in got["message"]
+
+
+@pytest.mark.slow
+def test_a_parameter_whose_wald_interval_crosses_its_bound_is_profiled(slider):
+    """The profile stage's traced path: with the load's lower bound moved
+    inside its Wald interval the cheap check fails, the profile is traced,
+    open at the bound below and closed above, where it agrees with the Wald
+    end (the model is nearly linear in F)."""
+    import dataclasses
+    from acausal.diagnose.intervals import profile_parameter, profile_tasks
+    res, _ = slider
+    label, tasks = profile_tasks(res.problem, res.calibration, res.ranking)
+    i = next(k for k, t in enumerate(tasks) if t.params[t.index].name.startswith("hyp_"))
+    task = tasks[i]
+    p = task.params[i]
+    first = profile_parameter(task)
+    assert first.method == "linear (checked)"
+    half = first.wald[1] - p.start
+    moved = dataclasses.replace(p, low=p.start - 0.3 * half)
+    task = dataclasses.replace(task, params=task.params[:i] + (moved,) + task.params[i + 1:])
+    got = profile_parameter(task)
+    print(f"\n{p.name}: Wald {first.wald}, profile [{got.lower}, {got.upper}] "
+          f"open {got.open_lower}/{got.open_upper}, {got.n_eval} evaluations")
+    assert got.method == "profile" and got.open_lower and not got.open_upper
+    assert got.lower == pytest.approx(moved.low)
+    assert got.upper == pytest.approx(first.wald[1], rel=0.1 * half / first.wald[1] + 1e-9)
