@@ -168,7 +168,9 @@ def details(d: Diagnosis) -> dict:
                      dict(aicc=num(dec.a0), starts=_starts(cal.nominal.starts))),
         free_drift=[dict(name=x.name, prior=x.prior, calibrated=x.calibrated,
                          relative=x.relative, far=x.far) for x in cal.drift],
-        candidates=[_one(dict(cause=r.candidate.hypothesis, location=r.candidate.location),
+        candidates=[_one(dict(cause=r.candidate.hypothesis, location=r.candidate.location,
+                              family="+".join(family_of(d, h) for h, _, _ in
+                                              r.candidate.members())),
                          r.fit, dict(aicc=num(r.aicc), heldout_rmse=num(r.heldout_rmse),
                                      lr_p=num(r.lr_p), starts=_starts(r.starts)))
                     for r in rk.rows],

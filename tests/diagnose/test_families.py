@@ -121,6 +121,18 @@ def test_a_pair_uses_one_hypothesis_at_two_sites(tmp_path):
     for body, F in (("m1", 1.0), ("m2", 2.0)):
         np.testing.assert_allclose(res[f"{body}.s"], F / 50.0 * (1 - np.cos(w * res.t)),
                                    atol=1e-6)
+    # the extended model file applies both (the second renamed) and runs
+    import dataclasses
+    from acausal.diagnose.stages import Ranking, extend
+    from acausal.modelfile import compile_file
+    row = _row("constant_load+constant_load", "m1+m2", {"hyp_cl.F": 1.0, "hyp_cl2.F": 2.0})
+    row = dataclasses.replace(row, candidate=pair)
+    path = extend(Problem(str(f), "", "acausal.diagnose.hypotheses", ()),
+                  Ranking((row,), [[0]], 0, 0, None, [], (), 1.0), tmp_path / "out")
+    assert ".renamed('hyp_cl2')" in open(path).read()
+    mf2, cm2 = compile_file(path)
+    res2 = cm2.simulate(**mf2.experiment.run_options(dense=True))
+    np.testing.assert_allclose(res2["m2.s"], 2.0 / 50.0 * (1 - np.cos(w * res2.t)), atol=1e-6)
 
 
 TWO_MASSES = '''
