@@ -83,6 +83,10 @@ def test_json_has_the_issue_11_keys_filled(slider):
         lo, hi = p["ci95"]
         assert lo < p["value"] < hi
     assert prof["spring.c"]["ci95"][0] < STIFF < prof["spring.c"]["ci95"][1]
+    from acausal.diagnose.result import details
+    rows = json.loads(json.dumps(details(res)))["candidates"]
+    assert {r["cause"]: r["family"] for r in rows} == {"coulomb_friction": "friction",
+                                                        "constant_load": "constant_load"}
 
 
 def test_next_experiment_splits_the_class(slider):
