@@ -643,7 +643,7 @@ class StribeckFriction(CoulombFriction):
     title = "Stribeck friction at a joint"
     prefix = "hyp_sf"
     law = ("f = -(F + dF*exp(-(v/v_s)^2))*tanh(v/v_eps): kinetic level F, static excess "
-           "dF >= 0 falling off over the Stribeck speed v_s")
+           "dF >= 0 falling off over the Stribeck speed v_s (tau, dtau when rotational)")
     explanation = ("Friction that is higher near rest than in sliding (the Stribeck effect "
                    "of a lubricated contact): slow phases lose more than fast ones.")
 
@@ -651,7 +651,7 @@ class StribeckFriction(CoulombFriction):
         t = graph.typical(location)
         d = domain_of(graph.components[location])
         return super().params(graph, location) + [
-            self._spec("dF", 0.0, 0.5 * t["force"], d.force_unit,
+            self._spec(f"d{d.force_name}", 0.0, 0.5 * t["force"], d.force_unit,
                        f"static friction excess over the kinetic level at {location}"),
             self._spec("v_s", 1e-3 * t["speed"], t["speed"], d.rate_unit,
                        f"Stribeck speed at {location}", initial=0.1 * t["speed"],
@@ -662,7 +662,8 @@ class StribeckFriction(CoulombFriction):
         d = domain_of(body)
         F = self._par(hyp, vals, d.force_name, d.force_unit,
                       f"kinetic friction level at {location}", min=0.0)
-        dF = self._par(hyp, vals, "dF", d.force_unit, f"static excess at {location}", min=0.0)
+        dF = self._par(hyp, vals, f"d{d.force_name}", d.force_unit,
+                       f"static excess at {location}", min=0.0)
         vs = self._par(hyp, vals, "v_s", d.rate_unit, "Stribeck speed", min=0.0, min_open=True)
         eps = self._par(hyp, vals, "v_eps", d.rate_unit, "speed below which the friction "
                         "is regularised", min=0.0, min_open=True)
