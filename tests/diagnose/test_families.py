@@ -258,7 +258,7 @@ def test_blind_drag_with_another_exponent_is_named_by_its_family(tmp_path):
           f"class {cc['family']} members "
           f"{[(m['member'], round(m['daicc'], 1), m['values']) for m in cc['members']]}, "
           f"leftover {cc['leftover_floors']:.3f}, held-out {out['gain']['after']['heldout']:.3f}"
-          f"; ranking {[(r['cause'], r['location'], round(r['aicc'], 1)) for r in out['ranking'][:6]]}")
+          f"; ranking {[(r['cause'], round(r['aicc'], 1)) for r in out['ranking'][:6]]}")
     assert out["cause"] == "power_drag" and out["location"] == "mass"
     assert out["causes"][0]["family"] == "drag"
     assert {m["member"] for m in cc["members"]} == {"quadratic_damping", "power_drag"}
