@@ -705,8 +705,9 @@ class PowerDrag(QuadraticDamping):
 
 
 def _spring_offset(graph, spring, d):
-    """(c, u(x)): the spring's rate and its deflection from its free length as
-    a function of the relative displacement x (as :class:`HardeningSpring`)."""
+    """(c, u(x)): the spring's rate (its value) and its deflection from its
+    free length as a function of the relative displacement x (as
+    :class:`HardeningSpring`)."""
     decl = spring.declarations()
 
     def ab(name):
@@ -774,7 +775,10 @@ class DeadBandSpring(HardeningSpring):
     def _extend(self, model, graph, hyp, location, vals):
         spring = model.find(location)
         d = domain_of(spring)
-        c, u = _spring_offset(graph, spring, d)
+        _, u = _spring_offset(graph, spring, d)
+        # the spring's own rate (its symbol, not its value: a calibrated or
+        # fitted spring.c moves the band's force with the spring's)
+        c = spring.c
         b = self._par(hyp, vals, "b", d.length_unit, f"dead band of {location}", min=0.0)
         hyp.band = d.component("relative_source", **{d.through: lambda x: -c * _clip(u(x), b)})
         model.connect(hyp.band.flange_a, spring.flange_a)
