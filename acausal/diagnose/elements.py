@@ -4,8 +4,9 @@ have (sign convention: :mod:`acausal.connectors`).
 * :class:`DisplacementForce` / :class:`DisplacementTorque`: a force growing
   linearly with the displacement of a flange from where it was at the start
   of the run (captured by an initial event, so it needs no start value).
-* :class:`VelocityRestitution`: a mixin that makes a contact's coefficient
-  of restitution fall linearly with the impact velocity.
+* :class:`VelocityRestitution`, :class:`PowerRestitution`: mixins that make
+  a contact's coefficient of restitution fall with the impact velocity
+  (linearly, or as a power law).
 """
 from sympy import Max, Min, Piecewise
 
@@ -74,17 +75,15 @@ class DisplacementTorque(Component):
         return [_capture(self, self.flange.phi)]
 
 
-class VelocityRestitution:
+class RestitutionLaw:
     """Mixin for a :class:`acausal.mechanics.contact.PartialContact`: the damping
-    of each impact uses ``e(v_i) = clip(e - slope * v_i, E_MIN, 1)`` instead of
-    ``e`` (``v_i`` the impact velocity captured at the onset, so ``e(v_i)`` is
-    constant during an impact). ``slope`` [s/m] is the symbol stored in the
-    instance attribute ``_e_slope`` (a model parameter). Law ``beta`` has no
-    restitution and is left unchanged. Applied by :func:`make_velocity_restitution`.
-    """
+    of each impact uses ``e_eff`` (:meth:`_e_eff`, a function of the impact
+    velocity ``v_i`` captured at the onset, so constant during an impact)
+    instead of ``e``. Law ``beta`` has no restitution and is left unchanged.
+    Subclasses define :meth:`_e_eff`."""
 
     def _e_eff(self):
-        return Max(E_MIN, Min(1, self.e - self._e_slope * self.v_i))
+        raise NotImplementedError
 
     def _factor(self):
         if self.law == "beta":
@@ -99,21 +98,55 @@ class VelocityRestitution:
         return damping_chi(self.law, self._e_eff()) * self.a_rel / self.v_i
 
 
+class VelocityRestitution(RestitutionLaw):
+    """``e(v_i) = clip(e - slope * v_i, E_MIN, 1)``; ``slope`` [s/m] is the
+    symbol stored in the instance attribute ``_e_slope`` (a model parameter).
+    Applied by :func:`make_velocity_restitution`."""
+
+    def _e_eff(self):
+        return Max(E_MIN, Min(1, self.e - self._e_slope * self.v_i))
+
+
+class PowerRestitution(RestitutionLaw):
+    """A restitution power law ``e(v_i) = clip(e * (v_i / v_ref)^(-p), E_MIN,
+    1)`` (``p`` >= 0: faster impacts dissipate a larger fraction); ``p`` and
+    ``v_ref`` are the symbols in ``_e_power`` and ``_e_vref``. Applied by
+    :func:`make_power_restitution`."""
+
+    def _e_eff(self):
+        return Max(E_MIN, Min(1, self.e * (self.v_i / self._e_vref) ** (-self._e_power)))
+
+
 _SWAPPED = {}
 
 
-def make_velocity_restitution(contact, slope):
-    """Turn ``contact`` (a PartialContact instance, already in its model) into
-    one whose restitution falls with the impact velocity at ``slope``: its
-    class becomes a subclass with :class:`VelocityRestitution` mixed in (same
-    connectors, parameters, start values and connections)."""
+def _swap(contact, mixin):
+    """Give ``contact`` (a PartialContact instance, already in its model) the
+    class ``mixin`` + its own (same connectors, parameters, start values and
+    connections)."""
     cls = type(contact)
-    if not issubclass(cls, VelocityRestitution):
-        sub = _SWAPPED.get(cls)
+    if not issubclass(cls, mixin):
+        sub = _SWAPPED.get((cls, mixin))
         if sub is None:
-            sub = _SWAPPED[cls] = type(f"VelocityRestitution{cls.__name__}",
-                                       (VelocityRestitution, cls),
-                                       {"__module__": __name__, "__doc__": cls.__doc__})
+            sub = _SWAPPED[(cls, mixin)] = type(f"{mixin.__name__}{cls.__name__}", (mixin, cls),
+                                                {"__module__": __name__,
+                                                 "__doc__": cls.__doc__})
         contact.__class__ = sub
+    return contact
+
+
+def make_velocity_restitution(contact, slope):
+    """Make ``contact``'s restitution fall with the impact velocity at ``slope``
+    (:class:`VelocityRestitution`)."""
+    _swap(contact, VelocityRestitution)
     object.__setattr__(contact, "_e_slope", slope)
+    return contact
+
+
+def make_power_restitution(contact, power, v_ref):
+    """Make ``contact``'s restitution follow the power law of
+    :class:`PowerRestitution` with exponent ``power`` and reference speed ``v_ref``."""
+    _swap(contact, PowerRestitution)
+    object.__setattr__(contact, "_e_power", power)
+    object.__setattr__(contact, "_e_vref", v_ref)
     return contact

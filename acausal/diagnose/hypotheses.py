@@ -39,6 +39,17 @@ contact_damping_law       contact         e(v_i) = e - a v_i (clipped to [0.01, 
                                           a >= 0: restitution falls with impact speed
 ========================  ==============  =============================================
 
+Families (``FAMILIES``: cause class -> members, the head first; the other
+members are fitted where the head is competitive, :mod:`.families`):
+friction (``coulomb_viscous_friction``: + b v; ``stribeck_friction``:
+(F + dF exp(-(v/v_s)^2)) tanh(v/v_eps)), drag (``power_drag``: c v
+(v^2 + v_eps^2)^((n-1)/2) / v_ref^(n-2)), spring_nonlinearity
+(``bilinear_spring``: k2 (u - clip(u, -d, d)); ``dead_band_spring``: the
+spring's force c (u - clip(u, -b, b))), contact_damping
+(``restitution_power_law``: e (v_i/v_ref)^(-p); ``contact_law_<law>``: the
+contact's damping follows the Hunt-Crossley, Lankarani-Nikravesh or Flores
+law with restitution e + de).
+
 Model files: :meth:`Hypothesis.code` gives the statements that apply a
 hypothesis to ``model`` (a call of :meth:`Hypothesis.apply` with the values
 written out), :func:`write_extended_model` a complete model file that
@@ -58,9 +69,10 @@ from ..compile import compile_model
 from ..errors import ModelError
 from ..modelfile import load_model_file
 from .domain import domain_of
-from .elements import make_velocity_restitution
+from .elements import make_power_restitution, make_velocity_restitution
 from .graph import ModelGraph, has_role
 from .nominal import nominal_result
+from .problem import second_prefix
 
 
 @dataclass
@@ -138,14 +150,24 @@ class Hypothesis:
         self._extend(model, graph, hyp, location, vals)
         return specs
 
+    def renamed(self, prefix):
+        """This hypothesis with its sub-model named ``prefix`` (a pair that
+        applies one hypothesis at two sites: ``hyp_cf`` and ``hyp_cf2``)."""
+        out = copy.copy(self)
+        out.prefix = prefix
+        return out
+
     def code(self, location, values):
         """Python statements that apply this hypothesis with ``values`` to a
         variable ``model`` in a model file."""
         vals = ", ".join(f"{k!r}: {float(v)!r}" for k, v in sorted((values or {}).items()))
+        default = HYPOTHESES[self.id].prefix if self.id in HYPOTHESES else type(self).prefix
+        which = (f"_HYPOTHESES[{self.id!r}]" if self.prefix == default else
+                 f"_HYPOTHESES[{self.id!r}].renamed({self.prefix!r})")
         return (f"# hypothesis {self.id} at {location}: {self.title}\n"
                 f"#   {self.law}\n"
                 "from acausal.diagnose.hypotheses import HYPOTHESES as _HYPOTHESES\n"
-                f"hypothesis_specs = _HYPOTHESES[{self.id!r}].apply(model, {location!r}, "
+                f"hypothesis_specs = {which}.apply(model, {location!r}, "
                 f"{{{vals}}})\n")
 
     # -- helpers for subclasses -----------------------------------------------------------
@@ -589,9 +611,263 @@ class ContactDampingLaw(Hypothesis):
         make_velocity_restitution(model.find(location), a)
 
 
+# -- family members: other standard laws of the same effects ---------------------------------
+class CoulombViscousFriction(CoulombFriction):
+    id = "coulomb_viscous_friction"
+    title = "Coulomb plus viscous friction at a joint"
+    prefix = "hyp_cvf"
+    law = ("f = -F*tanh(v/v_eps) - b*v on the body against the frame: Coulomb friction "
+           "plus a viscous term (lubricated guide)")
+    explanation = ("A friction force with a constant part (dry contact) and a part growing "
+                   "in proportion to the speed (a lubricating film, seals).")
+
+    def params(self, graph, location):
+        t = graph.typical(location)
+        d = domain_of(graph.components[location])
+        return super().params(graph, location) + [self._spec(
+            "b", 0.0, 0.5 * t["force"] / t["speed"], d.unit("{F}*s/{L}"),
+            f"viscous friction coefficient at the {d.guide} of {location}")]
+
+    def _extend(self, model, graph, hyp, location, vals):
+        super()._extend(model, graph, hyp, location, vals)
+        body = model.find(location)
+        d = domain_of(body)
+        b = self._par(hyp, vals, "b", d.unit("{F}*s/{L}"), f"viscous friction at {location}",
+                      min=0.0)
+        hyp.viscous = d.source(-b * getattr(body, d.rate))
+        model.connect(hyp.viscous.flange, body.flange)
+
+
+class StribeckFriction(CoulombFriction):
+    id = "stribeck_friction"
+    title = "Stribeck friction at a joint"
+    prefix = "hyp_sf"
+    law = ("f = -(F + dF*exp(-(v/v_s)^2))*tanh(v/v_eps): kinetic level F, static excess "
+           "dF >= 0 falling off over the Stribeck speed v_s (tau, dtau when rotational)")
+    explanation = ("Friction that is higher near rest than in sliding (the Stribeck effect "
+                   "of a lubricated contact): slow phases lose more than fast ones.")
+
+    def params(self, graph, location):
+        t = graph.typical(location)
+        d = domain_of(graph.components[location])
+        return super().params(graph, location) + [
+            self._spec(f"d{d.force_name}", 0.0, 0.5 * t["force"], d.force_unit,
+                       f"static friction excess over the kinetic level at {location}"),
+            self._spec("v_s", 1e-3 * t["speed"], t["speed"], d.rate_unit,
+                       f"Stribeck speed at {location}", initial=0.1 * t["speed"],
+                       scale=0.1 * t["speed"])]
+
+    def _extend(self, model, graph, hyp, location, vals):
+        body = model.find(location)
+        d = domain_of(body)
+        F = self._par(hyp, vals, d.force_name, d.force_unit,
+                      f"kinetic friction level at {location}", min=0.0)
+        dF = self._par(hyp, vals, f"d{d.force_name}", d.force_unit,
+                       f"static excess at {location}", min=0.0)
+        vs = self._par(hyp, vals, "v_s", d.rate_unit, "Stribeck speed", min=0.0, min_open=True)
+        eps = self._par(hyp, vals, "v_eps", d.rate_unit, "speed below which the friction "
+                        "is regularised", min=0.0, min_open=True)
+        v = getattr(body, d.rate)
+        hyp.friction = d.source(-(F + dF * sp.exp(-(v / vs) ** 2)) * sp.tanh(v / eps))
+        model.connect(hyp.friction.flange, body.flange)
+
+
+class PowerDrag(QuadraticDamping):
+    id = "power_drag"
+    title = "Drag growing with a power n of the speed"
+    prefix = "hyp_pd"
+    fixed = {"v_ref": 1.0, "v_eps": 1e-3}
+    law = ("f = -c*v*(v^2 + v_eps^2)^((n-1)/2) / v_ref^(n-2) (about -c*v*|v|^(n-1)/v_ref^(n-2); "
+           "n = 2 is quadratic drag, n = 1 viscous), v_ref the body's typical speed")
+    explanation = ("A drag growing with a power of the speed between linear (laminar, "
+                   "viscous) and quadratic or steeper (turbulent, orifice flow).")
+
+    def params(self, graph, location):
+        return super().params(graph, location) + [self._spec(
+            "n", 1.0, 3.0, "1", f"exponent of the drag on {location}", initial=2.0, scale=0.5)]
+
+    def defaults(self, graph, location):
+        v = graph.typical(location)["speed"]
+        return {"v_ref": v, "v_eps": 1e-3 * v}
+
+    def _extend(self, model, graph, hyp, location, vals):
+        body = model.find(location)
+        d = domain_of(body)
+        c = self._par(hyp, vals, "c", d.unit("{F}*s^2/{L}^2"), f"drag on {location}", min=0.0)
+        n = self._par(hyp, vals, "n", "1", "drag exponent", min=1.0, max=3.0)
+        vr = self._par(hyp, vals, "v_ref", d.rate_unit, "reference speed", min=0.0,
+                       min_open=True)
+        eps = self._par(hyp, vals, "v_eps", d.rate_unit, "regularisation speed", min=0.0,
+                        min_open=True)
+        v = getattr(body, d.rate)
+        hyp.drag = d.source(-c * v * (v ** 2 + eps ** 2) ** ((n - 1) / 2) / vr ** (n - 2))
+        model.connect(hyp.drag.flange, body.flange)
+
+
+def _spring_offset(graph, spring, d):
+    """(c, u(x)): the spring's rate (its value) and its deflection from its
+    free length as a function of the relative displacement x (as
+    :class:`HardeningSpring`)."""
+    decl = spring.declarations()
+
+    def ab(name):
+        return graph.absolute(spring.value(name), spring) if name in decl else 0
+    c = ab("c")
+    rigid = isinstance(c, (int, float)) and c == 0
+    free = ab(d.rel0) if rigid else ab(d.rel0) - ab(d.preload) / c
+    return c, (lambda x: x - free)
+
+
+def _clip(u, w):
+    return sp.Max(-w, sp.Min(w, u))
+
+
+class BilinearSpring(HardeningSpring):
+    id = "bilinear_spring"
+    title = "A piecewise-linear (bilinear) spring"
+    prefix = "hyp_bs"
+    law = ("f = k2*(u - clip(u, -d, d)) in parallel with the spring, u its deflection from "
+           "the free length: an extra stiffness k2 beyond |u| = d (a stop or second coil "
+           "engaging; k2 < 0 softens)")
+    explanation = ("The spring's rate changes at a deflection (a second spring or a rubber "
+                   "stop engages, a coil closes): the force is piecewise linear.")
+
+    def params(self, graph, location):
+        s = graph.site("spring", location)
+        _, dev = graph.spring_deflection(s.component)
+        c = graph.param(s.component, "c")
+        c = c if c > 0 else 1.0
+        d = domain_of(s.component)
+        return [self._spec("k2", -c / 2, 4 * c, d.unit("{F}/{L}"),
+                           f"extra stiffness of {location} beyond the knee"),
+                self._spec("d", 0.0, 2 * dev, d.length_unit, f"knee deflection of {location}",
+                           initial=dev / 2, scale=dev / 2)]
+
+    def _extend(self, model, graph, hyp, location, vals):
+        spring = model.find(location)
+        d = domain_of(spring)
+        _, u = _spring_offset(graph, spring, d)
+        k2 = self._par(hyp, vals, "k2", d.unit("{F}/{L}"), f"extra stiffness at {location}")
+        w = self._par(hyp, vals, "d", d.length_unit, f"knee of {location}", min=0.0)
+        hyp.knee = d.component("relative_source",
+                               **{d.through: lambda x: k2 * (u(x) - _clip(u(x), w))})
+        model.connect(hyp.knee.flange_a, spring.flange_a)
+        model.connect(hyp.knee.flange_b, spring.flange_b)
+
+
+class DeadBandSpring(HardeningSpring):
+    id = "dead_band_spring"
+    title = "A dead band (play) in a spring's attachment"
+    prefix = "hyp_db"
+    law = ("the spring's force is c*(u - clip(u, -b, b)): no force while its deflection u "
+           "from the free length lies within +-b (f = -c*clip(u, -b, b) added in parallel)")
+    explanation = ("The spring is attached with play (a loose pin, a slot): it carries no "
+                   "force over a band of travel around its free length, so small "
+                   "oscillations are slower and the motion crosses the band freely.")
+
+    def params(self, graph, location):
+        s = graph.site("spring", location)
+        _, dev = graph.spring_deflection(s.component)
+        d = domain_of(s.component)
+        return [self._spec("b", 0.0, dev, d.length_unit, f"half-width of the dead band of "
+                           f"{location}", scale=dev / 10)]
+
+    def _extend(self, model, graph, hyp, location, vals):
+        spring = model.find(location)
+        d = domain_of(spring)
+        _, u = _spring_offset(graph, spring, d)
+        # the spring's own rate (its symbol, not its value: a calibrated or
+        # fitted spring.c moves the band's force with the spring's)
+        c = spring.c
+        b = self._par(hyp, vals, "b", d.length_unit, f"dead band of {location}", min=0.0)
+        hyp.band = d.component("relative_source", **{d.through: lambda x: -c * _clip(u(x), b)})
+        model.connect(hyp.band.flange_a, spring.flange_a)
+        model.connect(hyp.band.flange_b, spring.flange_b)
+
+
+class RestitutionPowerLaw(ContactDampingLaw):
+    id = "restitution_power_law"
+    title = "Restitution falling as a power of the impact velocity"
+    prefix = "hyp_rp"
+    fixed = {"v_ref": 1.0}
+    law = ("the contact's damping uses e(v_i) = clip(e*(v_i/v_ref)^(-p), 0.01, 1), v_i the "
+           "impact velocity, v_ref the nominal run's largest, p >= 0")
+    explanation = ("The restitution falls with the impact speed as a power law (as measured "
+                   "for many metal impacts, e ~ v^(-1/4) in the plastic range).")
+
+    def params(self, graph, location):
+        return [self._spec("p", 0.0, 1.0, "1", f"exponent of the restitution of {location} "
+                           "against the impact velocity", scale=0.1)]
+
+    def defaults(self, graph, location):
+        v = graph._series(f"{location}.v_impact")
+        return {"v_ref": float(abs(v).max()) if v is not None and abs(v).max() > 0 else 1.0}
+
+    def _extend(self, model, graph, hyp, location, vals):
+        p = self._par(hyp, vals, "p", "1", f"restitution exponent of {location}", min=0.0)
+        vr = self._par(hyp, vals, "v_ref", "m/s", "reference impact speed", min=0.0,
+                       min_open=True)
+        make_power_restitution(model.find(location), p, vr)
+
+
+class ContactLaw(Hypothesis):
+    """The contact's damping follows another standard law (``law``), with its
+    restitution refitted (``de`` added to the model's ``e``)."""
+
+    site_kinds = ("contact",)
+
+    def __init__(self, law):
+        short = {"hunt_crossley": "hc", "lankarani_nikravesh": "ln", "flores": "fo"}[law]
+        self.target = law
+        self.id = f"contact_law_{law}"
+        self.prefix = f"hyp_{short}"
+        self.title = f"The contact's damping follows the {law.replace('_', '-')} law"
+        self.law = (f"F = K*delta^n*(1 + chi(e + de)*delta_dot/v_i) with chi of the {law} law "
+                    "in place of the model's, e + de its restitution")
+        self.explanation = ("The contact dissipates energy with another dependence on the "
+                            "indentation rate than modelled (the standard laws differ in how "
+                            "the damping grows with the impact: Hunt-Crossley, "
+                            "Lankarani-Nikravesh, Flores).")
+        self.distinguishing_experiment = ContactDampingLaw.distinguishing_experiment
+
+    def candidates(self, graph):
+        return [s.path for s in graph.contacts if "e" in s.component.declarations()
+                and s.component.law not in ("beta", self.target)
+                and graph.param(s.component, "e") < 0.999]
+
+    def params(self, graph, location):
+        e0 = graph.param(graph.site("contact", location).component, "e")
+        return [self._spec("de", max(-0.5, 0.05 - e0), 1 - e0, "1",
+                           f"change of the restitution of {location} under the {self.target} "
+                           "law", scale=0.05)]
+
+    def _extend(self, model, graph, hyp, location, vals):
+        c = model.find(location)
+        e0 = _orig(graph, c, "e", hyp, vals, self.prefix, "1", "restitution")
+        de = self._par(hyp, vals, "de", "1", f"change of the restitution of {location}")
+        c.set(law=self.target, e=e0 + de)
+
+
+CONTACT_LAWS = ("hunt_crossley", "lankarani_nikravesh", "flores")
+
+
 HYPOTHESES = {h.id: h for h in (CoulombFriction(), QuadraticDamping(), ConstantLoad(),
                                  HardeningSpring(), Clearance(), FlexibleLink(),
-                                 PositionDependentForce(), ContactDampingLaw())}
+                                 PositionDependentForce(), ContactDampingLaw(),
+                                 CoulombViscousFriction(), StribeckFriction(), PowerDrag(),
+                                 BilinearSpring(), DeadBandSpring(), RestitutionPowerLaw())
+              + tuple(ContactLaw(law) for law in CONTACT_LAWS)}
+
+# Families: where an effect has several standard laws, the first member (the
+# family's head) is fitted at every site and the others only where the head
+# is competitive (acausal/diagnose/families.py); the data choose the member.
+FAMILIES = {
+    "friction": ("coulomb_friction", "coulomb_viscous_friction", "stribeck_friction"),
+    "drag": ("quadratic_damping", "power_drag"),
+    "spring_nonlinearity": ("hardening_spring", "bilinear_spring", "dead_band_spring"),
+    "contact_damping": ("contact_damping_law", "restitution_power_law")
+    + tuple(f"contact_law_{law}" for law in CONTACT_LAWS),
+}
 
 
 # -- model files -------------------------------------------------------------------------------
@@ -652,21 +928,33 @@ def build_extended(path, hyp_id, location, values=None, h=None):
     return mf, cm
 
 
+def pair_members(pair):
+    """The two hypothesis objects of ``pair`` = ((hyp_id, location), ...):
+    the second renamed (:func:`.problem.second_prefix`) when its sub-model
+    would clash with the first's (one hypothesis at two sites)."""
+    h1, h2 = (_hypothesis(h) for h, _ in pair)
+    if h2.prefix == h1.prefix:
+        h2 = h2.renamed(second_prefix(h2.prefix))
+    return h1, h2
+
+
 def build_pair(path, pair):
     """(ModelFile, CompiledModel) of the model file extended by two
-    hypotheses at once, ``pair`` = ((hyp_id, location), (hyp_id, location))
-    of two different hypotheses (their sub-models must not clash); cached
-    per process as :func:`build_extended`. The fixed parameters' defaults
-    come from the unextended file's nominal run."""
+    hypotheses at once, ``pair`` = ((hyp_id, location), (hyp_id, location));
+    the same hypothesis at two sites gets its second sub-model renamed
+    (:func:`pair_members`). Cached per process as :func:`build_extended`.
+    The fixed parameters' defaults come from the unextended file's nominal
+    run."""
     apath = os.path.abspath(path)
     key = (apath, os.path.getmtime(apath) if os.path.exists(apath) else None, tuple(pair))
     hit = _CACHE.get(key)
     if hit is None:
         mf = load_model_file(apath)
         graph = ModelGraph(mf.model, result=nominal_result(apath))
-        defaults = [file_defaults(mf, h, loc, graph) for h, loc in pair]
-        for (h, loc), d in zip(pair, defaults):
-            _hypothesis(h).apply(mf.model, loc, d)
+        hyps = pair_members(pair)
+        defaults = [file_defaults(mf, h, loc, graph, hyp) for (h, loc), hyp in zip(pair, hyps)]
+        for (h, loc), hyp, d in zip(pair, hyps, defaults):
+            hyp.apply(mf.model, loc, d)
         if mf.experiment.stop is not None:
             mf.model.event(mf.experiment.stop.event(mf.model))
         hit = _CACHE[key] = (mf, compile_model(mf.model))

@@ -1,7 +1,8 @@
 """Where the diagnosis finds its hypotheses: by default
 :mod:`acausal.diagnose.hypotheses` (with :mod:`acausal.diagnose.graph`); any
 module with the same interface (``HYPOTHESES``, ``build_extended``,
-``write_extended_model`` and optionally ``ModelGraph`` and ``build_pair``) can stand in, named
+``write_extended_model`` and optionally ``ModelGraph``, ``build_pair`` and
+``FAMILIES``) can stand in, named
 by its import path so that worker processes can import it too."""
 from __future__ import annotations
 
@@ -27,6 +28,7 @@ def load_library(name: str | None = None) -> SimpleNamespace:
                            build_extended=mod.build_extended,
                            write_extended_model=mod.write_extended_model,
                            build_pair=getattr(mod, "build_pair", None),
+                           FAMILIES=getattr(mod, "FAMILIES", {}),
                            graph_of=lambda path: _graph_of(graph, path))
 
 

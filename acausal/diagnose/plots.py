@@ -18,6 +18,11 @@ def write_plots(out_dir, d) -> dict:
     figs["traces"] = _save(plt, _fitted(plt, d), out_dir, "fitted.png")
     if d.location is not None and d.location.terms:
         figs["located"] = _save(plt, _located(plt, d), out_dir, "located.png")
+    nxt = getattr(d.next_experiment, "result", None)
+    if nxt is not None and nxt.predictions:
+        from ..design import plot_next_experiment
+        plot_next_experiment(nxt, out_dir / "next_experiment.png")
+        figs["next"] = "next_experiment.png"
     return figs
 
 

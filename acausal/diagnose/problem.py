@@ -76,6 +76,21 @@ class Candidate:
 NOMINAL = Candidate(None, None, ())
 
 
+def second_name(name: str) -> str:
+    """The name of a parameter of a pair's second member whose sub-model
+    would clash with the first's (the same hypothesis, or two members of one
+    family, at two sites): ``hyp_cf.F`` -> ``hyp_cf2.F``. One rule for the
+    pair's candidate (:func:`.stages.pair_candidates`) and the library that
+    builds it (``build_pair``)."""
+    prefix, _, rest = name.partition(".")
+    return f"{second_prefix(prefix)}.{rest}"
+
+
+def second_prefix(prefix: str) -> str:
+    """The renamed sub-model of a pair's second member (see :func:`second_name`)."""
+    return prefix + "2"
+
+
 @dataclass(frozen=True)
 class FitSettings:
     """How hard each fit tries. ``lhs``: Latin-hypercube starts over the

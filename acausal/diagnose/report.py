@@ -55,7 +55,7 @@ def markdown(d, figs=None) -> str:
              _section_fingerprints(d), _section_hypotheses(d, figs),
              "## 4. Cause, evidence and equivalent causes\n", "\n".join(evidence(d)) + "\n",
              _section_located(d, figs), _section_gain(d, s, figs), _section_extended(d, s),
-             _section_cost(d)]
+             _section_next(d, s, figs), _section_profiles(d, s), _section_cost(d)]
     return "\n".join(parts) + "\n"
 
 
@@ -242,11 +242,59 @@ def _section_extended(d, s):
     return "\n".join(L)
 
 
+def _section_next(d, s, figs):
+    nx = s["next_experiment"]
+    L = ["## 7. The next experiment\n"]
+    if nx is None:
+        return "\n".join(L + ["Not computed (design=False).\n"])
+    members = ", ".join(nx["members"]) or "none"
+    if not nx["computed"]:
+        return "\n".join(L + [f"Rivals: {members}. Not computed: {nx['message']}.\n"])
+    cond = ", ".join(f"`{k}` = {fmt(v)}" for k, v in nx["conditions"].items()) or "as run"
+    L += [f"Rivals (the best candidate's class, one per cause class): {members}. The "
+          f"experiment whose predictions differ most between them (Hunter-Reiner, in "
+          f"instrument floors: sqrt of the rise of chi^2 the wrong rival would show), the "
+          f"other conditions as in experiment `{nx['reference_experiment']}`:\n",
+          f"- conditions: {cond}; record `{nx['signal']}`",
+          f"- predicted separation: **{fmt(nx['separation_floors'], 3)} floors** "
+          f"({fmt(nx['rms_floors'], 3)} per sample; at the experiment already run: "
+          f"{fmt(nx['baseline_floors'], 3)}); closest pair: {' vs '.join(nx['closest_pair'])}",
+          f"- {'decisive' if nx['decisive'] else 'not decisive'}"
+          + (f": {nx['message']}" if nx["message"] else ""), ""]
+    if "next" in figs:
+        L.append(f"![each rival's predicted signal]({figs['next']})\n")
+    return "\n".join(L)
+
+
+def _section_profiles(d, s):
+    pr = s["profile_ci95"]
+    L = ["## 8. Profile-likelihood intervals\n"]
+    if not pr:
+        return "\n".join(L + ["Not computed.\n"])
+    of = next(iter(pr.values()))["of"]
+    L += [f"For the fit of {of}: each parameter's linearised (Wald) interval is checked "
+          f"first (the rise of chi^2 at its ends, 1 for a linear model); where the check "
+          f"fails, the profile is traced (`acausal/profile.py`).\n",
+          "| parameter | value | 95 % interval | method | Wald | check ratios |",
+          "|---|---|---|---|---|---|"]
+    for name, p in pr.items():
+        lo, hi = p["ci95"]
+        lo_s = f"{fmt(lo)}{' (open)' if p['open_lower'] else ''}"
+        hi_s = f"{fmt(hi)}{' (open)' if p['open_upper'] else ''}"
+        L.append(f"| `{name}` | {fmt(p['value'])} | [{lo_s}, {hi_s}] | {p['method']} | "
+                 f"[{fmt(p['wald'][0])}, {fmt(p['wald'][1])}] | "
+                 f"{', '.join(fmt(q, 3) for q in p['check_ratios'])} |")
+    return "\n".join(L + [""])
+
+
 def _section_cost(d):
     t = d.timing
     return ("## Method and cost\n\n"
             f"{t['n_candidates']} candidate fits + the nominal fit in {t['fit_s']:.1f} s, "
-            f"leave-one-out in {t['cv_s']:.1f} s; {t['n_sim']} simulations for the fits. "
+            f"then {t['cv_s']:.1f} s for the later stages (leave-one-out, located term, "
+            f"profiles {t.get('profile_s', 0.0):.1f} s, next experiment "
+            f"{t.get('design_s', 0.0):.1f} s; family members "
+            f"{t.get('families_s', 0.0):.1f} s); {t['n_sim']} simulations for the fits. "
             f"Hypothesis library: `{d.problem.library}`.\n")
 
 
@@ -271,14 +319,28 @@ def verdict(d, s) -> str:
         txt = f"**Discrepancy, but the evidence is weak: no cause is named.** {reasons}."
         if best is not None:
             txt += f" The best candidate would be {best.candidate.label} ({held})."
-        return txt
+        return txt + _class_sentence(s["cause_class"])
     txt = (f"**Discrepancy; cause: {s['cause']} at `{s['location']}`.** {held[0].upper()}"
            f"{held[1:]} (train {fmt(g['before']['train'], 3)} -> "
            f"{fmt(g['after']['train'], 3)}).")
     if s["equivalent_causes"]:
         txt += " The data cannot tell it from: " + ", ".join(
             f"{e['cause']} at `{e['location']}`" for e in s["equivalent_causes"]) + "."
-    return txt
+    return txt + _class_sentence(s["cause_class"])
+
+
+def _class_sentence(cc):
+    """The cause class of the best candidate with the misfit its best law
+    leaves (said even when no cause is named)."""
+    if cc is None:
+        return ""
+    laws = ", ".join(f"{m['member']} (dAICc {fmt(m['daicc'], 3)})" for m in cc["members"])
+    left = (f"it reaches the instrument floor ({fmt(cc['leftover_floors'], 3)}x RMS)"
+            if cc["within_floor"] else
+            f"**its best law still leaves {fmt(cc['leftover_floors'], 3)}x the floor (RMS)**: "
+            "the effect belongs to this class but follows none of its laws exactly")
+    return (f" Cause class: **{cc['family']} at `{cc['location']}`**, best law "
+            f"{cc['member']}; {left}. Laws fitted there: {laws}.")
 
 
 def evidence(d) -> list:

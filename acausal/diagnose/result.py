@@ -8,6 +8,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .stats import OVERDISPERSION
+
 
 @dataclass
 class Diagnosis:
@@ -22,9 +24,11 @@ class Diagnosis:
     ranking: object               # stages.Ranking
     extended_model: str | None
     views: object = None          # views.Views (None: not computed)
-    next_experiment: dict | None = None
+    next_experiment: object = None  # nextexp.NextStep (None: not run)
     timing: dict = field(default_factory=dict)
     location: object = None       # locate.Location (None: not run)
+    intervals: object = None      # intervals.Intervals (None: not run)
+    families: object = None       # families.FamilyIndex (None: no families)
 
 
 def num(x):
@@ -72,18 +76,46 @@ def _equivalent(d: Diagnosis):
             for i in rk.classes[0] if rk.cause is None or i != rk.cause]
 
 
-def _causes(row):
-    """One entry per cause of a named single or pair: its own parameters."""
+def family_of(d: Diagnosis, hid):
+    """The cause class (family) of hypothesis ``hid``: its own id without families."""
+    return d.families.family(hid) if d.families is not None else hid
+
+
+def _causes(d, row):
+    """One entry per cause of a named single or pair: its family (cause
+    class), member (the law) and own parameters."""
     every = parameters(row)
-    return [dict(cause=h, location=loc, parameters={k: every[k] for k in names})
+    return [dict(cause=h, location=loc, family=family_of(d, h), member=h,
+                 parameters={k: every[k] for k in names})
             for h, loc, names in row.candidate.members()]
+
+
+def cause_class(d: Diagnosis):
+    """The best candidate's family at its site, every member fitted there
+    (best first) and the misfit the best member leaves (RMS in floors,
+    sqrt(S/(n-k))): named as a class even when no cause is named. None with
+    no discrepancy or when the best candidate is a pair."""
+    rk, best = d.ranking, d.ranking.best
+    if best is None or "+" in best.candidate.hypothesis:
+        return None
+    hid, loc = best.candidate.key
+    fam = family_of(d, hid)
+    rows = [r for r in rk.rows if r.candidate.location == loc
+            and "+" not in r.candidate.hypothesis and family_of(d, r.candidate.hypothesis) == fam]
+    left = math.sqrt(best.S / max(best.fit.n - best.k, 1))
+    return dict(family=fam, location=loc, member=hid, named=rk.named is not None,
+                leftover_floors=num(left), within_floor=bool(left ** 2 <= OVERDISPERSION),
+                members=[dict(member=r.candidate.hypothesis, aicc=num(r.aicc),
+                              daicc=num(r.aicc - best.aicc), S=num(r.S),
+                              heldout_rmse=num(r.heldout_rmse),
+                              values={k: r.fit.values[k] for k in r.own}) for r in rows])
 
 
 def summary(d: Diagnosis) -> dict:
     """The JSON summary (docs/diagnosis.md lists the keys)."""
     rk = d.ranking
     named = rk.named
-    causes = [] if named is None else _causes(named)
+    causes = [] if named is None else _causes(d, named)
     return dict(
         discrepancy=d.decision.discrepancy,
         cause=None if named is None else named.candidate.hypothesis,
@@ -96,8 +128,10 @@ def summary(d: Diagnosis) -> dict:
         extended_model=d.extended_model,
         causes=causes,
         unexplained=unexplained(d),
-        next_experiment=d.next_experiment,
-        profile_ci95={},
+        next_experiment=None if d.next_experiment is None else clean(
+            d.next_experiment.to_dict()),
+        profile_ci95={} if d.intervals is None else clean(d.intervals.to_dict()),
+        cause_class=cause_class(d),
     )
 
 
@@ -134,7 +168,9 @@ def details(d: Diagnosis) -> dict:
                      dict(aicc=num(dec.a0), starts=_starts(cal.nominal.starts))),
         free_drift=[dict(name=x.name, prior=x.prior, calibrated=x.calibrated,
                          relative=x.relative, far=x.far) for x in cal.drift],
-        candidates=[_one(dict(cause=r.candidate.hypothesis, location=r.candidate.location),
+        candidates=[_one(dict(cause=r.candidate.hypothesis, location=r.candidate.location,
+                              family="+".join(family_of(d, h) for h, _, _ in
+                                              r.candidate.members())),
                          r.fit, dict(aicc=num(r.aicc), heldout_rmse=num(r.heldout_rmse),
                                      lr_p=num(r.lr_p), starts=_starts(r.starts)))
                     for r in rk.rows],

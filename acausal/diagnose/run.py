@@ -2,7 +2,8 @@
 cause, an extended model and the measured gain.
 
 :func:`diagnose` chains the stages of :mod:`.stages` (calibrate ->
-candidates -> fit -> decide -> cross-validate -> rank -> extend -> views),
+candidates -> fit -> family members -> decide -> pairs -> cross-validate ->
+rank -> locate -> intervals -> extend -> next experiment -> views),
 keeps what they return in a :class:`~.result.Diagnosis`, renders the
 report from it (:mod:`.report`, a pure view) and returns the JSON summary
 (:func:`.result.summary`).
@@ -20,7 +21,10 @@ from pathlib import Path
 from ..executor import open_executor
 from . import stages
 from . import stats as st
+from .families import family_index, fit_members, prefer_simplest
+from .intervals import intervals
 from .locate import Location, locate
+from .nextexp import next_experiment
 from .problem import FitSettings
 from .result import Diagnosis, details, summary
 from .resume import FitStore
@@ -32,14 +36,19 @@ __all__ = ["diagnose", "run_stages", "DiagnosisError"]
 def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
                progress=True, hypotheses=None, locations=None, alpha=st.ALPHA,
                exact_cv=True, library=None, views=True, settings=None,
-               collect=None, generic=True, pairs=True) -> Diagnosis:
+               collect=None, generic=True, pairs=True, families=True, profile=True,
+               design=True) -> Diagnosis:
     """The stages in order; returns the :class:`Diagnosis` (writes only the
     extended model file into ``out_dir``). ``collect(task, result)`` is
     called as each fit result arrives (a checkpoint store plugs in there).
     ``generic``: locate a discrepancy the library does not explain
     (:mod:`.locate`); ``pairs``: search pairs of causes when the best single
-    one leaves misfit (:func:`.stages.pair_candidates`)."""
-    t0 = time.perf_counter()
+    one leaves misfit (:func:`.stages.pair_candidates`); ``families``: fit
+    the other members of a competitive family (:mod:`.families`);
+    ``profile``: profile-likelihood intervals where the linearised ones fail
+    the check (:mod:`.intervals`); ``design``: the next experiment that
+    splits the best candidate's class (:mod:`.nextexp`)."""
+    t0, clock = time.perf_counter(), {}
     problem, ds = stages.load_problem(model_path, data_folder, library, settings)
     cands = stages.candidates(problem, hypotheses, locations)
     with open_executor(scheduler, workers) as ex:
@@ -47,16 +56,28 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
         fits = stages.fit(problem, cal, cands, ex, progress, collect)
         t_fit = time.perf_counter() - t0
         dec = stages.decide(ds, cal, fits, alpha)
+        members = _timed(clock, "families_s", fit_members, problem, cal, dec, ex, progress,
+                         collect) if families else ()
+        if members:
+            fits += members
+            dec = stages.decide(ds, cal, fits, alpha)
         if pairs and stages.pairs_needed(dec):
             fits += stages.fit(problem, cal, stages.pair_candidates(problem, dec), ex,
                                progress, collect)
             dec = stages.decide(ds, cal, fits, alpha)
         cv = stages.cross_validate(problem, ds, cal, dec, ex, exact_cv, progress)
         rk = stages.rank(ds, cal, dec, cv)
+        if families:
+            rk = prefer_simplest(rk, family_index(problem.library))
         where = locate(problem, cal, dec, rk, ex, progress, collect) if generic else Location(
             skipped="not run (generic=False)")
+        ivs = _timed(clock, "profile_s", intervals, problem, cal, rk, ex,
+                     progress) if profile else None
     Path(out_dir).mkdir(parents=True, exist_ok=True)
     extended = stages.extend(problem, rk, out_dir)
+    index = family_index(problem.library)
+    nxt = _timed(clock, "design_s", next_experiment, problem, ds, dec, rk,
+                 index) if design else None
     t_cv = time.perf_counter() - t0 - t_fit
     shown = None
     if views:
@@ -64,15 +85,24 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
         shown = make_views(problem, cal, rk)
     n_sim = cal.fit.n_sim + sum(r.fit.n_sim for r in fits if r.fit is not None)
     timing = dict(fit_s=t_fit, cv_s=t_cv, n_candidates=len(cands), n_sim=n_sim,
-                  total_s=time.perf_counter() - t0)
+                  total_s=time.perf_counter() - t0, **clock)
     return Diagnosis(problem, ds, cal, len(cands), dec, cv, rk, extended, shown,
-                     None, timing, where)
+                     nxt, timing, where, ivs, index)
+
+
+def _timed(clock, key, fn, *args):
+    """``fn(*args)``, its wall time [s] kept in ``clock[key]``."""
+    t = time.perf_counter()
+    out = fn(*args)
+    clock[key] = time.perf_counter() - t
+    return out
 
 
 def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
              progress=True, hypotheses=None, locations=None, alpha=st.ALPHA,
              exact_cv=True, library=None, plots=True, max_nfev=60, settings=None,
-             collect=None, generic=True, pairs=True) -> dict:
+             collect=None, generic=True, pairs=True, families=True, profile=True,
+             design=True) -> dict:
     """Diagnose ``model_path`` against the dataset folder ``data_folder``.
 
     Writes ``report.md``, ``diagnosis.json``, ``candidates.json``, plots and
@@ -90,11 +120,13 @@ def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
     if collect is None:   # keep finished fits in <out_dir>/checkpoint/ (resume after a kill)
         store = collect = FitStore(out_dir, model_path, data_folder, dict(
             hypotheses=hypotheses, locations=locations, alpha=alpha, exact_cv=exact_cv,
-            library=library, settings=repr(settings), generic=generic, pairs=pairs))
+            library=library, settings=repr(settings), generic=generic, pairs=pairs,
+            families=families))
     d = run_stages(model_path, data_folder, out_dir=out_dir, scheduler=scheduler,
                    workers=workers, progress=progress, hypotheses=hypotheses,
                    locations=locations, alpha=alpha, exact_cv=exact_cv, library=library,
-                   settings=settings, collect=collect, generic=generic, pairs=pairs)
+                   settings=settings, collect=collect, generic=generic, pairs=pairs,
+                   families=families, profile=profile, design=design)
     out_dir = Path(out_dir)
     from .report import write_report
     write_report(out_dir, d, plots=plots)

@@ -2,8 +2,10 @@
 dataclasses to a new one (none mutates its input):
 
 calibrate -> candidates -> fit -> decide -> cross-validate -> rank ->
-extend -> views (the simulated traces and fingerprints the report shows)
--> next experiment (not computed yet: ``None``).
+extend -> views (the simulated traces and fingerprints the report shows);
+the family members (:mod:`.families`), the located term (:mod:`.locate`),
+the intervals (:mod:`.intervals`) and the next experiment
+(:mod:`.nextexp`) are stages of their own modules.
 
 The worker-side units of work are in :mod:`.tasks`; the statistics in
 :mod:`.stats`; :mod:`.run` chains the stages and :mod:`.report` renders
@@ -24,7 +26,7 @@ from ..modelfile import compile_file
 from . import stats as st
 from .fitting import heldout_rms
 from .library import load_library
-from .problem import NOMINAL, Candidate, FitSettings, Param, Problem, free_param
+from .problem import NOMINAL, Candidate, FitSettings, Param, Problem, free_param, second_name
 from .tasks import CandidateFit, FitTask, LooTask, calibrate_nominal, fit_candidate, \
     refit_without
 
@@ -67,14 +69,23 @@ def _select(items, wanted, what):
     return [i for i in items if i in wanted]
 
 
+def _heads(lib):
+    """The library's hypotheses without the non-head members of its
+    families (those are fitted where their head is competitive: :mod:`.families`)."""
+    later = {m for ms in (getattr(lib, "FAMILIES", None) or {}).values() for m in ms[1:]}
+    return {k: v for k, v in lib.HYPOTHESES.items() if k not in later}
+
+
 def candidates(problem: Problem, hypotheses=None, locations=None) -> tuple:
     """Stage 2: every (hypothesis, location) the model graph offers, with
     the extension's parameters (neutral starts). ``locations``: paths
-    (exact, or a prefix followed by '.') to keep."""
+    (exact, or a prefix followed by '.') to keep. Without ``hypotheses``,
+    a family's members other than its head are left to :mod:`.families`."""
     lib = load_library(problem.library)
     graph = lib.graph_of(problem.model_path)
     out = []
-    for hid in _select(lib.HYPOTHESES, hypotheses, "hypothesis"):
+    for hid in _select(_heads(lib) if hypotheses is None else lib.HYPOTHESES, hypotheses,
+                       "hypothesis"):
         hyp = lib.HYPOTHESES[hid]
         for loc in hyp.candidates(graph):
             if locations is not None and not any(
@@ -191,9 +202,10 @@ def pairs_needed(dec) -> bool:
 
 
 def pair_candidates(problem: Problem, dec, top=PAIR_TOP) -> tuple:
-    """Pairs of two different hypotheses among the ``top`` best tested
-    single candidates, each parameter seeded from its single fit (its
-    neutral value kept as the prior)."""
+    """Pairs among the ``top`` best tested single candidates (two
+    hypotheses, or one at two sites: the second's sub-model renamed), each
+    parameter seeded from its single fit (its neutral value kept as the
+    prior)."""
     if load_library(problem.library).build_pair is None:
         return ()
     singles = [r for r in dec.rows if "+" not in r.candidate.hypothesis
@@ -202,13 +214,22 @@ def pair_candidates(problem: Problem, dec, top=PAIR_TOP) -> tuple:
     for i, a in enumerate(singles):
         for b in singles[i + 1:]:
             ca, cb = a.candidate, b.candidate
-            if ca.hypothesis == cb.hypothesis:
+            if ca.location == cb.location and ca.hypothesis == cb.hypothesis:
                 continue
-            params = tuple(p.moved(r.fit.values[p.name]) for r in (a, b)
-                           for p in r.candidate.params)
+            first = {p.name.split(".")[0] for p in ca.params}
+            params = tuple(p.moved(a.fit.values[p.name]) for p in ca.params) + tuple(
+                _renamed(p, first).moved(b.fit.values[p.name]) for p in cb.params)
             out.append(Candidate(f"{ca.hypothesis}+{cb.hypothesis}",
                                  f"{ca.location}+{cb.location}", params))
     return tuple(out)
+
+
+def _renamed(p: Param, first) -> Param:
+    """A second member's parameter, renamed when its sub-model clashes with
+    the first's (one hypothesis at two sites: :func:`.problem.second_name`)."""
+    if p.name.split(".")[0] not in first:
+        return p
+    return Param(second_name(p.name), p.start, p.low, p.high, p.scale, p.prior)
 
 
 # -- stage 4: decide ------------------------------------------------------------------------
@@ -456,10 +477,12 @@ def _append_second(problem, lib, part, row, path):
     from .hypotheses import file_defaults
     from ..modelfile import load_model_file
     h, loc, names = part
-    vals = file_defaults(load_model_file(problem.model_path), h, loc)
+    hyp, prefix = lib.HYPOTHESES[h], names[0].split(".")[0]
+    if getattr(hyp, "prefix", prefix) != prefix:     # the same hypothesis at two sites
+        hyp = hyp.renamed(prefix)
+    vals = file_defaults(load_model_file(problem.model_path), h, loc, h=hyp)
     vals.update({k: row.fit.values[k] for k in names})
-    code = lib.HYPOTHESES[h].code(loc, vals).replace("hypothesis_specs =",
-                                                      "hypothesis_specs_2 =")
+    code = hyp.code(loc, vals).replace("hypothesis_specs =", "hypothesis_specs_2 =")
     Path(path).write_text(Path(path).read_text() + "\n" + code)
 
 

@@ -30,7 +30,8 @@ FAST = ["coulomb_friction", "quadratic_damping", "constant_load"]
 LIGHT = FitSettings(lhs=2, refine=1)
 LIGHT_CLI = ["--starts", "2", "--refine", "1"]
 KEYS = {"discrepancy", "cause", "location", "equivalent_causes", "parameters", "ranking",
-        "gain", "extended_model", "causes", "unexplained", "next_experiment", "profile_ci95"}
+        "gain", "extended_model", "causes", "unexplained", "next_experiment", "profile_ci95",
+        "cause_class"}
 
 
 def _latch_data(folder, seed, **kw):
@@ -48,7 +49,7 @@ def blind(tmp_path_factory):
     # the stages, then the report from a pickled copy of the result with the
     # simulator disabled: the result is picklable and the report a pure view
     res = run_stages(LATCH, d / "data", out_dir=d / "out", workers=2, progress=False,
-                     hypotheses=FAST, settings=LIGHT)
+                     hypotheses=FAST, settings=LIGHT, families=False)
     res = pickle.loads(pickle.dumps(res))
 
     def no_simulation(*a, **k):
@@ -79,9 +80,17 @@ def test_blind_case_names_the_hidden_cause(blind):
                                  "heldout_rmse": out["ranking"][0]["heldout_rmse"]}
     assert out["extended_model"] and os.path.exists(out["extended_model"])
     assert out["causes"] == [{"cause": "coulomb_friction", "location": "latch",
+                              "family": "friction", "member": "coulomb_friction",
                               "parameters": {name: out["parameters"][name]}}]
-    assert out["unexplained"]["value"] is False and out["next_experiment"] is None
-    assert out["profile_ci95"] == {}
+    assert out["unexplained"]["value"] is False
+    # one member in the class (or several cause classes and no condition declared):
+    # the next experiment says so instead of a null
+    nxt = out["next_experiment"]
+    assert nxt["members"][0] == "coulomb_friction at latch"
+    assert nxt["computed"] is (len(nxt["members"]) > 1)
+    assert set(out["profile_ci95"]) == set(out["parameters"])
+    for p in out["profile_ci95"].values():
+        assert p["of"] == "coulomb_friction at latch" and p["ci95"][0] < p["value"]
 
 
 def test_blind_case_report(blind):

@@ -104,7 +104,13 @@ def _nominal(path, measure, tight):
 def test_library_ids_and_texts():
     assert list(HYPOTHESES) == ["coulomb_friction", "quadratic_damping", "constant_load",
                                 "hardening_spring", "clearance", "flexible_link",
-                                "position_dependent_force", "contact_damping_law"]
+                                "position_dependent_force", "contact_damping_law",
+                                # family members (fitted where their head is competitive)
+                                "coulomb_viscous_friction", "stribeck_friction", "power_drag",
+                                "bilinear_spring", "dead_band_spring", "restitution_power_law",
+                                "contact_law_hunt_crossley", "contact_law_lankarani_nikravesh",
+                                "contact_law_flores"]
+    assert len({h.prefix for h in HYPOTHESES.values()}) == len(HYPOTHESES)
     for h in HYPOTHESES.values():
         assert h.title and h.explanation and h.law and h.distinguishing_experiment
         assert h.site_kinds and h.prefix.startswith("hyp_")
@@ -124,6 +130,18 @@ def test_breaker_candidates():
                           "main_shaft.body:cam"],
         "position_dependent_force": ["armature.coil"],
         "contact_damping_law": ["contact"],
+        "coulomb_viscous_friction": ["armature.mass", "hook.body", "main_shaft.body"],
+        "stribeck_friction": ["armature.mass", "hook.body", "main_shaft.body"],
+        "power_drag": ["armature.mass", "hook.body", "main_shaft.body"],
+        "bilinear_spring": ["armature.reset", "hook.reset", "main_shaft.open_spring",
+                            "main_shaft.wipe_spring"],
+        "dead_band_spring": ["armature.reset", "hook.reset", "main_shaft.open_spring",
+                             "main_shaft.wipe_spring"],
+        "restitution_power_law": ["contact"],
+        # the breaker's contact follows Lankarani-Nikravesh: the other two laws
+        "contact_law_hunt_crossley": ["contact"],
+        "contact_law_lankarani_nikravesh": [],
+        "contact_law_flores": ["contact"],
     }
 
 

@@ -1,0 +1,140 @@
+"""Stage: hypotheses as families. Where an effect has several standard laws
+(friction: Coulomb, Coulomb + viscous, Stribeck; drag: v|v|, v^n; spring
+nonlinearity: cubic, bilinear, dead band; contact damping: restitution
+falling linearly or as a power of the impact speed, or the Hunt-Crossley,
+Lankarani-Nikravesh or Flores law), the library declares them as one
+family (``FAMILIES``: cause class -> member ids, the first the head).
+
+How many fits: the head is fitted at every site with the other candidates;
+the other members only at the sites where the head is competitive (among
+the ``TOP`` best tested single candidates), each seeded from the head's fit
+(the free parameters at the head's values, a member's parameter of the same
+name at the head's value: Coulomb's F seeds the Stribeck and the viscous
+member's F, the quadratic drag's c the power law's). That bounds the extra
+fits by TOP x (members - 1) and spends them where the class is plausible;
+fitting every member everywhere would multiply the fit stage by up to 3.
+The members are then ranked with everything else (AICc, held-out error);
+:class:`FamilyIndex` tells the report and the JSON which family (cause
+class) and member a row is.
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+from .library import load_library
+from .problem import Candidate, Param
+from .stages import fit_tasks, run_tasks
+from .tasks import fit_candidate
+
+TOP = 4               # members are fitted at the sites of the TOP best single candidates
+
+
+@dataclass(frozen=True)
+class FamilyIndex:
+    """hypothesis id -> (family, member position); ``members``: family ->
+    member ids (the head first)."""
+
+    of: dict
+    members: dict
+
+    def family(self, hid):
+        """The cause class of a hypothesis (its own id when it has no family)."""
+        return self.of.get(hid, (hid, 0))[0]
+
+    def is_head(self, hid):
+        return self.of.get(hid, (hid, 0))[1] == 0
+
+
+def family_index(library) -> FamilyIndex:
+    fams = getattr(load_library(library), "FAMILIES", None) or {}
+    return FamilyIndex({m: (f, i) for f, ms in fams.items() for i, m in enumerate(ms)},
+                       {f: tuple(ms) for f, ms in fams.items()})
+
+
+def heads(dec, index: FamilyIndex, top=TOP) -> list:
+    """The competitive head rows: family heads among the ``top`` best tested
+    single candidates."""
+    singles = [r for r in dec.rows if "+" not in r.candidate.hypothesis
+               and r.starts.tested][:top]
+    return [r for r in singles if r.candidate.hypothesis in index.of
+            and index.is_head(r.candidate.hypothesis)]
+
+
+def _seeded(spec, head_values, head_prefix):
+    short = spec.name.partition(".")[2]
+    seed = head_values.get(f"{head_prefix}.{short}")
+    p = Param(spec.name, float(spec.initial), float(spec.low), float(spec.high),
+              float(spec.scale) or 1.0, float(spec.initial))
+    return p if seed is None else p.moved(seed)
+
+
+def member_candidates(problem, dec, index: FamilyIndex, done=()) -> list:
+    """[(Candidate, head row)] of every other member at each competitive
+    head's site (not already fitted: ``done`` keys)."""
+    lib = load_library(problem.library)
+    rows = heads(dec, index)
+    if not rows:
+        return []
+    graph = lib.graph_of(problem.model_path)
+    out = []
+    for r in rows:
+        hid, loc = r.candidate.hypothesis, r.candidate.location
+        prefix = r.candidate.params[0].name.partition(".")[0] if r.candidate.params else ""
+        for mid in index.members[index.family(hid)][1:]:
+            h = lib.HYPOTHESES.get(mid)
+            if h is None or (mid, loc) in done or loc not in h.candidates(graph):
+                continue
+            params = tuple(_seeded(s, r.fit.values, prefix) for s in h.params(graph, loc))
+            out.append((Candidate(mid, loc, params), r))
+    return out
+
+
+def fit_members(problem, cal, dec, ex, progress=True, collect=None) -> tuple:
+    """Stage: the other members of each competitive family, fitted at the
+    head's site with the free parameters starting from the head's fit (only
+    when a discrepancy is found: on data the model explains there is no
+    cause class to refine)."""
+    if not dec.discrepancy:
+        return ()
+    index = family_index(problem.library)
+    done = {r.candidate.key for r in dec.rows} | {r.candidate.key for r in dec.failed}
+    pairs = member_candidates(problem, dec, index, done)
+    if not pairs:
+        return ()
+    tasks = fit_tasks(problem, cal, [c for c, _ in pairs])
+    tasks = [dataclasses.replace(t, free=tuple(p.moved(head.fit.values[p.name])
+                                               for p in t.free))
+             for t, (_, head) in zip(tasks, pairs)]
+    return tuple(run_tasks(ex, fit_candidate, tasks, "fitting family members", progress,
+                           collect))
+
+
+PARSIMONY = 2.0       # AICc units: an extra parameter that gains less is uninformative
+
+
+def prefer_simplest(rk, index: FamilyIndex):
+    """The ranking with the named (and best) row moved to the member of the
+    same family at the same site with the fewest parameters whose AICc is
+    within PARSIMONY units of it: a law with an extra parameter that gains
+    less than 2 AICc units is not supported by the data (Arnold, "Uninformative
+    parameters and model selection using Akaike's Information Criterion",
+    J. Wildlife Management 74 (2010) 1175-1178; Burnham and Anderson 2002,
+    sec. 2.6). Coulomb friction is then named rather than Coulomb + viscous
+    with a viscous term the data cannot see. Rows and classes are unchanged."""
+    if rk.after is None:
+        return rk
+    best = rk.rows[rk.after]
+    hid, loc = best.candidate.key
+    if "+" in hid:
+        return rk
+    fam = index.family(hid)
+    mates = [i for i, r in enumerate(rk.rows) if r.candidate.location == loc
+             and "+" not in r.candidate.hypothesis
+             and index.family(r.candidate.hypothesis) == fam
+             and r.aicc <= best.aicc + PARSIMONY and r.starts.tested]
+    pick = min(mates, key=lambda i: (rk.rows[i].k, rk.rows[i].aicc), default=rk.after)
+    if pick == rk.after:
+        return rk
+    return dataclasses.replace(rk, after=pick,
+                               cause=pick if rk.cause is not None else None)
