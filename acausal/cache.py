@@ -101,6 +101,30 @@ def _serial(expr):
     return walk(expr)
 
 
+def digest(exprs):
+    """SHA-256 (hex) of sympy expressions, the same in every process: the
+    text of :func:`_serial`, but each node's text replaced by the hash of its
+    class and its arguments' hashes, so that a tree with much sharing (the
+    sensitivity residuals) costs its number of distinct nodes, not the
+    length of its printed form."""
+    memo = {}
+
+    def walk(e):
+        out = memo.get(e)
+        if out is None:
+            if e.is_Atom or not e.args:
+                text = sp.srepr(e)
+            else:
+                text = type(e).__name__ + "(" + ",".join(walk(a) for a in e.args) + ")"
+            out = memo[e] = hashlib.sha256(text.encode()).hexdigest()[:32]
+        return out
+    h = hashlib.sha256()
+    for e in exprs:
+        h.update((walk(e) if isinstance(e, sp.Basic) else repr(e)).encode())
+        h.update(b"\x1f")
+    return h.hexdigest()
+
+
 def model_key(flat):
     """SHA-256 (hex) of everything compilation depends on in ``flat``, of the
     compiler's source and of the library versions."""

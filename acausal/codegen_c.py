@@ -74,17 +74,17 @@ def _function(name, extra_args, decl, body):
 def _jacs_entries(res, ysyms, ypsyms, n):
     """(expressions, targets) of ``dF/dy`` and ``dF/dy'`` as two row-major
     ``n`` x ``n`` arrays (what the Python ``jacs`` callback fills): the
-    initialisation and the re-initialisation at events need them apart."""
+    initialisation and the re-initialisation at events need them apart.
+    The entries are the iteration matrix's (:func:`~acausal.codegen._jacobian_entries`,
+    cached: no second differentiation)."""
     exprs, targets = [], []
-    for i, r in enumerate(res):
-        fs = r.free_symbols
-        for j in range(n):
-            if ysyms[j] in fs:
-                exprs.append(sp.diff(r, ysyms[j]))
-                targets.append(f"Jy[{i * n + j}]")
-            if ypsyms[j] is not None and ypsyms[j] in fs:
-                exprs.append(sp.diff(r, ypsyms[j]))
-                targets.append(f"Jyp[{i * n + j}]")
+    for i, j, dy, dyp in _jacobian_entries(res, ysyms, ypsyms):
+        if dy != 0:
+            exprs.append(dy)
+            targets.append(f"Jy[{i * n + j}]")
+        if dyp != 0:
+            exprs.append(dyp)
+            targets.append(f"Jyp[{i * n + j}]")
     return exprs, targets
 
 

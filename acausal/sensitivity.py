@@ -200,7 +200,8 @@ def _cache_key(cm, names, residuals):
     import os
     h = hashlib.sha256(cm.source.encode())
     h.update("\0".join(names).encode())
-    h.update("\0".join(map(str, residuals)).encode())
+    from .cache import digest
+    h.update(digest(residuals).encode())
     here = os.path.dirname(os.path.abspath(__file__))
     for mod in ("sensitivity.py", "codegen.py", "fastdiff.py"):
         with open(os.path.join(here, mod), "rb") as fh:
