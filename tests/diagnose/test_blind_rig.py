@@ -28,6 +28,9 @@ def _run(tmp_path, effect, value=None, seed=3, name=None):
     ("hardening", 1.6, "hardening_spring", "spring", "hyp_hs.k3"),
     ("coulomb", 8e-3, "coulomb_friction", "rotor", "hyp_cf.tau"),
     ("drag", 1e-4, "quadratic_damping", "rotor", "hyp_qd.c"),
+    # play in the spring's attachment: out of the library until the spring
+    # nonlinearity family gained its dead-band member (issue 11, item 5)
+    ("dead_band", 0.005, "dead_band_spring", "spring", "hyp_db.b"),
 ])
 def test_rig_strong_single_cause(tmp_path, effect, value, cause, location, param):
     """50-500 noise floors over 16 periods: the right cause at the right
@@ -41,7 +44,6 @@ def test_rig_strong_single_cause(tmp_path, effect, value, cause, location, param
 
 @pytest.mark.slow
 @pytest.mark.parametrize("effect, value", [
-    ("dead_band", 0.005),     # play in the spring's attachment
     ("threshold", 0.02),      # a torque that sets in above 10 rad/s
 ])
 def test_rig_out_of_library_is_not_explained(tmp_path, effect, value):
