@@ -239,7 +239,31 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
     every ``res.t``, ``res.event_sensitivity("spring.c")`` the derivatives of
     the event times."""
     wall0 = _time.perf_counter()
-    backend = _backend(backend)
+    run, y, yp, d, cb, stop = _start(cm, t0, t_end, params, rtol, atol, atol_algebraic,
+                                     max_step, max_steps, _backend(backend), linsolver,
+                                     sensitivities)
+    _check_output_size(cm, t0, t_end, output_step, output_times, max_rows)
+    tout = _output_times(t0, t_end, output_step, output_times)
+    run.record(t0, y, yp, d)
+    watch = _Watch(run, wall0, max_rows, max_wall, max_total_steps, progress)
+    try:
+        _integrate(run, watch, cb, t0, y, yp, d, stop, tout, output_step)
+    except SolverError as exc:
+        exc.result = exc.result or run.result("failed", str(exc))
+        exc.result.stats["wall_s"] = _time.perf_counter() - wall0
+        raise
+    finally:
+        watch.close()
+    res = run.result()
+    res.stats["wall_s"] = _time.perf_counter() - wall0
+    res.stats["compile_s"] = cm.compile_s
+    return res
+
+
+def _start(cm, t0, t_end, params, rtol, atol, atol_algebraic, max_step, max_steps, backend,
+           linsolver, sensitivities):
+    """The run and its consistent start: (run, y, y', d, callbacks, stop),
+    after the event iteration at ``t0`` (``stop``: a terminal event fired)."""
     params, starts = cm.split_overrides(params)
     p = cm.param_vector(params)
     d = cm.discrete_start()
@@ -258,48 +282,40 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
         y, yp, d, cb = run.sens.start(p, d, t0, y, yp, starts)
         run.cb_d = list(d)
     y, yp, d, cb, stop = _event_iteration(run, cb, t0, y, yp, d, initial=True)
-    _check_output_size(cm, t0, t_end, output_step, output_times, max_rows)
-    tout = _output_times(t0, t_end, output_step, output_times)
-    run.record(t0, y, yp, d)
-    t = t0
-    watch = _Watch(run, wall0, max_rows, max_wall, max_total_steps, progress)
-    try:
-        while not stop and t < t_end:
-            tspan = _tspan(t, tout, t_end, watch.horizon(t))
-            seg = watch.solve(run.solver(), watch.wrap(cb, tspan), d, tspan, y, yp,
-                              every_step=output_step == 0)
-            run.nfev += seg.nfev
-            run.njev += seg.njev
-            run.steps += seg.steps
-            if len(seg.t) > 1:
-                run.record(seg.t[1:], seg.y[1:], seg.yp[1:], d)
-            if seg.status < 0:
-                _observers(run, cb, seg, d)   # those located before it (a dead-centre warning)
-                raise _failure(run, run.cm, seg, cb)
-            t, y, yp = float(seg.t[-1]), np.array(seg.y[-1]), np.array(seg.yp[-1])
-            watch.check(t)
-            d, fired = _observers(run, cb, seg, d)
-            if d != run.cb_d:
-                cb = run.callbacks(d)
-            run.cb_d = list(d)
-            if seg.status != 2:
-                if tspan[-1] < t_end:   # the end of a window of the watch
-                    continue
-                break
-            d_before = list(d)
-            y, yp, d, cb, stop = _handle(run, cb, t, y, yp, d, fired)
-            if list(d) != d_before:
-                run.record(t, y, yp, d)
-    except SolverError as exc:
-        exc.result = exc.result or run.result("failed", str(exc))
-        exc.result.stats["wall_s"] = _time.perf_counter() - wall0
-        raise
-    finally:
-        watch.close()
-    res = run.result()
-    res.stats["wall_s"] = _time.perf_counter() - wall0
-    res.stats["compile_s"] = cm.compile_s
-    return res
+    return run, y, yp, d, cb, stop
+
+
+def _integrate(run, watch, cb, t, y, yp, d, stop, tout, output_step):
+    """The hybrid loop: segments between events (each ends at a terminal
+    root, the end or a window of the watch), observer roots, event actions
+    with re-initialisation and event iteration; output is recorded in ``run``."""
+    t_end = run.t_end
+    while not stop and t < t_end:
+        tspan = _tspan(t, tout, t_end, watch.horizon(t))
+        seg = watch.solve(run.solver(), watch.wrap(cb, tspan), d, tspan, y, yp,
+                          every_step=output_step == 0)
+        run.nfev += seg.nfev
+        run.njev += seg.njev
+        run.steps += seg.steps
+        if len(seg.t) > 1:
+            run.record(seg.t[1:], seg.y[1:], seg.yp[1:], d)
+        if seg.status < 0:
+            _observers(run, cb, seg, d)   # those located before it (a dead-centre warning)
+            raise _failure(run, run.cm, seg, cb)
+        t, y, yp = float(seg.t[-1]), np.array(seg.y[-1]), np.array(seg.yp[-1])
+        watch.check(t)
+        d, fired = _observers(run, cb, seg, d)
+        if d != run.cb_d:
+            cb = run.callbacks(d)
+        run.cb_d = list(d)
+        if seg.status != 2:
+            if tspan[-1] < t_end:   # the end of a window of the watch
+                continue
+            break
+        d_before = list(d)
+        y, yp, d, cb, stop = _handle(run, cb, t, y, yp, d, fired)
+        if list(d) != d_before:
+            run.record(t, y, yp, d)
 
 
 
