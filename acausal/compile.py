@@ -10,6 +10,7 @@ import numpy as np
 import sympy as sp
 
 from .aliases import eliminate_aliases
+from .backends import BAND_MAX_FRACTION, BAND_MIN_SIZE, LinearSolver, choose_linear_solver  # noqa: F401
 from .causalize import build_dae
 from . import cache as _cache
 from .codegen import Triplets, generate, load as load_generated
@@ -29,21 +30,6 @@ class ParamEntry:
     desc: str
     decl: object
     owner: str
-
-
-BAND_MIN_SIZE = 40        # unknowns from which a narrow band beats the dense solver
-BAND_MAX_FRACTION = 0.25  # a band at most this fraction of n wide counts as narrow
-
-
-@dataclass
-class LinearSolver:
-    """IDA's linear solver for a model: its ``kind``, the keyword ``options``
-    for ``sksundae.ida.IDA`` and ``jac_index``, the position in
-    :meth:`CompiledModel.callbacks` of the Jacobian callback that fills the
-    storage this solver uses (1: 2-D array, 6: CSC array)."""
-    kind: str
-    options: dict
-    jac_index: int
 
 
 class CompiledModel:
@@ -369,19 +355,7 @@ class CompiledModel:
         then ``callbacks(...)[6]``) or ``"auto"``: dense below
         :data:`BAND_MIN_SIZE` unknowns or when the band is not narrow, else
         band."""
-        sp_ = self.sparsity
-        n = sp_.n
-        if kind == "auto":
-            narrow = sp_.lband + sp_.uband + 1 <= BAND_MAX_FRACTION * n
-            kind = "band" if n >= BAND_MIN_SIZE and narrow else "dense"
-        if kind == "dense":
-            return LinearSolver("dense", {}, 1)
-        if kind == "band":
-            return LinearSolver("band", dict(linsolver="band", lband=int(sp_.lband),
-                                             uband=int(sp_.uband)), 1)
-        if kind == "sparse":
-            return LinearSolver("sparse", dict(linsolver="sparse", sparsity=sp_.matrix()), 6)
-        raise UsageError(f"linear solver {kind!r}: choose 'auto', 'dense', 'band' or 'sparse'")
+        return choose_linear_solver(self.sparsity, kind)
 
     def simulate(self, **kw):
         from .simulate import simulate

@@ -53,9 +53,11 @@ import weakref
 import numpy as np
 import sympy as sp
 
+from .backends import choose_linear_solver
 from .causalize import DAE
 from .codegen import Names, Sparsity, _body, _namespace, _unpack, generate, load
 from .errors import ModelError, UsageError
+from .events import EventState
 from .fastdiff import diff
 
 _models = weakref.WeakKeyDictionary()   # CompiledModel -> {names: SensitivityModel}
@@ -160,8 +162,7 @@ class SensitivityModel:
         return self._make(list(map(float, p)), list(map(float, d)))
 
     def linear_solver(self, kind="auto"):
-        from .compile import CompiledModel
-        return CompiledModel.linear_solver(self, kind)
+        return choose_linear_solver(self.sparsity, kind)
 
     # -- packing ---------------------------------------------------------------
     def pack(self, y, S):
@@ -453,7 +454,6 @@ class SensRun:
         derivative along the total derivative of what they read (the
         observed values at the event time ``t + dtau dp``, the parameters,
         the discrete values), by central differences."""
-        from .simulate import EventState
         sm, cm = self.sm, self.sm.base
         nd, nobs = len(cm.disc_syms), len(cm.var_names)
         sd = self.sd_all.copy()

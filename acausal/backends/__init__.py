@@ -25,7 +25,22 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import AcausalError
+from ..errors import AcausalError, UsageError
+
+BAND_MIN_SIZE = 40        # unknowns from which a narrow band beats the dense solver
+BAND_MAX_FRACTION = 0.25  # a band at most this fraction of n wide counts as narrow
+
+
+@dataclass
+class LinearSolver:
+    """IDA's linear solver for a model: its ``kind``, the keyword ``options``
+    for ``sksundae.ida.IDA`` and ``jac_index``, the position in
+    :meth:`acausal.compile.CompiledModel.callbacks` of the Jacobian callback that fills the
+    storage this solver uses (1: 2-D array, 6: CSC array)."""
+    kind: str
+    options: dict
+    jac_index: int
+
 
 BACKENDS = ("sundae", "compiled")
 
@@ -111,3 +126,23 @@ def compiled_available():
     except Unavailable as exc:
         return str(exc)
     return None
+
+
+def choose_linear_solver(sparsity, kind="auto"):
+    """IDA's linear solver for an iteration matrix of pattern ``sparsity``
+    (:class:`acausal.codegen.Sparsity`): ``"dense"``, ``"band"`` (bandwidths
+    from the pattern), ``"sparse"`` (SuperLU_MT on the CSC pattern) or
+    ``"auto"``: dense below :data:`BAND_MIN_SIZE` unknowns or when the band
+    is not narrow, else band. Raises UsageError for another ``kind``."""
+    n = sparsity.n
+    if kind == "auto":
+        narrow = sparsity.lband + sparsity.uband + 1 <= BAND_MAX_FRACTION * n
+        kind = "band" if n >= BAND_MIN_SIZE and narrow else "dense"
+    if kind == "dense":
+        return LinearSolver("dense", {}, 1)
+    if kind == "band":
+        return LinearSolver("band", dict(linsolver="band", lband=int(sparsity.lband),
+                                         uband=int(sparsity.uband)), 1)
+    if kind == "sparse":
+        return LinearSolver("sparse", dict(linsolver="sparse", sparsity=sparsity.matrix()), 6)
+    raise UsageError(f"linear solver {kind!r}: choose 'auto', 'dense', 'band' or 'sparse'")

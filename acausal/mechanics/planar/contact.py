@@ -30,7 +30,8 @@ from sympy import sqrt, tanh
 from acausal import Eq, Parameter, Variable, der
 
 from ..contact import PartialContact
-from .partials import PartialTwoFrames, rotate
+from .geometry import rotate
+from .partials import PartialTwoFrames
 
 __all__ = ["PartialCircleContact", "CircleLineContact", "CircleCircleContact"]
 

@@ -33,7 +33,7 @@ from sympy import Eq, Piecewise, sqrt
 
 from acausal import Event
 
-from .partials import rotate
+from .geometry import rotate
 
 DEAD_CENTRE_SIN = 0.05   # warn within about 2.9 deg of a dead centre
 

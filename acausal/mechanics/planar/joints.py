@@ -5,7 +5,8 @@ joints to 1-D flanges)."""
 
 from acausal import Eq, Flange, Parameter, ParameterError, RotFlange, Variable, der
 
-from .partials import PartialJoint, rotate
+from .geometry import rotate
+from .partials import PartialJoint
 
 __all__ = ["Revolute", "Prismatic"]
 

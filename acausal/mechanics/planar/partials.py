@@ -1,15 +1,10 @@
 """Partial planar models that own the frame equations (Modelica
 PlanarMechanics' PartialTwoFrames idea), so that a leaf is its parameters and
 its law. Sign convention: :mod:`acausal.connectors` (:class:`Frame`)."""
-from sympy import cos, sin, sqrt
+from sympy import sqrt
 
 from acausal import Component, Discrete, Eq, Variable
 from acausal.connectors import Frame
-
-
-def rotate(phi, rx, ry):
-    """World components of the vector (rx, ry) given in a frame at angle phi."""
-    return cos(phi) * rx - sin(phi) * ry, sin(phi) * rx + cos(phi) * ry
 
 
 class PartialOneFrame(Component):

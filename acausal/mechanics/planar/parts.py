@@ -3,7 +3,8 @@
 
 from acausal import Eq, Parameter, Variable, der
 
-from .partials import PartialOneFrame, PartialRigidLink, rotate
+from .geometry import rotate
+from .partials import PartialOneFrame, PartialRigidLink
 
 __all__ = ["Fixed", "Body", "FixedTranslation"]
 

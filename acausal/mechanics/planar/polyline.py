@@ -52,7 +52,7 @@ from acausal import Discrete, Event, Parameter, Variable
 from acausal.errors import ParameterError
 
 from .contact import PartialCircleContact
-from .partials import rotate
+from .geometry import rotate
 
 __all__ = ["CirclePolylineContact", "Profile"]
 
