@@ -80,33 +80,12 @@ def _value(v):
     return repr(v)
 
 
-def _serial(expr):
-    """An exact text of a sympy expression that is the same in every
-    process: the class of every node and its arguments in sympy's stored
+def _walker(finish):
+    """A memoised walk of a sympy tree that is the same in every process:
+    the class of every node and its arguments' results in sympy's stored
     (canonical, name-sorted) order, atoms by ``srepr`` (a Float with all its
-    digits, a Symbol with its assumptions). ``srepr`` of the whole tree
-    gives the same information but sorts every sum's terms for printing; it
-    took a third of compiling a 100-mass chain."""
-    memo = {}
-
-    def walk(e):
-        out = memo.get(e)
-        if out is None:
-            if e.is_Atom or not e.args:
-                out = sp.srepr(e)
-            else:
-                out = type(e).__name__ + "(" + ",".join(walk(a) for a in e.args) + ")"
-            memo[e] = out
-        return out
-    return walk(expr)
-
-
-def digest(exprs):
-    """SHA-256 (hex) of sympy expressions, the same in every process: the
-    text of :func:`_serial`, but each node's text replaced by the hash of its
-    class and its arguments' hashes, so that a tree with much sharing (the
-    sensitivity residuals) costs its number of distinct nodes, not the
-    length of its printed form."""
+    digits, a Symbol with its assumptions); ``finish`` maps each node's text
+    to its result."""
     memo = {}
 
     def walk(e):
@@ -116,8 +95,25 @@ def digest(exprs):
                 text = sp.srepr(e)
             else:
                 text = type(e).__name__ + "(" + ",".join(walk(a) for a in e.args) + ")"
-            out = memo[e] = hashlib.sha256(text.encode()).hexdigest()[:32]
+            out = memo[e] = finish(text)
         return out
+    return walk
+
+
+def _serial(expr):
+    """An exact text of a sympy expression that is the same in every
+    process (:func:`_walker`). ``srepr`` of the whole tree gives the same
+    information but sorts every sum's terms for printing; it took a third of
+    compiling a 100-mass chain."""
+    return _walker(lambda text: text)(expr)
+
+
+def digest(exprs):
+    """SHA-256 (hex) of sympy expressions, the same in every process: the
+    walk of :func:`_serial` with each node's text replaced by its hash, so
+    that a tree with much sharing (the sensitivity residuals) costs its
+    number of distinct nodes, not the length of its printed form."""
+    walk = _walker(lambda text: hashlib.sha256(text.encode()).hexdigest()[:32])
     h = hashlib.sha256()
     for e in exprs:
         h.update((walk(e) if isinstance(e, sp.Basic) else repr(e)).encode())

@@ -10,7 +10,7 @@ import numpy as np
 import sympy as sp
 
 from .aliases import eliminate_aliases
-from .backends import BAND_MAX_FRACTION, BAND_MIN_SIZE, LinearSolver, choose_linear_solver  # noqa: F401
+from .backends import choose_linear_solver
 from .causalize import build_dae
 from . import cache as _cache
 from .codegen import Triplets, generate, load as load_generated
@@ -348,12 +348,12 @@ class CompiledModel:
 
     def linear_solver(self, kind="auto"):
         """The IDA linear solver for this model's iteration matrix, chosen from
-        its structure (:attr:`sparsity`): a :class:`LinearSolver`.
+        its structure (:attr:`sparsity`): a :class:`acausal.backends.LinearSolver`.
 
         ``kind``: ``"dense"``, ``"band"`` (bandwidths from the pattern),
         ``"sparse"`` (SuperLU_MT on the CSC pattern; the Jacobian callback is
         then ``callbacks(...)[6]``) or ``"auto"``: dense below
-        :data:`BAND_MIN_SIZE` unknowns or when the band is not narrow, else
+        :data:`acausal.backends.BAND_MIN_SIZE` unknowns or when the band is not narrow, else
         band."""
         return choose_linear_solver(self.sparsity, kind)
 

@@ -17,7 +17,7 @@ import numpy as np
 
 from .backends import BACKENDS, BackendError, make_solver
 from .errors import ChatteringError, LimitError, SolverError, UsageError
-from .events import EventState  # noqa: F401  (re-exported: event actions' state)
+from .events import EventState
 from .initialize import ask_components, initial_point, reinitialize, suspect_parameters
 from .result import Result
 

@@ -344,19 +344,9 @@ class HardeningSpring(Hypothesis):
     def _extend(self, model, graph, hyp, location, vals):
         spring = model.find(location)
         d = domain_of(spring)
-        ref, pre = d.rel0, d.preload
-        decl = spring.declarations()
-
-        def ab(name):
-            return graph.absolute(spring.value(name), spring) if name in decl else 0
-
-        c = ab("c")
-        free = ab(ref) if (isinstance(c, (int, float)) and c == 0) else ab(ref) - ab(pre) / c
+        _, u = _spring_offset(graph, spring, d)
         k3 = self._par(hyp, vals, "k3", d.unit("{F}/{L}^3"), f"cubic stiffness at {location}")
-        hyp.cubic = d.component("relative_source",
-                                **{d.through: lambda x: k3 * (x - free) ** 3})
-        model.connect(hyp.cubic.flange_a, spring.flange_a)
-        model.connect(hyp.cubic.flange_b, spring.flange_b)
+        _parallel_force(model, hyp, "cubic", spring, d, lambda x: k3 * u(x) ** 3)
 
 
 class Clearance(Hypothesis):
@@ -718,6 +708,16 @@ def _spring_offset(graph, spring, d):
     return c, (lambda x: x - free)
 
 
+def _parallel_force(model, hyp, name, spring, d, force):
+    """``hyp.<name>``: a force (torque) ``force(x)`` of the relative
+    displacement x, in parallel with ``spring`` (the spring nonlinearity
+    family's members)."""
+    setattr(hyp, name, d.component("relative_source", **{d.through: force}))
+    source = getattr(hyp, name)
+    model.connect(source.flange_a, spring.flange_a)
+    model.connect(source.flange_b, spring.flange_b)
+
+
 def _clip(u, w):
     return sp.Max(-w, sp.Min(w, u))
 
@@ -749,10 +749,7 @@ class BilinearSpring(HardeningSpring):
         _, u = _spring_offset(graph, spring, d)
         k2 = self._par(hyp, vals, "k2", d.unit("{F}/{L}"), f"extra stiffness at {location}")
         w = self._par(hyp, vals, "d", d.length_unit, f"knee of {location}", min=0.0)
-        hyp.knee = d.component("relative_source",
-                               **{d.through: lambda x: k2 * (u(x) - _clip(u(x), w))})
-        model.connect(hyp.knee.flange_a, spring.flange_a)
-        model.connect(hyp.knee.flange_b, spring.flange_b)
+        _parallel_force(model, hyp, "knee", spring, d, lambda x: k2 * (u(x) - _clip(u(x), w)))
 
 
 class DeadBandSpring(HardeningSpring):
@@ -780,9 +777,7 @@ class DeadBandSpring(HardeningSpring):
         # fitted spring.c moves the band's force with the spring's)
         c = spring.c
         b = self._par(hyp, vals, "b", d.length_unit, f"dead band of {location}", min=0.0)
-        hyp.band = d.component("relative_source", **{d.through: lambda x: -c * _clip(u(x), b)})
-        model.connect(hyp.band.flange_a, spring.flange_a)
-        model.connect(hyp.band.flange_b, spring.flange_b)
+        _parallel_force(model, hyp, "band", spring, d, lambda x: -c * _clip(u(x), b))
 
 
 class RestitutionPowerLaw(ContactDampingLaw):

@@ -96,16 +96,24 @@ def _residual_measure(ax, d, s, cond):
     ax.set_xlabel(cond or "experiment")
 
 
-def _residuals(plt, d):
+def _panel_figure(plt, d, height, on_trace, on_measure):
+    """One panel per signal of the dataset (:func:`_panels`): ``on_trace(ax,
+    d, s)`` or ``on_measure(ax, d, s, condition)`` draws it."""
     ds = d.dataset
     traces, panels = _panels(ds)
     cond = ds.condition_names[0] if ds.condition_names else None
-    fig, axes = plt.subplots(len(panels), 1, figsize=(8, 2.8 * len(panels)), squeeze=False)
+    fig, axes = plt.subplots(len(panels), 1, figsize=(8, height * len(panels)), squeeze=False)
     for ax, s in zip(axes[:, 0], panels):
         if s in traces:
-            _residual_trace(ax, d, s)
+            on_trace(ax, d, s)
         else:
-            _residual_measure(ax, d, s, cond)
+            on_measure(ax, d, s, cond)
+    return fig, axes, panels
+
+
+def _residuals(plt, d):
+    fig, axes, panels = _panel_figure(plt, d, 2.8, _residual_trace, _residual_measure)
+    for ax, s in zip(axes[:, 0], panels):
         ax.axhline(0, color="k", lw=0.5)
         ax.set_ylabel(f"{s}\nresidual [SI]")
         ax.legend(fontsize=7, ncol=3)
@@ -171,15 +179,8 @@ def _fitted_measure(ax, d, s, cond):
 
 
 def _fitted(plt, d):
-    ds = d.dataset
-    traces, panels = _panels(ds)
-    cond = ds.condition_names[0] if ds.condition_names else None
-    fig, axes = plt.subplots(len(panels), 1, figsize=(8, 3 * len(panels)), squeeze=False)
+    fig, axes, panels = _panel_figure(plt, d, 3, _fitted_trace, _fitted_measure)
     for ax, s in zip(axes[:, 0], panels):
-        if s in traces:
-            _fitted_trace(ax, d, s)
-        else:
-            _fitted_measure(ax, d, s, cond)
         ax.set_ylabel(f"{s} [SI]")
         ax.legend(fontsize=7, ncol=2)
     axes[0, 0].set_title("measured (dots) against the calibrated model (solid) and "
