@@ -107,28 +107,21 @@ class Names:
     def check(self, exprs, what):
         """``exprs`` as sympy expressions, checked to use only the DAE's
         symbols (printed with :attr:`code`, not renamed: no rebuilding)."""
-        out = []
-        for e in exprs:
-            e = sp.sympify(e)
-            bad = [s for s in e.free_symbols if s not in self.map]
-            if bad:
-                raise ValueError(  # internal: CompiledModel.resolve checked user expressions
-                    f"internal: {what} refers to {bad[0]} which is not "
-                                 "a state, algebraic unknown, parameter or discrete value")
-            out.append(e)
-        return out
+        return [_known(sp.sympify(e), self.map, what) for e in exprs]
 
     def rename(self, exprs, what):
-        out = []
-        for e in exprs:
-            e = sp.sympify(e).xreplace(self.map)
-            bad = [s for s in e.free_symbols if s not in self.allowed]
-            if bad:
-                raise ValueError(  # internal: CompiledModel.resolve checked user expressions
-                    f"internal: {what} refers to {bad[0]} which is not "
-                    "a state, algebraic unknown, parameter or discrete value")
-            out.append(e)
-        return out
+        """``exprs`` with the DAE's symbols replaced by the generated names."""
+        return [_known(sp.sympify(e).xreplace(self.map), self.allowed, what) for e in exprs]
+
+
+def _known(e, symbols, what):
+    """``e``, checked to contain only ``symbols``."""
+    bad = [s for s in e.free_symbols if s not in symbols]
+    if bad:
+        raise ValueError(  # internal: CompiledModel.resolve checked user expressions
+            f"internal: {what} refers to {bad[0]} which is not "
+            "a state, algebraic unknown, parameter or discrete value")
+    return e
 
 
 def _body(exprs, targets, indent="        ", symbols=None):
