@@ -89,11 +89,11 @@ def _jacs_entries(res, ysyms, ypsyms, n):
 
 
 def _observe(cm, names, real, decl, ysyms, ypsyms):
-    """``acs_observe`` (every variable of ``cm.var_names``, as the Python
+    """``acs_observe`` (``cm.observed_exprs()``, as the Python
     ``observe`` callback) and ``acs_has_observe``: 0 when an observed
     expression has no C form, and the caller keeps the Python one (the
     residual and root functions decide whether the backend can run)."""
-    obs = [cm.resolve(cm.flat.variables[nm].symbol) for nm in cm.var_names]
+    obs = cm.observed_exprs()
     exprs = [e.xreplace(real) for e in names.rename(obs, "an observed variable")]
     try:
         body = _body(exprs, [f"o[{i}]" for i in range(len(exprs))])

@@ -100,7 +100,7 @@ class CompiledModel:
             raise ModelError(_nothing_to_integrate(flat))
         self._subs = dict(red.param_subs)
         self._alias = red.subs
-        observed = [self.resolve(flat.variables[n].symbol) for n in self.var_names]
+        observed = self.observed_exprs()
         roots = [self.resolve(e.expr) for e in self.events] + \
                 [self.resolve(a.expr) for a in self.assertions]
         fixed_rows = [k for k, n in enumerate(self.var_names)
@@ -338,6 +338,11 @@ class CompiledModel:
             e = self.resolve(self.flat.variables[name].symbol)
             cols[name] = self.dae.y.index(e) if e in self.dae.y else None
         return cols[name]
+
+    def observed_exprs(self):
+        """The expressions the observe callback computes: every variable of
+        :attr:`var_names`, resolved to the DAE's unknowns."""
+        return [self.resolve(self.flat.variables[n].symbol) for n in self.var_names]
 
     def callbacks(self, p, d):
         """(res, jac, roots, jacs, observe, count, jac_csc) for parameter vector

@@ -109,7 +109,7 @@ class SensitivityModel:
         SD = [[sp.Symbol(f"__sensd{j}__{cm.disc_syms[q].name}") for q in self.dyn]
               for j in range(m)]
         self._sd_syms = [s for row in SD for s in row]
-        lin = _Linearize(dae, P, [cm.disc_syms[q] for q in self.dyn], S, Sp, SD)
+        lin = self._lin = _Linearize(dae, P, [cm.disc_syms[q] for q in self.dyn], S, Sp, SD)
         rows = [lin.total(r) for r in dae.residuals]      # rows[i][j]
         self.order = self._order()
         y_all = list(dae.y) + [s for j in range(m) for s in S[j]]
@@ -138,11 +138,17 @@ class SensitivityModel:
         """The augmented system's generated callbacks (:func:`acausal.codegen.generate`):
         its residuals, exact Jacobian, the base roots and the observed
         variables followed by their sensitivities."""
+        return generate(self.dae, self.base.param_syms, self.disc_syms, roots,
+                        self.observed_exprs())
+
+    def observed_exprs(self):
+        """The base model's observed variables, then their sensitivities per
+        parameter (the observe callback's output, :attr:`n_observed`)."""
         cm = self.base
-        observed = [cm.resolve(cm.flat.variables[v].symbol) for v in cm.var_names]
-        obs_sens = [lin.total(o) for o in observed]
-        observed += [obs_sens[k][j] for j in range(self.m) for k in range(len(cm.var_names))]
-        return generate(self.dae, cm.param_syms, self.disc_syms, roots, observed)
+        observed = cm.observed_exprs()
+        obs_sens = [self._lin.total(o) for o in observed]
+        return observed + [obs_sens[k][j] for j in range(self.m)
+                           for k in range(len(cm.var_names))]
 
     def __getattr__(self, name):
         if name == "base":   # not set yet (copying, pickling)
@@ -163,6 +169,12 @@ class SensitivityModel:
 
     def linear_solver(self, kind="auto"):
         return choose_linear_solver(self.sparsity, kind)
+
+    @property
+    def n_observed(self):
+        """Length of the observe callback's output: the base model's observed
+        variables, then their sensitivities per parameter."""
+        return len(self.base.var_names) * (1 + self.m)
 
     # -- packing ---------------------------------------------------------------
     def pack(self, y, S):
@@ -322,8 +334,11 @@ class SensRun:
     """The sensitivity bookkeeping of one run: initial sensitivities, the
     event-time sensitivities and the jumps at mode changes."""
 
-    def __init__(self, sm, p, span):
+    def __init__(self, sm, p, span, serve=None):
         self.sm, self.p = sm, np.asarray(p, float)
+        # (model, d) -> that model's callbacks in mode d, as the run's backend
+        # serves them (compiled C on the compiled backend)
+        self.serve = serve or (lambda model, d: model.callbacks(self.p, d))
         self.span = max(float(span), 1e-300)
         self.dtau = np.zeros(sm.m)       # of the instant being handled
         self.sd_all = np.zeros((sm.m, len(sm.base.disc_syms)))   # of every discrete value
@@ -338,8 +353,9 @@ class SensRun:
         theorem), the rest re-solved."""
         sm, cm = self.sm, self.sm.base
         d_aug = list(d) + [0.0] * len(sm._sd_syms)
-        cb = sm.callbacks(p, d_aug)
-        ds = _initial_state_sensitivities(sm, cm, cb, p, d, t0, y, yp, starts)
+        cb = self.serve(sm, d_aug)
+        ds = _initial_state_sensitivities(sm, cm, cb, self.serve(cm, d), p, d, t0, y, yp,
+                                          starts)
         S = np.zeros((sm.m, sm.n))
         S[:, :sm.ns] = ds
         Y, YP = sm.pack(y, S), sm.pack(yp, np.zeros((sm.m, sm.n)))
@@ -356,13 +372,13 @@ class SensRun:
         from .initialize import _algebraic_rates, _jacobians, reinitialize
         sm, cm = self.sm, self.sm.base
         n, ns = sm.n, sm.ns
-        cb = cm.callbacks(self.p, list(d_aug[:len(cm.disc_syms)]))
+        cb = self.serve(cm, d_aug[:len(cm.disc_syms)])
         (y, S), (yp, Sp) = sm.unpack(Y), sm.unpack(YP)
         y, yp = reinitialize(cm, cb, t, y, yp)
         S, Sp = S.copy(), Sp.copy()
         S[:, ns:] = 0.0
         Sp[:, :ns] = 0.0
-        cba = sm.callbacks(self.p, d_aug)
+        cba = self.serve(sm, d_aug)
         r = np.zeros(len(sm.dae.y))
         cba[0](t, sm.pack(y, S), sm.pack(yp, Sp), r)
         Jy, Jyp = _jacobians(cb, t, y, yp, n)
@@ -415,7 +431,8 @@ class SensRun:
         if not fired:
             return {}
         Y, YP = self.polish(t, Y, YP, d_aug)
-        rates = _rates(self.sm, self.p, t, Y, YP, d_aug)
+        rates = _rates(self.sm, self.serve(self.sm.base, d_aug[:len(self.sm.base.disc_syms)]),
+                       t, Y, YP)
         taus = {i: self.event_time(t, Y, YP, d_aug, i, rates) for i in fired}
         if current and taus:
             first = taus[min(taus)]
@@ -437,7 +454,7 @@ class SensRun:
         Y, YP = self.polish(t, Y, YP, d_before)
         self.sd_all = self._action_sensitivities(events, t, Y, YP, d_before, obs, self.dtau)
         d_new = list(d_after[:nd]) + self.sd_all[:, sm.dyn].ravel().tolist()
-        cb = sm.callbacks(self.p, d_new)
+        cb = self.serve(sm, d_new)
         Y1, YP1 = self.reinit(t, Y, YP, d_new, rates=False)
         ns = sm.ns
         jump = (np.asarray(YP)[:ns] - YP1[:ns])[None, :] * self.dtau[:, None]   # m x ns
@@ -459,7 +476,7 @@ class SensRun:
         sd = self.sd_all.copy()
         if not any(ev.action is not None for ev in events):
             return sd
-        out = np.asarray(sm.callbacks(self.p, d_before)[4](t, Y, YP), float)
+        out = np.asarray(self.serve(sm, d_before)[4](t, Y, YP), float)
         dobs = out[nobs:].reshape(sm.m, nobs)
         odot = self._observed_rate(t, Y, YP, d_before)
         obs = np.asarray(obs, float)[:nobs]
@@ -494,7 +511,7 @@ class SensRun:
         """d(observed)/dt along the solution, by a central difference."""
         sm = self.sm
         nobs = len(sm.base.var_names)
-        obs = sm.callbacks(self.p, d_aug)[4]
+        obs = self.serve(sm, d_aug)[4]
         dt = 1e-7 * self.span
         Y, YP = np.asarray(Y, float), np.asarray(YP, float)
         a = np.asarray(obs(t + dt, Y + dt * YP, YP), float)[:nobs]
@@ -512,8 +529,8 @@ class SensRun:
         return Sensitivities(self.sm, self.p, T, Y, YP, D, SD, E)
 
 
-def _rates(sm, p, t, Y, YP, d_aug):
-    """(y', y'') of the base model at a consistent point: y' of the states
+def _rates(sm, cb, t, Y, YP):
+    """(y', y'') of the base model (its callbacks ``cb``) at a consistent point: y' of the states
     from ``YP``, y' of the algebraic unknowns and y'' of the states from the
     equations differentiated once along the solution,
     ``[F_y(alg) F_y'(states)] [y'_alg; y''_states] = -(F_t + F_y(states) y'_states)``
@@ -525,7 +542,6 @@ def _rates(sm, p, t, Y, YP, d_aug):
     ydot, ydd = np.array(yp, float), np.zeros(n)
     if n == ns and not any(s is not None for s in cm.dae.yp):
         return ydot, ydd
-    cb = cm.callbacks(p, list(d_aug[:len(cm.disc_syms)]))
     Jy, Jyp = _jacobians(cb, t, y, yp, n)
     dt = 1e-7 * max(1.0, abs(t))
     rp, rm = np.zeros(n), np.zeros(n)
@@ -542,14 +558,15 @@ def _rates(sm, p, t, Y, YP, d_aug):
     return ydot, ydd
 
 
-def _initial_state_sensitivities(sm, cm, cb, p, d, t0, y, yp, starts):
-    """d(states)/dp (m x ns) at the consistent initial point: the initial
+def _initial_state_sensitivities(sm, cm, cb, cb_base, p, d, t0, y, yp, starts):
+    """d(states)/dp (m x ns) at the consistent initial point (``cb``, ``cb_base``:
+    the augmented and the base model's callbacks): the initial
     system (residuals, fixed starts, imposed guesses; see
     :mod:`acausal.initialize`) differentiated with respect to each parameter
     and solved for ``dz = (dy, dy'_states)`` (implicit function theorem)."""
     from .initialize import _choose_guesses, _jacobians, _lstsq_scaled
     n, ns, m = sm.n, sm.ns, sm.m
-    Jy, Jyp = _jacobians(cm.callbacks(p, d), t0, y, yp, n)
+    Jy, Jyp = _jacobians(cb_base, t0, y, yp, n)
     rows = [np.hstack([Jy, Jyp[:, :ns]])]
     fixed = cm.fixed_starts(p, starts)
     if fixed:

@@ -94,7 +94,7 @@ class _Run:
         self.firings = {}    # (owner, event name) -> times of its last CHATTER_COUNT firings
         self.nfev = self.njev = self.steps = self.rows = 0
         self.sens = None   # acausal.sensitivity.SensRun when sensitivities are asked for
-        self._cbs = {}
+        self._cbs, self._served = {}, {}
 
     def record(self, t, y, yp, d):
         self.T.append(np.atleast_1d(np.asarray(t, float)))
@@ -109,12 +109,22 @@ class _Run:
         """Mode ``d``'s generated callbacks, as the backend serves them to
         the loop (the compiled backend's call C: :meth:`SegmentSolver.callbacks`),
         made once per mode of the run (contacts switch back and forth)."""
-        if self.sens is not None:   # the augmented model's own callbacks (Python)
-            return self.cm.callbacks(self.p, d)
+        if self.sens is not None:   # the sensitivities of discrete values change at each event
+            return self.serve(self.cm, d)
         key = tuple(map(float, d))
         cb = self._cbs.get(key)
         if cb is None:
             cb = self._cbs[key] = self.solver().callbacks(self.cm.callbacks(self.p, d), d)
+        return cb
+
+    def serve(self, model, d):
+        """``model``'s callbacks in mode ``d`` as this run's backend serves
+        them (a sensitivity run's augmented model and its base model), made
+        once per model and mode of the run."""
+        key = (id(model),) + tuple(map(float, d))
+        cb = self._served.get(key)
+        if cb is None:
+            cb = self._served[key] = self.solver().serve(model, self.p, list(key[1:]))
         return cb
 
     def solver(self):
@@ -230,11 +240,11 @@ def _start(cm, t0, t_end, params, rtol, atol, atol_algebraic, max_step, max_step
         model = sensitivity_model(cm, sensitivities)
         atol = model.atol(atol, p)
     run = _Run(model, p, t0, t_end, rtol, atol, max_step, max_steps, backend, linsolver)
-    cb = cm.callbacks(p, d) if sensitivities else run.callbacks(d)
+    cb = run.serve(cm, d) if sensitivities else run.callbacks(d)
     run.cb_d = list(d)
     y, yp = initial_point(cm, p, d, cb, t0, starts)
     if sensitivities:
-        run.sens = SensRun(model, p, t_end - t0)
+        run.sens = SensRun(model, p, t_end - t0, run.serve)
         y, yp, d, cb = run.sens.start(p, d, t0, y, yp, starts)
         run.cb_d = list(d)
     y, yp, d, cb, stop = _event_iteration(run, cb, t0, y, yp, d, initial=True)

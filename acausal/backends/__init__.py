@@ -93,6 +93,12 @@ class SegmentSolver:
         or a backend's faster equivalent of it (same tuple, same results)."""
         return cb
 
+    def serve(self, model, p, d):
+        """The callbacks of ``model`` (this solver's, or one run beside it:
+        a sensitivity run's base model, :mod:`acausal.sensitivity`) with
+        parameters ``p`` in mode ``d``, as :meth:`callbacks` serves them."""
+        return model.callbacks(p, d)
+
 
 class BackendError(AcausalError):
     """A backend was asked for that does not exist or cannot run here."""

@@ -188,7 +188,11 @@ class _Library:
         lib.acs_init_newton.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_double, vp, vp,
                                         ctypes.c_int, vp, vp, ctypes.c_int, vp, ctypes.c_int]
         self.n_fixed = sum(1 for nm in cm.var_names if cm.flat.variables[nm].start.fixed)
-        self.n_obs = len(cm.var_names) if lib.acs_has_observe() else None
+        # the C observe serves the model's observe callback when it gives the
+        # same values (a sensitivity model observes their sensitivities too,
+        # which its C does not: its Python observe then serves)
+        n_obs = getattr(cm, "n_observed", len(cm.var_names))
+        self.n_obs = n_obs if lib.acs_has_observe() and lib.acs_n_observed() == n_obs else None
         self.idle = {}
         weakref.finalize(self, _free_idle, lib, self.idle)
 
@@ -309,6 +313,9 @@ class CompiledSolver(SegmentSolver):
         """``cb`` (mode ``d``'s generated callbacks) calling the compiled
         library where it can: see :class:`CCallbacks`."""
         return CCallbacks(self.L, self.cm, self.p, d, cb)
+
+    def serve(self, model, p, d):
+        return CCallbacks(library(model), model, p, d, model.callbacks(p, d))
 
 
 def _f64(a):

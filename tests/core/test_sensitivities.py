@@ -292,3 +292,31 @@ def test_hertz_exponent_sensitivity_against_central_differences():
     fd = (np.array(a.event_times()) - np.array(b.event_times())) / (2 * h)
     got = res.event_sensitivity("contact.gamma")
     assert np.max(np.abs(got - fd)) < 1e-6 * np.max(np.abs(fd))
+
+
+@pytest.mark.slow
+def test_compiled_callbacks_of_a_sensitivity_model_match_its_python_ones():
+    """The compiled backend serves a sensitivity run's callbacks from C, the
+    observed variables' sensitivities included: the same values as the
+    generated Python at an arbitrary point (in contact, so the impact law's
+    discrete values and their sensitivities are used)."""
+    if compiled_available() is not None:
+        pytest.skip(compiled_available())
+    from acausal.backends.compiled import CompiledSolver
+    from acausal.sensitivity import sensitivity_model
+    cm = _bouncing()
+    sm = sensitivity_model(cm, ["contact.K", "contact.e"])
+    p = cm.param_vector({})
+    rng = np.random.default_rng(4)
+    d = list(rng.uniform(0.1, 1.0, len(sm.disc_syms)))
+    N = len(sm.dae.y)
+    y, yp = rng.normal(size=N) * 1e-3, rng.normal(size=N)
+    solver = CompiledSolver(sm, p, dict(rtol=1e-6, atol=1e-8, max_num_steps=500))
+    c, py = solver.serve(sm, p, d), sm.callbacks(p, d)
+    assert c[4] is not py[4]                      # observe runs in C
+    assert len(c[4](0.0, y, yp)) == sm.n_observed == 3 * len(cm.var_names)
+    np.testing.assert_allclose(c[4](0.0, y, yp), py[4](0.0, y, yp), rtol=1e-12, atol=1e-300)
+    rc, rp = np.zeros(N), np.zeros(N)
+    c[0](0.0, y, yp, rc)
+    py[0](0.0, y, yp, rp)
+    np.testing.assert_allclose(rc, rp, rtol=1e-12, atol=1e-300)
