@@ -452,8 +452,9 @@ def _reinitialize(cm, cb, t, y, yp):
     return y, _algebraic_rates(cm, cb, t, y, yp)
 
 
-def _algebraic_rates(cm, cb, t, y, yp):
-    """Fill y' of the algebraic slots with their true rates.
+def _algebraic_rates(cm, cb, t, y, yp, solve=None):
+    """Fill y' of the algebraic slots with their true rates (``solve(J, b)``:
+    the linear solve, :func:`_solve_square` unless a caller knows better).
 
     IDA keeps every component, algebraic ones too, in its BDF history and
     error test; an algebraic unknown that moves (a holding force under a
@@ -478,7 +479,7 @@ def _algebraic_rates(cm, cb, t, y, yp):
     if count is not None:   # these are not solver step attempts
         count[:] = saved
     rhs = -((rp - rm) / (2 * dt) + Jy_states @ yp[:ns])
-    sol = _solve_square(J, rhs)
+    sol = (solve or _solve_square)(J, rhs)
     if np.all(np.isfinite(sol)):
         yp[ns:] = sol[:n - ns]
     return yp
