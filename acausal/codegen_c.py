@@ -18,7 +18,8 @@ import sympy as sp
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.codeprinter import PrintMethodNotImplementedError
 
-from .codegen import NamedTemps, Names, _fixed_entries, _jacobian_entries, _repeated
+from .codegen import (NamedTemps, Names, _fixed_entries, _jacobian_entries, _repeated,
+                      replace_shared)
 
 
 class _Printer(NamedTemps, C99CodePrinter):
@@ -94,7 +95,7 @@ def _observe(cm, names, real, decl, ysyms, ypsyms):
     expression has no C form, and the caller keeps the Python one (the
     residual and root functions decide whether the backend can run)."""
     obs = cm.observed_exprs()
-    exprs = [e.xreplace(real) for e in names.rename(obs, "an observed variable")]
+    exprs = [replace_shared(e, real) for e in names.rename(obs, "an observed variable")]
     try:
         body = _body(exprs, [f"o[{i}]" for i in range(len(exprs))])
         fixjac = _fixjac(cm, exprs, ysyms, ypsyms)
@@ -132,9 +133,10 @@ def generate_c(cm):
         [cm.resolve(a.expr) for a in cm.assertions]
     res = names.rename(dae.residuals, "a residual")
     g = names.rename(roots, "an event")
-    real = {s: sp.Symbol(s.name, real=True) for s in names.allowed}
-    res = [r.xreplace(real) for r in res]
-    g = [e.xreplace(real) for e in g]
+    # (Names' symbols are real already: then there is nothing to replace)
+    real = {s: r for s in names.allowed if (r := sp.Symbol(s.name, real=True)) is not s}
+    res = [replace_shared(r, real) for r in res]
+    g = [replace_shared(e, real) for e in g]
     # the symbols as they stand in the expressions, found by name (whatever
     # assumptions Names gives them)
     by_name = {v.name: v for v in real.values()}
