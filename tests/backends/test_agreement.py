@@ -120,14 +120,26 @@ def _no_worse(err, tol, what):
     assert err["sundae"] <= 2 * err["compiled"] + tol, (what, err, tol)
 
 
+# The toggle's knee, latched 1.4 deg from its dead centre, makes its
+# re-initialisation matrix 100 times worse conditioned than the planar
+# breaker's (column-scaled condition number 5e7 against 5.7e5; 2.3e5 for
+# the 1-D breaker): IDA's corrector cannot converge below rtol 1e-10 there
+# (it fails at t = 8 us at rtol 1e-10 and at 0.27 ms at 1e-11, on either
+# backend), so its reference is the tightest run it allows: 3e-2 of the
+# file's tolerances (rtol 3e-10), still 30 times the accuracy of the runs.
+TIGHTEN = {"breaker_24kv_toggle": 3e-2}
+
+
 def _check_equally_accurate(path, params=None):
     """Both backends against the reference backend at 1e-3 of the file's
-    tolerances: event times, measures and traces (on the dense grid) no less
-    accurate on one backend than on the other (see the module doc)."""
+    tolerances (:data:`TIGHTEN` where the model's conditioning does not
+    allow that): event times, measures and traces (on the dense grid) no
+    less accurate on one backend than on the other (see the module doc)."""
     mf, cm = _compiled(path)
     opts = _trace_options(mf)
     rtol, atol = opts.get("rtol", 1e-6), float(np.max(opts.get("atol", 1e-8)))
-    tight = dict(opts, rtol=rtol * 1e-3, atol=atol * 1e-3)
+    f = TIGHTEN.get(os.path.basename(path)[:-3], 1e-3)
+    tight = dict(opts, rtol=rtol * f, atol=atol * f)
     tol = GLOBAL * rtol
     ref = cm.simulate(params=params, backend="sundae", **tight)
     runs = dict(zip(("sundae", "compiled"), _both(cm, params, opts)))
