@@ -85,11 +85,9 @@ def _solve_initial(cm, p, d, cb, t0, starts=None):
     # trust-region least squares is the fallback; its long steps (in
     # variables with small Jacobian columns, such as lengths in m) can reach
     # another solution.
-    newton = getattr(cb, "init_newton", None)    # the same Newton in C (compiled backend)
-    z = newton(t0, z0, guess_rows, fixed) if newton is not None else NotImplemented
-    if z is NotImplemented:
-        z = _newton(lambda zz: residual(zz, guess_rows), lambda zz: jac(zz, guess_rows), z0)
-    checked = z is not None and _consistent(cm, residual(z, []), jac(z, []), z, fixed, n)
+    z, checked = _first_newton(cb, t0, z0, guess_rows, fixed, residual, jac,
+                               lambda zz: _consistent(cm, residual(zz, []), jac(zz, []), zz,
+                                                      fixed, n))
     if not checked:
         sol = least_squares(residual, z0, jac=jac, args=(guess_rows,), method="trf",
                             xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=200,
@@ -117,6 +115,21 @@ def _solve_initial(cm, p, d, cb, t0, starts=None):
     z = np.concatenate([y, yp[:ns]])
     _check(cm, residual(z, []), jac(z, []), z, fixed, n)
     return y, yp    # reinitialize has filled the algebraic rates
+
+
+def _first_newton(cb, t0, z0, guess_rows, fixed, residual, jac, consistent):
+    """(z, consistent(z)) of Gauss-Newton from the guesses: the backend's
+    own (``cb.init_newton``, the compiled backend's C) where it has one,
+    else :func:`_newton`; also :func:`_newton` when the C point fails the
+    check (its QR declines only below a 1e-10 ratio of R's diagonal, and a
+    nearly rank-deficient system, such as a 1e-12 kg*m^2 hook inertia, is
+    solved better by the SVD of numpy's least squares)."""
+    newton = getattr(cb, "init_newton", None)
+    z = newton(t0, z0, guess_rows, fixed) if newton is not None else NotImplemented
+    if z is not NotImplemented and z is not None and consistent(z):
+        return z, True
+    z = _newton(lambda zz: residual(zz, guess_rows), lambda zz: jac(zz, guess_rows), z0)
+    return z, z is not None and consistent(z)
 
 
 # unknowns (y and the states' y') from which the initialisation assembles

@@ -241,7 +241,9 @@ def test_absurd_parameter_named_instead_of_inconsistent_starts():
     mf, cm = compile_file(os.path.join(ROOT, "models", "breaker_24kv.py"))
     opts = mf.experiment.run_options()
     light = [cm.simulate(params={"hook.Jh": j}, **opts).t[-1] for j in (1e-12, 1e-30)]
-    assert abs(light[1] - light[0]) < 1e-12
+    # the same end within the integration's tolerance (rtol relative: 1.4e-11 s;
+    # the two runs' steps differ on the compiled backend, 3.3e-12 s apart)
+    assert abs(light[1] - light[0]) < opts["rtol"] * light[0]
     for name, value in (("main_shaft.kw", 1e30), ("armature.ma", 1e-30)):
         # the initialisation fails (InitializationError) or, when it still
         # solves, the integration does (SolverError): either names the parameter
