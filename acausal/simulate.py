@@ -397,6 +397,7 @@ class _Watch:
         Python backend) stops the run."""
         self.t_call = _time.perf_counter()
         self.every_step = len(tspan) == 2
+        solver.guard = self._hard     # (a compiled backend's check, per output buffer)
         try:
             return solver.solve(cb, d, float(tspan[0]), y, yp, tspan[1:], every_step)
         except _HardStop as exc:

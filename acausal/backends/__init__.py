@@ -83,6 +83,10 @@ class SegmentSolver:
     name = "?"
     detail = ""
     fallback = None   # why another backend runs in place of the one asked for
+    # guard(steps): called by a backend that does not call the Python residual
+    # (compiled) whenever its output buffer fills, with the steps of the call
+    # so far; raises to stop a call that runs far past the run's limits
+    guard = None
 
     def solve(self, cb, d, t, y, yp, tout, every_step):
         raise NotImplementedError

@@ -287,6 +287,9 @@ class CompiledSolver(SegmentSolver):
             if k:
                 T.append(bt[:k].copy()), Y.append(by[:k].copy()), YP.append(byp[:k].copy())
             if flag == _FULL:
+                if self.guard is not None:
+                    L.acs_counters(self.h, self.counters.ctypes.data)
+                    self.guard(int(self.counters[0]))
                 continue
             if flag != _ROOT:
                 break
