@@ -84,7 +84,8 @@ def _setup(task: ProfileTask):
     bounds = (np.array([p.low for p in ps]), np.array([p.high for p in ps]))
     J = jacobian_in_profile_variables(task.jacobian, x, log=log, scale=scale)
     obj = Objective(model_of(task.problem, task.candidate), dataset_of(task.problem),
-                    [p.name for p in ps], max_evals=MAX_EVALS, penalty=task.penalty)
+                    [p.name for p in ps], max_evals=MAX_EVALS, penalty=task.penalty,
+                    backend=task.problem.settings.integrator)
     return x, dict(log=log, scale=scale, bounds=bounds, jacobian=J, fd_step=FD_STEP), obj
 
 
