@@ -11,6 +11,7 @@ alone explains).
 from __future__ import annotations
 
 import time
+from collections import OrderedDict
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -21,6 +22,7 @@ from ..data import Dataset
 from ..errors import AcausalError
 
 PENALTY = 1e3   # weighted residual given to every sample of a failed simulation
+RECENT = 16     # evaluations an Objective remembers (the optimum's residuals reused)
 MAX_STEPS = 5000  # solver steps between two outputs beyond which a run counts as failed
 # Finite differences (FD_STEP of each parameter's scale, absolute; see
 # acausal.calibrate): the residuals of an adaptive, event-located simulation
@@ -173,6 +175,7 @@ class Objective:
         self.size = None
         self.best_cost, self.best_x = np.inf, None
         self.timed = True
+        self.recent = OrderedDict()   # x bytes -> weighted_residuals output (RECENT last)
 
     def params(self, x):
         return {**self.fixed, **dict(zip(self.names, np.asarray(x, float).tolist()))}
@@ -190,8 +193,8 @@ class Objective:
         self.n_eval += 1
         self.n_sim += len(self.dataset.experiments)
         try:
-            vec = weighted_residuals(self.pair, self.dataset, self.params(x),
-                                     self.backend)[0]
+            vec = self._remember(x, weighted_residuals(self.pair, self.dataset, self.params(x),
+                                                       self.backend))[0]
             self.size = vec.size
             if not np.all(np.isfinite(vec)):
                 vec = np.nan_to_num(vec, nan=PENALTY, posinf=PENALTY, neginf=-PENALTY)
@@ -207,6 +210,22 @@ class Objective:
             self.best_cost, self.best_x = c, np.array(x, float)
         return vec
 
+
+    def _remember(self, x, out):
+        self.recent[np.asarray(x, float).tobytes()] = out
+        while len(self.recent) > RECENT:
+            self.recent.popitem(last=False)
+        return out
+
+    def residuals_at(self, x):
+        """:func:`weighted_residuals` at ``x``: an evaluation's own output when
+        ``x`` is one of the last :data:`RECENT` evaluated (the simulations are
+        deterministic), else simulated (and counted)."""
+        got = self.recent.get(np.asarray(x, float).tobytes())
+        if got is None:
+            got = weighted_residuals(self.pair, self.dataset, self.params(x), self.backend)
+            self.n_sim += len(self.dataset.experiments)
+        return got
 
     def jac_x(self, x):
         """d residuals / d x from forward sensitivities (:func:`weighted_jacobian`),
@@ -332,11 +351,10 @@ def failed_fit(names, x0, obj, message):
 
 
 def finish(obj, x, J, ok, message, lo):
-    """The :class:`Fit` at ``x``: residuals re-simulated there, the
-    Jacobian reshaped, intervals (log intervals for positive parameters)."""
-    r, groups, signals = weighted_residuals(obj.pair, obj.dataset, obj.params(x),
-                                                obj.backend)
-    obj.n_sim += len(obj.dataset.experiments)
+    """The :class:`Fit` at ``x``: residuals there (:meth:`Objective.residuals_at`:
+    the optimiser's own evaluation of ``x``, or a new one), the Jacobian
+    reshaped, intervals (log intervals for positive parameters)."""
+    r, groups, signals = obj.residuals_at(x)
     names = obj.names
     J = np.asarray(J)[:r.size].reshape(r.size, len(names)) if names else np.zeros((r.size, 0))
     out = Fit(names, dict(zip(names, np.asarray(x, float).tolist())), float(r @ r), r, J,
