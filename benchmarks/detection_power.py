@@ -83,6 +83,35 @@ def run_case(model, hyp, effect, seed, library, quick):
                 cause=out["cause"], wall_s=time.perf_counter() - t0)
 
 
+def job_list(args, hyps, effects):
+    """Every case, seed-major (every hypothesis and effect at the first seed,
+    then the next seed, ...) with the null datasets spread among them, so
+    that a run stopped early has covered every cell as evenly as it could."""
+    per_seed = [[(args.model, h, e, 1000 * i + s, args.library, args.quick)
+                 for i, h in enumerate(hyps) for e in effects] for s in range(args.seeds)]
+    nulls = [(args.model, None, 0.0, 90000 + s, args.library, args.quick)
+             for s in range(args.nulls)]
+    jobs = []
+    for k, block in enumerate(per_seed):
+        share = nulls[k * len(nulls) // max(args.seeds, 1):(k + 1) * len(nulls)
+                      // max(args.seeds, 1)]
+        step = max(1, len(block) // max(len(share), 1))
+        for j, job in enumerate(block):
+            jobs.append(job)
+            if share and (j + 1) % step == 0:
+                jobs.append(share.pop(0))
+        jobs += share
+    return jobs if args.seeds else nulls
+
+
+def _sited(model, hyps, library):
+    """The hypotheses with at least one site on the model, and the others."""
+    from acausal.diagnose.run import candidates
+    path = SETUPS[model]["path"]
+    have = [h for h in hyps if candidates(path, library, [h])[2]]
+    return have, [h for h in hyps if h not in have]
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--model", choices=sorted(SETUPS), default="latch")
@@ -93,17 +122,17 @@ def main(argv=None):
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--library", default=None)
     ap.add_argument("--quick", action="store_true", help="fewer optimiser steps")
-    ap.add_argument("--out", default=None)
+    ap.add_argument("--out", default=None, help="the Markdown table (rewritten after every "
+                    "case, marked partial until all are done; every case's outcome in "
+                    "the .json beside it)")
     args = ap.parse_args(argv)
 
     from acausal.diagnose.library import load_library
     lib = load_library(args.library)
     hyps = args.hypotheses.split(",") if args.hypotheses else list(lib.HYPOTHESES)
+    hyps, unsited = _sited(args.model, hyps, args.library)
     effects = [float(x) for x in args.effects.split(",")]
-    jobs = [(args.model, h, e, 1000 * i + s, args.library, args.quick)
-            for i, h in enumerate(hyps) for e in effects for s in range(args.seeds)]
-    jobs += [(args.model, None, 0.0, 90000 + s, args.library, args.quick)
-             for s in range(args.nulls)]
+    jobs = job_list(args, hyps, effects)
     t0 = time.perf_counter()
     results = []
     with cf.ProcessPoolExecutor(args.workers) as ex:
@@ -119,23 +148,43 @@ def main(argv=None):
                   f" at {r['location']} (achieved {r['achieved']:.2f}): right={r['right']} "
                   f"named={r['named']} "
                   f"cause={r['cause']} ({r['wall_s']:.0f} s)", file=sys.stderr)
-    wall = time.perf_counter() - t0
-    table = render(results, hyps, effects, args, wall)
+            _write(args, results, hyps, effects, time.perf_counter() - t0, len(jobs), unsited)
+    table = _write(args, results, hyps, effects, time.perf_counter() - t0, len(jobs), unsited)
     print(table)
+
+
+def _write(args, results, hyps, effects, wall, n_jobs, unsited=()):
+    """The table (and, with ``--out``, the files) of the cases done so far."""
+    table = render(results, hyps, effects, args, wall, n_jobs, unsited)
     if args.out:
         with open(args.out, "w") as f:
             f.write(table)
         import json
         with open(os.path.splitext(args.out)[0] + ".json", "w") as f:
-            json.dump(dict(args=vars(args), wall_s=wall, cases=results), f, indent=1,
-                      default=float)
+            json.dump(dict(args=vars(args), wall_s=wall, n_cases=n_jobs, cases=results), f,
+                      indent=1, default=float)
+    return table
 
 
-def render(results, hyps, effects, args, wall):
+def render(results, hyps, effects, args, wall, n_jobs=None, unsited=()):
+    n_jobs = len(results) if n_jobs is None else n_jobs
     L = [f"Detection power on `{args.model}` ({args.seeds} seeds per cell, "
          f"{args.nulls} null datasets; {wall / 60:.0f} min with {args.workers} workers).",
          "Cell: right-cause rate (right cause at the right location, named or in the "
          "named class) / named exactly / weak (discrepancy, no cause named) / missed.", ""]
+    if len(results) < n_jobs:
+        done = max(len(results), 1)
+        L[1:1] = ["", f"**PARTIAL: {len(results)} of {n_jobs} cases done after "
+                  f"{wall / 60:.0f} min** ({wall / done:.0f} s of wall per case with "
+                  f"{args.workers} workers; all {n_jobs} would take about "
+                  f"{wall / done * n_jobs / 60:.0f} min at that rate). Cells show the cases "
+                  "done so far (n/a: none yet)."]
+    if unsited:
+        L.insert(1, f"Not run (no site for them on this model): {', '.join(unsited)}.")
+    load = os.getloadavg()
+    L.insert(1, f"Machine load (1/5/15 min) when written: {load[0]:.1f}/{load[1]:.1f}/"
+             f"{load[2]:.1f} on {os.cpu_count()} CPUs; mean wall per case "
+             f"{np.mean([r['wall_s'] for r in results]) if results else float('nan'):.0f} s.")
     L.append("| hypothesis | " + " | ".join(f"effect {e:g}" for e in effects) + " |")
     L.append("|---|" + "---|" * len(effects))
     for h in hyps:

@@ -11,6 +11,7 @@ alone explains).
 from __future__ import annotations
 
 import time
+from collections import OrderedDict
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -21,6 +22,7 @@ from ..data import Dataset
 from ..errors import AcausalError
 
 PENALTY = 1e3   # weighted residual given to every sample of a failed simulation
+RECENT = 16     # evaluations an Objective remembers (the optimum's residuals reused)
 MAX_STEPS = 5000  # solver steps between two outputs beyond which a run counts as failed
 # Finite differences (FD_STEP of each parameter's scale, absolute; see
 # acausal.calibrate): the residuals of an adaptive, event-located simulation
@@ -68,23 +70,39 @@ def subset(dataset: Dataset, names) -> Dataset:
                    dataset.instrument)
 
 
+def run_options(mf, e):
+    """The simulation options of experiment ``e``: the model file's. An
+    experiment with a trace and no measures is simulated only up to its
+    last sample (a growing-window fit then pays only for its window), with
+    output at the trace's own sample times (IDA's interpolant there, in
+    place of the dense grid the samples were interpolated from: the same
+    values where the samples lie on that grid, and cheaper: about a third
+    of a breaker simulation went into storing its 950 dense rows for 100
+    samples). With measures, the dense grid (measures need every event
+    row; the samples are interpolated from it)."""
+    opts = {**mf.experiment.run_options(dense=e.trace is not None), "max_steps": MAX_STEPS}
+    if not e.measures and e.trace is not None and e.trace.time.size:
+        opts["t_end"] = min(opts["t_end"], float(e.trace.time[-1]) * (1 + 1e-9) + 1e-12)
+        opts["output_step"] = None
+        opts["output_times"] = e.trace.time
+    return opts
+
+
 def weighted_residuals(model, dataset, params, backend=None):
     """(vector, groups, signals) of weighted residuals for ``params``, as
     :func:`acausal.calibrate.residual_vector` (measures first, then trace
     samples), except that an experiment without measures is simulated only
     up to its last trace sample (a growing-window fit then pays only for
-    its window) and its measures are not evaluated. ``backend``: the
+    its window, with output at the sample times: :func:`run_options`) and its
+    measures are not evaluated. ``backend``: the
     integrator (:func:`acausal.simulate.simulate`; None: the library's)."""
     from ..calibrate import _sigma
     from ..modelfile import evaluate_measures
     mf, cm = resolve(model)
     vec, groups, signals = [], [], []
     for e in dataset.experiments:
-        # samples compared with a trace: the model file's dense grid
-        opts = {**mf.experiment.run_options(dense=e.trace is not None), "max_steps": MAX_STEPS}
-        if not e.measures and e.trace is not None and e.trace.time.size:
-            opts["t_end"] = min(opts["t_end"], float(e.trace.time[-1]) * (1 + 1e-9) + 1e-12)
-        res = cm.simulate(params={**params, **e.conditions}, backend=backend, **opts)
+        res = cm.simulate(params={**params, **e.conditions}, backend=backend,
+                          **run_options(mf, e))
         if e.measures:
             meas = evaluate_measures(mf, res)
             for m, y in e.measures.items():
@@ -100,7 +118,7 @@ def weighted_residuals(model, dataset, params, backend=None):
     return np.asarray(vec, float), groups, signals
 
 
-def weighted_jacobian(model, dataset, params, names):
+def weighted_jacobian(model, dataset, params, names, backend=None):
     """(vector, d vector / d params over ``names``) as
     :func:`weighted_residuals`, the Jacobian from one simulation per
     experiment with forward sensitivities (:mod:`acausal.sensitivity`; a
@@ -112,11 +130,8 @@ def weighted_jacobian(model, dataset, params, names):
     mf, cm = resolve(model)
     vec, rows = [], []
     for e in dataset.experiments:
-        opts = {**mf.experiment.run_options(dense=e.trace is not None), "max_steps": MAX_STEPS,
-                "sensitivities": list(names)}
-        if not e.measures and e.trace is not None and e.trace.time.size:
-            opts["t_end"] = min(opts["t_end"], float(e.trace.time[-1]) * (1 + 1e-9) + 1e-12)
-        res = cm.simulate(params={**params, **e.conditions}, **opts)
+        res = cm.simulate(params={**params, **e.conditions}, backend=backend,
+                          sensitivities=list(names), **run_options(mf, e))
         if e.measures:
             meas = evaluate_measures(mf, res)
             for m, y in e.measures.items():
@@ -160,6 +175,7 @@ class Objective:
         self.size = None
         self.best_cost, self.best_x = np.inf, None
         self.timed = True
+        self.recent = OrderedDict()   # x bytes -> weighted_residuals output (RECENT last)
 
     def params(self, x):
         return {**self.fixed, **dict(zip(self.names, np.asarray(x, float).tolist()))}
@@ -177,8 +193,8 @@ class Objective:
         self.n_eval += 1
         self.n_sim += len(self.dataset.experiments)
         try:
-            vec = weighted_residuals(self.pair, self.dataset, self.params(x),
-                                     self.backend)[0]
+            vec = self._remember(x, weighted_residuals(self.pair, self.dataset, self.params(x),
+                                                       self.backend))[0]
             self.size = vec.size
             if not np.all(np.isfinite(vec)):
                 vec = np.nan_to_num(vec, nan=PENALTY, posinf=PENALTY, neginf=-PENALTY)
@@ -195,12 +211,29 @@ class Objective:
         return vec
 
 
+    def _remember(self, x, out):
+        self.recent[np.asarray(x, float).tobytes()] = out
+        while len(self.recent) > RECENT:
+            self.recent.popitem(last=False)
+        return out
+
+    def residuals_at(self, x):
+        """:func:`weighted_residuals` at ``x``: an evaluation's own output when
+        ``x`` is one of the last :data:`RECENT` evaluated (the simulations are
+        deterministic), else simulated (and counted)."""
+        got = self.recent.get(np.asarray(x, float).tobytes())
+        if got is None:
+            got = weighted_residuals(self.pair, self.dataset, self.params(x), self.backend)
+            self.n_sim += len(self.dataset.experiments)
+        return got
+
     def jac_x(self, x):
         """d residuals / d x from forward sensitivities (:func:`weighted_jacobian`),
         penalty rows included; a failed run raises its AcausalError."""
         self._check()
         self.n_sim += len(self.dataset.experiments)
-        J = weighted_jacobian(self.pair, self.dataset, self.params(x), self.names)[1]
+        J = weighted_jacobian(self.pair, self.dataset, self.params(x), self.names,
+                              self.backend)[1]
         if not np.all(np.isfinite(J)):
             from ..errors import SolverError
             raise SolverError("non-finite sensitivities")
@@ -318,11 +351,10 @@ def failed_fit(names, x0, obj, message):
 
 
 def finish(obj, x, J, ok, message, lo):
-    """The :class:`Fit` at ``x``: residuals re-simulated there, the
-    Jacobian reshaped, intervals (log intervals for positive parameters)."""
-    r, groups, signals = weighted_residuals(obj.pair, obj.dataset, obj.params(x),
-                                                obj.backend)
-    obj.n_sim += len(obj.dataset.experiments)
+    """The :class:`Fit` at ``x``: residuals there (:meth:`Objective.residuals_at`:
+    the optimiser's own evaluation of ``x``, or a new one), the Jacobian
+    reshaped, intervals (log intervals for positive parameters)."""
+    r, groups, signals = obj.residuals_at(x)
     names = obj.names
     J = np.asarray(J)[:r.size].reshape(r.size, len(names)) if names else np.zeros((r.size, 0))
     out = Fit(names, dict(zip(names, np.asarray(x, float).tolist())), float(r @ r), r, J,

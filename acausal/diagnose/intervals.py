@@ -12,8 +12,8 @@ above zero, value / scale otherwise; the threshold is the fit's (Student t,
 the noise scaled by max(1, S/(n-k)), as :func:`.fitting.confidence`).
 
 Each parameter is one task (:func:`profile_parameter`, a pure function of
-its :class:`ProfileTask`), with an evaluation budget: a profile that runs
-out keeps the linearised interval and says so.
+its :class:`ProfileTask`), with a budget of :data:`MAX_SIMS` simulations: a
+profile that runs out keeps the linearised interval and says so.
 """
 from __future__ import annotations
 
@@ -27,7 +27,12 @@ from .problem import NOMINAL
 from .stages import run_tasks
 from .tasks import dataset_of, model_of
 
-MAX_EVALS = 150       # dataset evaluations per traced profile (budget)
+MAX_SIMS = 2400       # simulations per parameter's check and traced profile (budget):
+# counted in simulations, so a dataset of many experiments gets as much
+# as one of few; 150 dataset evaluations (900 simulations of the report's
+# six experiments) did not finish the report data's K profile (one point
+# re-optimises the others: about 6 evaluations, up to 2 x MAX_POINTS points)
+MIN_EVALS = 60        # ... but at least this many dataset evaluations
 MAX_POINTS = 12       # traced points per side
 CROSSING_TOL = 0.05   # the threshold crossing to 5 % of the last step
 
@@ -83,9 +88,16 @@ def _setup(task: ProfileTask):
     scale = [abs(p.scale) or 1.0 for p in ps]
     bounds = (np.array([p.low for p in ps]), np.array([p.high for p in ps]))
     J = jacobian_in_profile_variables(task.jacobian, x, log=log, scale=scale)
-    obj = Objective(model_of(task.problem, task.candidate), dataset_of(task.problem),
-                    [p.name for p in ps], max_evals=MAX_EVALS, penalty=task.penalty)
+    ds = dataset_of(task.problem)
+    obj = Objective(model_of(task.problem, task.candidate), ds, [p.name for p in ps],
+                    max_evals=budget_evals(len(ds.experiments)), penalty=task.penalty,
+                    backend=task.problem.settings.integrator)
     return x, dict(log=log, scale=scale, bounds=bounds, jacobian=J, fd_step=FD_STEP), obj
+
+
+def budget_evals(n_experiments: int) -> int:
+    """Dataset evaluations within :data:`MAX_SIMS` simulations."""
+    return max(MIN_EVALS, MAX_SIMS // max(1, n_experiments))
 
 
 def profile_parameter(task: ProfileTask) -> ParamInterval:

@@ -87,8 +87,9 @@ def rivals(problem, rows, ref, signals):
     from ..design import ModelRival
     from .tasks import model_of
     times = ref.trace.time if ref.trace is not None else np.array([0.0])
+    opts = dict(backend=problem.settings.integrator)     # the fits' integrator
     return {r.candidate.label: ModelRival(model_of(problem, r.candidate), r.fit.values,
-                                          [s.name for s in signals], times)
+                                          [s.name for s in signals], times, opts)
             for r in rows}
 
 

@@ -6,13 +6,27 @@ import math
 import os
 from dataclasses import dataclass, field
 
-FIT_TOL = 1e-6   # ftol/xtol of the candidate fits (S to about 1e-6 relative)
+# ftol/xtol of the candidate fits: S to about 1e-5 relative (0.01-0.03 on the
+# breaker's 1272 values, against decisions made in AICc units and the
+# converged-start rule's max(0.5, 1e-3 S)); 1e-6 took 9 % more simulations
+# for changes in the fitted values of about 1e-4 of their own (benchmarks/
+# diagnose_speed.py, docs/diagnosis.md "Timing")
+FIT_TOL = 1e-5
 LOO_TOL = 1e-4   # of the warm-started leave-one-out refits (predictions only)
 # The diagnosis's fits run thousands of simulations of a few models: IDA
 # calling generated C (acausal.backends.compiled; falls back to "sundae"
 # without a C compiler) is 9x (breaker) to 18x (torsion rig) faster per
 # simulation and agrees to the integrator's tolerance (docs/diagnosis.md).
 FIT_BACKEND = "compiled"
+# The Jacobian of every least-squares step: forward differences (one
+# simulation per parameter and experiment, :data:`acausal.calibrate.FD_STEP`)
+# or exact forward sensitivities (:mod:`acausal.sensitivity`: one augmented
+# simulation per experiment; where one fails, the differences answer). Measured
+# on the breaker (docs/diagnosis.md, "Timing"): an augmented run with three
+# parameters costs about 9 plain runs (its event handling is Python), so the
+# differences (3 runs) stay the default; the sensitivities are the choice for
+# models with many parameters and few events.
+FIT_JACOBIAN = "differences"
 
 
 @dataclass(frozen=True)
@@ -99,7 +113,8 @@ class FitSettings:
     reported); ``windows``: fractions of the trace for the growing-window
     homotopy of the nominal calibration (1.0 last); ``backend``: the
     integrator of every fit's simulations (None: ``ACAUSAL_BACKEND``, else
-    :data:`FIT_BACKEND`)."""
+    :data:`FIT_BACKEND`); ``jacobian``: "differences" or "sensitivities"
+    (:data:`FIT_JACOBIAN`)."""
 
     max_nfev: int = 60
     tol: float = FIT_TOL
@@ -109,6 +124,7 @@ class FitSettings:
     windows: tuple = (0.3, 1.0)
     seed: int = 0
     backend: str | None = None
+    jacobian: str = FIT_JACOBIAN
 
     @property
     def integrator(self) -> str:

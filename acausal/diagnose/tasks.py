@@ -11,13 +11,16 @@ are drawn over their declared bounds (log-uniform between 1/30 of the
 typical magnitude and the bound, on each side the bounds allow), each
 combined with the calibrated free parameters and with the model file's own
 (uncalibrated) values, so that an effect the free parameters absorbed in
-the calibration can be recovered. Every start is scored once (after a
-linearised re-calibration of the free parameters), the best ``refine`` are
-refined by least squares, and the result says how many of them reached the
-best point and whether the extension was tested at all.
+the calibration can be recovered. Every start is scored once, on the first
+window of the traces (where the refinement starts: :class:`Refiner`), after
+a linearised re-calibration of the free parameters; the best ``refine`` are
+refined by least squares through the growing windows, and the result says
+how many of them reached the best point and whether the extension was
+tested at all.
 """
 from __future__ import annotations
 
+import dataclasses
 import os
 import time
 from dataclasses import dataclass, field
@@ -123,6 +126,22 @@ def window(ds: Dataset, frac: float) -> Dataset:
             trace = Trace(t[keep], {k: v[keep] for k, v in e.trace.signals.items()})
         out.append(Experiment(e.name, e.conditions, {}, trace, e.line, e.use))
     return Dataset(ds.folder, out, ds.instrument)
+
+
+def window_rows(ds: Dataset, frac: float) -> np.ndarray:
+    """Which rows of the whole record's residual vector (the order of
+    :func:`.fitting.weighted_residuals`: per experiment its measures, then
+    each trace signal's samples) :func:`window` keeps."""
+    keep = []
+    for e in ds.experiments:
+        keep.extend([frac >= 1.0] * len(e.measures))
+        if e.trace is not None:
+            t = e.trace.time
+            rows = t <= t[0] + frac * (t[-1] - t[0]) * (1 + 1e-9) if frac < 1.0 else \
+                np.ones(t.size, bool)
+            for _ in e.trace.signals:
+                keep.extend(rows.tolist())
+    return np.asarray(keep, bool)
 
 
 # -- starting points ----------------------------------------------------------------------
@@ -250,22 +269,30 @@ def _multistart(task: FitTask):
     lo, hi, sc = _bounds(params)
     ds = dataset_of(p)
     pair = model_of(p, cand)
-    obj = Objective(pair, ds, names, budget_s=task.budget_s, penalty=_penalty(cand),
-                    backend=s.integrator)
+    first = _windows(ds, s)[0]           # starts are scored on the first window
+    obj = Objective(pair, window(ds, first), names, budget_s=task.budget_s,
+                    penalty=_penalty(cand), backend=s.integrator)
     pts = start_points(task)
-    scored = score_starts(obj, [x for x, _ in pts], lo, hi, task.absorb)
+    scored = score_starts(obj, [x for x, _ in pts], lo, hi, _windowed(task.absorb, ds, first))
     if not scored:
         return failed_fit(names, pts[0][0], obj, "every starting point failed"), Starts()
-    fits, n_sim = [], obj.n_sim
     picked = _pick(scored, len(cand.params), sc, s.refine)
-    for _, x in picked:
-        f = _homotopy(pair, ds, names, x, lo, hi, sc, _windows(ds, s), s, task.budget_s,
+    refiner = Refiner(pair, ds, names, lo, hi, sc, _windows(ds, s), s, task.budget_s,
                       _penalty(cand))
-        n_sim += f.n_sim
-        fits.append(f)
+    fits = refiner.all([x for _, x in picked])
     best, starts = _summary(fits, len(scored), cand.params, True, [x for _, x in picked])
-    best.n_sim = n_sim
+    best = dataclasses.replace(best, n_sim=obj.n_sim + sum(f.n_sim for f in fits))
     return best, starts
+
+
+def _windowed(absorb, ds, frac):
+    """``absorb`` = (names, Jacobian of the whole record) with the rows of the
+    window ``frac`` only (None stays None)."""
+    if absorb is None or not absorb[0]:
+        return absorb
+    J = np.asarray(absorb[1], float)
+    rows = window_rows(ds, frac)
+    return (absorb[0], J[rows]) if rows.size == J.shape[0] else None
 
 
 def calibrate_nominal(task: FitTask) -> CandidateFit:
@@ -289,10 +316,10 @@ def calibrate_nominal(task: FitTask) -> CandidateFit:
     if not scored:
         return CandidateFit(task.candidate, None, {}, "every starting point failed",
                             time.perf_counter() - t0)
-    fits = [_homotopy(pair, ds, names, x, lo, hi, sc, windows, s)
-            for _, x in scored[:max(1, s.refine if n_lhs else 1)]]
+    fits = Refiner(pair, ds, names, lo, hi, sc, windows, s).all(
+        [x for _, x in scored[:max(1, s.refine if n_lhs else 1)]])
     best, starts = _summary(fits, len(scored))
-    best.n_sim = obj.n_sim + sum(f.n_sim for f in fits)
+    best = dataclasses.replace(best, n_sim=obj.n_sim + sum(f.n_sim for f in fits))
     loo = linear_loo(best) if best.ok else {}
     return CandidateFit(task.candidate, best, loo, None, time.perf_counter() - t0, starts)
 
@@ -303,20 +330,78 @@ def _penalty(cand):
     return np.asarray(cand.penalty, float), np.array([abs(p.scale) or 1.0 for p in cand.params])
 
 
-def _homotopy(pair, ds, names, x, lo, hi, sc, windows, s, budget_s=None, penalty=None):
-    """Refine ``x`` on each window in turn, the last being the whole record
-    (the windows before it get a third of the evaluations). ``n_sim`` of
-    the returned fit counts every window."""
-    fit, n_sim = None, 0
-    full = s.evals_per_param * (len(names) + 1)
-    for w in windows:
-        obj = Objective(pair, window(ds, w), names, budget_s=budget_s, penalty=penalty,
-                        max_evals=full if w >= 1.0 else max(3, full // 3), backend=s.integrator)
-        fit = finish(obj, *refine_or_keep(obj, x, lo, hi, sc, s.max_nfev, s.tol), lo)
-        n_sim += obj.n_sim
-        x = np.array([fit.values[n] for n in names])
-    fit.n_sim = n_sim
-    return fit
+AGREE_X = 1e-2      # two refinements meet: every parameter within this many scales ...
+# ... and S within max(0.5, 1e-3 S) (the converged-start rule of _summary)
+
+
+@dataclass
+class Refiner:
+    """Least-squares refinement through the growing windows (homotopy from
+    the start of the record to all of it: the windows before the last get a
+    third of the evaluations each), of one model on one dataset.
+
+    :meth:`all` refines several starts. A later start whose refinement
+    meets an earlier one's on a window before the last (the same point: S
+    within the converged-start tolerance, every parameter within
+    :data:`AGREE_X` of its scale) would follow it from there: it takes that
+    refinement's final fit (as converged, with only its own simulations
+    counted) instead of repeating the longer windows. Refinements that do
+    not meet are carried to the end as before."""
+
+    pair: tuple
+    ds: object
+    names: list
+    lo: np.ndarray
+    hi: np.ndarray
+    sc: np.ndarray
+    windows: tuple
+    settings: object
+    budget_s: float | None = None
+    penalty: object = None
+
+    def window_fit(self, w, x):
+        """The fit on window ``w`` from ``x``."""
+        s = self.settings
+        full = s.evals_per_param * (len(self.names) + 1)
+        obj = Objective(self.pair, window(self.ds, w), self.names, budget_s=self.budget_s,
+                        penalty=self.penalty, backend=s.integrator, jacobian=s.jacobian,
+                        max_evals=full if w >= 1.0 else max(3, full // 3))
+        return finish(obj, *refine_or_keep(obj, x, self.lo, self.hi, self.sc, s.max_nfev,
+                                           s.tol), self.lo)
+
+    def path(self, x, earlier=()):
+        """The per-window fits from ``x`` (the last on the whole record), or
+        those of an ``earlier`` path it meets. ``n_sim`` of the last fit
+        counts this path's own simulations on every window."""
+        out, n_sim = [], 0
+        for i, w in enumerate(self.windows):
+            fit = self.window_fit(w, x)
+            n_sim += fit.n_sim
+            out.append(fit)
+            met = next((p for p in earlier if i < len(p) - 1 and self.meets(fit, p[i])), None)
+            if met is not None:
+                out = list(met[:i]) + [fit] + list(met[i + 1:])
+                break
+            x = np.array([fit.values[n] for n in self.names])
+        out[-1] = dataclasses.replace(out[-1], n_sim=n_sim)
+        return out
+
+    def meets(self, a: Fit, b: Fit) -> bool:
+        """``a`` and ``b`` (fits on the same window) are the same point."""
+        if not (a.ok and b.ok and np.isfinite(a.cost) and np.isfinite(b.cost)):
+            return False
+        if abs(a.cost - b.cost) > max(0.5, 1e-3 * min(a.cost, b.cost)):
+            return False
+        xa = np.array([a.values[n] for n in self.names])
+        xb = np.array([b.values[n] for n in self.names])
+        return bool(np.all(np.abs(xa - xb) <= AGREE_X * self.sc))
+
+    def all(self, starts):
+        """The final fit of each start's path, in order."""
+        paths = []
+        for x in starts:
+            paths.append(self.path(x, paths))
+        return [p[-1] for p in paths]
 
 
 # -- leave-one-experiment-out refits ------------------------------------------------------------
@@ -348,7 +433,8 @@ def refit_without(task: LooTask) -> LooResult:
     lo, hi, sc = _bounds(task.params)
     s = task.problem.settings
     obj = Objective(pair, train, names, budget_s=task.budget_s,
-                    max_evals=s.evals_per_param * (len(names) + 1) // 3, backend=s.integrator)
+                    max_evals=s.evals_per_param * (len(names) + 1) // 3, backend=s.integrator,
+                    jacobian=s.jacobian)
     x0 = np.array([q.start for q in task.params])
     f = finish(obj, *refine_or_keep(obj, x0, lo, hi, sc, task.max_nfev, LOO_TOL), lo)
     r = weighted_residuals(pair, subset(ds, [task.held]), f.values, s.integrator)[0]

@@ -31,13 +31,14 @@ class Views:
     fingerprints: dict = field(default_factory=dict)
 
 
-def simulate_all(pair, ds, values):
-    """experiment -> result (None where the simulation fails)."""
+def simulate_all(pair, ds, values, backend=None):
+    """experiment -> result (None where the simulation fails); ``backend``:
+    the integrator (the fits' own, :attr:`.problem.FitSettings.integrator`)."""
     mf, cm = pair
     out = {}
     for e in ds.experiments:
         try:
-            out[e.name] = cm.simulate(params={**values, **e.conditions},
+            out[e.name] = cm.simulate(params={**values, **e.conditions}, backend=backend,
                                       **mf.experiment.run_options(dense=True))
         except AcausalError:
             out[e.name] = None
@@ -83,11 +84,12 @@ def views(problem, cal, ranking) -> Views:
     ds = dataset_of(problem)
     from .problem import NOMINAL
     f0 = cal.fit
-    sims0 = simulate_all(model_of(problem, NOMINAL), ds, f0.values)
+    backend = problem.settings.integrator
+    sims0 = simulate_all(model_of(problem, NOMINAL), ds, f0.values, backend)
     best = ranking.best
     sims1, raw1 = {}, {}
     if best is not None:
-        sims1 = simulate_all(model_of(problem, best.candidate), ds, best.fit.values)
+        sims1 = simulate_all(model_of(problem, best.candidate), ds, best.fit.values, backend)
         raw1 = raw_residuals(best.fit, ds)
     raw0 = raw_residuals(f0, ds)
     lib = load_library(problem.library)

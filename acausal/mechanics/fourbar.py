@@ -29,6 +29,7 @@ same configuration as ``|cos(lambda)| = 1`` in eq. 9: where the linkage stops
 closing. Along a closed linkage
 ``(r2 + r3) sin(theta2 + theta3) = mode * d * sin(lambda)``.
 """
+import functools
 import math
 
 import sympy as sp
@@ -72,6 +73,15 @@ class _Sym:
         # would see a singular Jacobian) so that a start that cannot close is
         # reported by the initialisation with the component's message
         return Min(Max(c, -1 + _CLIP), 1 - _CLIP)
+
+
+@functools.lru_cache(maxsize=64)
+def _guess_exprs(th1, e, f, r1, r2, r3, mode):
+    """(theta2, theta3) of :func:`_closed_form` in sympy, once per process for
+    the same symbols (building it costs about 0.1 s, and a diagnosis flattens
+    the same linkage in every hypothesis model it compiles)."""
+    th2, th3, _ = _closed_form(th1, e, f, r1, r2, r3, mode, _Sym)
+    return th2, th3
 
 
 def fourbar_angles(theta1, e=0.0002, f=0.125, r1=0.116, r2=0.036, r3=0.0533, mode=1):
@@ -180,9 +190,8 @@ class FourBar(Component):
 
     def _guess_expr(self, th1):
         """theta2, theta3 (sympy expressions of the parameters) at ``th1``."""
-        th2, th3, _ = _closed_form(sp.sympify(th1), self.e, self.f, self.r1, self.r2,
-                                   self.r3, self.mode, _Sym)
-        return th2, th3
+        return _guess_exprs(sp.sympify(th1), self.e, self.f, self.r1, self.r2, self.r3,
+                            self.mode)
 
     # -- law ---------------------------------------------------------------------
     def equations(self):

@@ -1,0 +1,177 @@
+"""Speed of ``acausal diagnose`` end to end on the breaker (issue #10's
+target: a 6-experiment breaker diagnosis in <= 20 s on 2 cores).
+
+The case is the slow tier's first blind case (tests/diagnose/test_diagnose.py
+SLOW_CASES[0]): hidden Coulomb friction at ``hook.body``, 8 noise floors,
+hook-angle and armature traces at six impact velocities, seed 100. The data
+are synthesized once into ``--data`` (kept between runs); the diagnosis
+then runs with everything the command line runs by default (families,
+pairs, located term, profiles, next experiment; no plots).
+
+Printed: the verdict, held-out errors, wall and CPU time (this process and
+its finished workers), the diagnosis's own stage times, the load average
+before and after, and -- with ``--serial`` -- the simulations and wall time
+per stage (counted in this process: every task runs here), optionally with
+a cProfile of the whole run (``--profile FILE``).
+
+    PYTHONPATH=. python benchmarks/diagnose_speed.py            # 2 workers
+    PYTHONPATH=. python benchmarks/diagnose_speed.py --serial --profile prof.txt
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import sys
+import tempfile
+import time
+from collections import Counter
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+BREAKER = os.path.join(ROOT, "models", "breaker_24kv.py")
+SETUP = dict(conditions={"v_impact": [3.3, 3.5, 3.8, 4.0, 4.2, 4.5]},
+             traces=["hook.phi", "armature.mass.s"], sample_rate=50e3,
+             noise={"hook.phi": 3e-4, "armature.mass.s": 1e-5},
+             resolution={"hook.phi": 3.5e-4, "armature.mass.s": 1e-5},
+             units={"time": "ms", "hook.phi": "deg", "armature.mass.s": "mm"})
+CASES = {  # name -> (hypothesis, location, effect [floors], seed): the slow tier's
+    "coulomb": ("coulomb_friction", "hook.body", 8.0, 100),
+    "damping_law": ("contact_damping_law", "contact", 8.0, 107),
+    "flexible": ("flexible_link", "hook.body:hook.arm3", 5.0, 105),
+    "null": (None, None, 0.0, 500),
+}
+
+
+def data_folder(case, root):
+    """The case's dataset (synthesized on first use); returns (folder, truth)."""
+    from acausal.diagnose.synth import synthesize
+    hyp, loc, effect, seed = CASES[case]
+    folder = os.path.join(root, f"breaker_{case}")
+    marker = os.path.join(folder, "truth.json")
+    if os.path.exists(marker):
+        with open(marker) as f:
+            return folder, json.load(f)
+    truth = synthesize(BREAKER, folder, hypothesis=hyp, location=loc,
+                       effect=None if hyp is None else (effect, effect), free_jitter=0.1,
+                       seed=seed, **SETUP)
+    with open(marker, "w") as f:
+        json.dump(truth.to_dict(), f, default=float)
+    return folder, truth.to_dict()
+
+
+class StageCounter:
+    """Simulations and wall time per diagnosis stage (serial runs only:
+    every task then runs in this process)."""
+
+    STAGES = {"stages": ("calibrate", "fit", "cross_validate"),
+              "run": ("fit_members", "locate", "intervals", "next_experiment")}
+
+    def __init__(self):
+        self.sims, self.wall, self.calls = Counter(), Counter(), Counter()
+        self.current = "load/other"
+
+    def install(self):
+        from acausal import compile as comp
+        from acausal.diagnose import run, stages
+        inner = comp.CompiledModel.simulate
+        me = self
+
+        def counted(cm, *a, **k):
+            me.sims[me.current] += 1
+            return inner(cm, *a, **k)
+        comp.CompiledModel.simulate = counted
+        for modname, names in self.STAGES.items():
+            mod = run if modname == "run" else stages
+            for name in names:
+                setattr(mod, name, self._wrap(name, getattr(mod, name)))
+
+    def _wrap(self, name, fn):
+        me = self
+
+        def wrapped(*a, **k):
+            me.calls[name] += 1
+            label = name if not (name == "fit" and me.calls[name] > 1) else "fit (pairs)"
+            before, me.current = me.current, label
+            t = time.perf_counter()
+            try:
+                return fn(*a, **k)
+            finally:
+                me.wall[label] += time.perf_counter() - t
+                me.current = before
+        return wrapped
+
+    def table(self):
+        rows = ["| stage | simulations | wall [s] |", "|---|---|---|"]
+        for k in list(dict.fromkeys(list(self.wall) + list(self.sims))):
+            rows.append(f"| {k} | {self.sims[k]} | {self.wall[k]:.1f} |")
+        rows.append(f"| total | {sum(self.sims.values())} | |")
+        return "\n".join(rows)
+
+
+def cpu_s():
+    me, ch = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return me.ru_utime + me.ru_stime + ch.ru_utime + ch.ru_stime
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--case", choices=sorted(CASES), default="coulomb")
+    ap.add_argument("--data", default=os.path.join(tempfile.gettempdir(), "acausal_dspeed"))
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--serial", action="store_true", help="run every task in this process "
+                    "(per-stage simulation counts)")
+    ap.add_argument("--profile", default=None, help="write a cProfile (cumulative) here")
+    ap.add_argument("--json", default=None, help="append the result as one JSON line here")
+    args = ap.parse_args(argv)
+    from acausal.diagnose.run import diagnose
+    folder, truth = data_folder(args.case, args.data)
+    counter = None
+    if args.serial:
+        counter = StageCounter()
+        counter.install()
+    prof = None
+    if args.profile:
+        import cProfile
+        prof = cProfile.Profile()
+    load0, c0, t0 = os.getloadavg(), cpu_s(), time.perf_counter()
+    with tempfile.TemporaryDirectory() as out:
+        if prof:
+            prof.enable()
+        res = diagnose(BREAKER, folder, out_dir=out, progress=False,
+                       workers=None if args.serial else args.workers,
+                       plots=False, scheduler="serial" if args.serial else None)
+        if prof:
+            prof.disable()
+        timing = json.loads(open(os.path.join(out, "candidates.json")).read())["timing"]
+    wall, cpu, load1 = time.perf_counter() - t0, cpu_s() - c0, os.getloadavg()
+    g = res["gain"]
+    line = dict(case=args.case, truth=[truth["hypothesis"], truth["location"]],
+                cause=res["cause"], location=res["location"],
+                heldout=[g["before"]["heldout"], g["after"]["heldout"]],
+                wall_s=wall, cpu_s=cpu, load_before=load0, load_after=load1,
+                serial=args.serial, timing=timing)
+    print(f"case {args.case}: truth {truth['hypothesis']} at {truth['location']}; named "
+          f"{res['cause']} at {res['location']}; held-out {g['before']['heldout']:.3f} -> "
+          f"{g['after']['heldout']:.3f}")
+    print(f"wall {wall:.1f} s, CPU {cpu:.1f} s, load {load0[0]:.1f} -> {load1[0]:.1f}")
+    print("diagnosis timing: " + ", ".join(f"{k} {v:.1f}" if isinstance(v, float) else
+                                           f"{k} {v}" for k, v in timing.items()))
+    if counter:
+        print(counter.table())
+        line["stages"] = {k: [counter.sims[k], counter.wall[k]] for k in counter.wall}
+    if prof:
+        import pstats
+        prof.dump_stats(args.profile + ".prof")
+        with open(args.profile, "w") as f:
+            st = pstats.Stats(prof, stream=f)
+            st.sort_stats("cumulative").print_stats(80)
+            st.sort_stats("tottime").print_stats(40)
+    if args.json:
+        with open(args.json, "a") as f:
+            f.write(json.dumps(line, default=float) + "\n")
+
+
+if __name__ == "__main__":
+    main()
