@@ -18,7 +18,9 @@ the located shape zigzags. Each direction of the weights whose effect on
 the data a free parameter reproduces (to ``PIN_TOL``), or that has no
 effect on the data (``NULL_TOL``), gets a stiff penalty row, so the term
 is fitted orthogonal to the free parameters' Jacobian columns and they
-keep what they can explain.
+keep what they can explain. The position and velocity parts' shared
+constant is pinned by construction: the velocity part carries no force at
+rest (:func:`at_rest_row`).
 """
 from __future__ import annotations
 
@@ -28,7 +30,7 @@ import numpy as np
 
 from . import stats as st
 from .fitting import heldout_rms
-from .generic import GENERIC, N_V, N_X, SMOOTH, penalty, shape
+from .generic import GENERIC, N_V, N_X, SMOOTH, hats, penalty, shape
 from .problem import Candidate, Param
 from .stages import fit_tasks, run_tasks
 from .tasks import dataset_of, fit_candidate, model_of
@@ -37,7 +39,8 @@ MARGIN = 10.0    # AICc units by which the generic term must beat the library
 PIN_TOL = 0.05   # a free parameter whose effect on the data the term reproduces to 5 %
                  # (relative residual of the least-squares match) is degenerate with it
 NULL_TOL = 1e-6  # directions of the weights with no effect on the data (singular value
-                 # relative to the largest): the position and velocity parts' shared constant
+                 # relative to the largest); the position and velocity parts' shared
+                 # constant is pinned by construction (at_rest_row)
 PIN_WEIGHT = 1e3  # pin rows' size relative to the term's largest singular value
 STEP = 1e-4      # finite-difference step (of each weight's / free parameter's scale)
 
@@ -153,9 +156,22 @@ def pin_rows(task):
         Jg = _columns(pair, ds, base, cand.params, p.settings.integrator)
         Jf = _columns(pair, ds, base, task.free, p.settings.integrator)
     except AcausalError:     # the fit reports the failure; nothing to pin
-        return np.zeros((0, len(cand.params)))
+        return np.zeros((0, len(cand.params))), 0.0
     Q, s0 = degenerate_directions(Jg, Jf)
-    return PIN_WEIGHT * s0 * Q
+    return PIN_WEIGHT * s0 * Q, s0
+
+
+def at_rest_row(ranges):
+    """The row that pins the velocity part's force at rest, f_v(0) = 0 (on
+    the weights over their scale, which is one for all of them): the
+    position and velocity parts share a constant, which this gives to the
+    position part. The data cannot tell them apart, but the finite-difference
+    Jacobian of an adaptive simulation only shows it to about 1e-3, above
+    ``NULL_TOL``. None when the velocity range does not reach 0."""
+    v_lo, v_hi = ranges[2], ranges[3]
+    if not v_lo <= 0.0 <= v_hi:
+        return None
+    return np.concatenate([np.zeros(N_X), hats(0.0, v_lo, v_hi, N_V)[0]])
 
 
 def _pinned(problem, cal, gens, ex, progress):
@@ -163,7 +179,10 @@ def _pinned(problem, cal, gens, ex, progress):
     import dataclasses
     tasks = fit_tasks(problem, cal, [g[0] for g in gens])
     out = []
-    for g, rows in zip(gens, run_tasks(ex, pin_rows, tasks, "pinning", progress)):
+    for g, (rows, s0) in zip(gens, run_tasks(ex, pin_rows, tasks, "pinning", progress)):
+        rest = at_rest_row(g[1])
+        if rest is not None and s0 > 0:
+            rows = np.vstack([rows, PIN_WEIGHT * s0 * rest / np.linalg.norm(rest)])
         P = np.vstack([np.asarray(g[0].penalty, float), rows])
         out.append((dataclasses.replace(g[0], penalty=P),) + tuple(g[1:]))
     return out

@@ -56,7 +56,8 @@ def velocity_shape_error(term, law, v_max):
     difference of the fitted part over that of the truth, on the knots."""
     import numpy as np
 
-    from acausal.diagnose.generic import GENERIC, N_V, shape
+    from acausal.diagnose import generic
+    GENERIC, N_V, shape = generic.GENERIC, generic.N_V, generic.shape
     sh = shape(term["values"], GENERIC.prefix, term["ranges"], n=401)
     v, fv = sh["v"], sh["f_v"]
     m = np.abs(v) <= v_max
