@@ -201,47 +201,28 @@ def pairs_needed(dec) -> bool:
     return bool(dec.discrepancy and dec.rows and dec.c_hat > st.OVERDISPERSION)
 
 
-def pair_candidates(problem: Problem, dec, top=PAIR_TOP) -> tuple:
+def pair_candidates(problem: Problem, dec, top=PAIR_TOP, ex=None) -> tuple:
     """Pairs among the ``top`` best tested single candidates (two
     hypotheses, or one at two sites: the second's sub-model renamed), each
     parameter seeded from its single fit (its neutral value kept as the
-    prior); and the best single with each of the ``PAIR_SCORED`` others
-    that best explain what it leaves (:func:`_complements`)."""
+    prior); with an executor ``ex``, also the best single with each of the
+    ``PAIR_SCORED`` others that best explain what it leaves
+    (:mod:`.pairscore`)."""
     if load_library(problem.library).build_pair is None:
         return ()
     tested = [r for r in dec.rows if "+" not in r.candidate.hypothesis and r.starts.tested]
     singles = tested[:top]
     ab = [(a, b) for i, a in enumerate(singles) for b in singles[i + 1:]]
-    if singles:
-        ab += [(singles[0], b) for b in _complements(singles[0], tested[top:])]
+    if singles and ex is not None:
+        from .pairscore import complements
+        ab += [(singles[0], b) for b in complements(problem, singles[0], tested[top:], ex,
+                                                    PAIR_SCORED, run_tasks)]
     return tuple(_pair(a, b) for a, b in ab
                  if not (a.candidate.location == b.candidate.location
                          and a.candidate.hypothesis == b.candidate.hypothesis))
 
 
 PAIR_SCORED = 2       # + pairs of the best single with this many score-test complements
-
-
-def _complements(best, rows, n=PAIR_SCORED) -> list:
-    """The ``n`` rows whose own parameters' Jacobian columns (at their
-    single fits), made orthogonal to the best fit's columns, reduce the
-    best fit's residuals most to first order (a score test): a second cause
-    that a free parameter half-absorbed in its single fit, or that alone
-    explains less than the rivals of the first, can still complete it."""
-    f = best.fit
-    Q = np.linalg.qr(f.jacobian)[0] if f.jacobian.size else np.zeros((f.n, 0))
-    gains = []
-    for r in rows:
-        own = [r.fit.names.index(p) for p in r.own if p in r.fit.names]
-        if not own or r.fit.residuals.shape != f.residuals.shape:
-            continue
-        J = r.fit.jacobian[:, own]
-        J = J - Q @ (Q.T @ J)
-        if not np.all(np.isfinite(J)) or np.linalg.norm(J) == 0:
-            continue
-        U = np.linalg.svd(J, full_matrices=False)[0]
-        gains.append((float(np.sum((U.T @ f.residuals) ** 2)), r))
-    return [r for _, r in sorted(gains, key=lambda g: -g[0])[:n]]
 
 
 def _pair(a, b) -> Candidate:
