@@ -25,8 +25,14 @@ from .domain import domain_of
 from .hypotheses import Hypothesis, build_extended
 
 N_X = 9          # knots in position (a feature of 1/8 of the range is resolved)
-N_V = 9          # knots in velocity (with 5, a torque that sets in above a speed
-                 # was no better fitted than quadratic drag: docs/diagnosis.md)
+N_V = 17         # knots in velocity. With 5, a torque that sets in above a speed was no
+                 # better fitted than quadratic drag (docs/diagnosis.md). With 9 (knots
+                 # 7.3 rad/s apart on the torsion rig) its law, which bends at 10 and 20
+                 # rad/s, was not representable: the best 9-knot term zigzagged between
+                 # knots to match the energy lost per cycle (data cost 1.6 n, shape 84 %
+                 # RMS off the truth's net of its linear part); with 17 the same fit
+                 # reaches the noise (1.02 n) and the shape is 13 % off
+                 # (tests/diagnose/test_blind_rig.py).
 SMOOTH = 1.0     # penalty weight on second differences, per data value: a second
                  # difference of one typical force/3 (the weights' scale) costs as much
                  # as every value missing by one noise floor. With a weight of 1 in all

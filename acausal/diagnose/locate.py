@@ -7,6 +7,20 @@ misfit (by AICc, with its held-out error) locates the discrepancy.
 The verdict "not explained by the library" needs: the best generic term
 beats the best library candidate by more than ``MARGIN`` AICc units and by
 held-out error, and it reaches closer to the instrument floor.
+
+Degenerate directions are pinned before the fit (:func:`pin_rows`): the
+spline reproduces constants and straight lines exactly, so its constant
+and linear parts can do what a free parameter acting at the node does (a
+spring's stiffness, a damper's coefficient), and its position and
+velocity parts share one constant. Fitted with the free parameters, those
+directions are undetermined: the fit trades them off, converges slowly and
+the located shape zigzags. Each direction of the weights whose effect on
+the data a free parameter reproduces (to ``PIN_TOL``), or that has no
+effect on the data (``NULL_TOL``), gets a stiff penalty row, so the term
+is fitted orthogonal to the free parameters' Jacobian columns and they
+keep what they can explain. The position and velocity parts' shared
+constant is pinned by construction: the velocity part carries no force at
+rest (:func:`at_rest_row`).
 """
 from __future__ import annotations
 
@@ -16,12 +30,19 @@ import numpy as np
 
 from . import stats as st
 from .fitting import heldout_rms
-from .generic import GENERIC, N_V, N_X, SMOOTH, penalty, shape
+from .generic import GENERIC, N_V, N_X, SMOOTH, hats, penalty, shape
 from .problem import Candidate, Param
 from .stages import fit_tasks, run_tasks
-from .tasks import fit_candidate
+from .tasks import dataset_of, fit_candidate, model_of
 
 MARGIN = 10.0    # AICc units by which the generic term must beat the library
+PIN_TOL = 0.05   # a free parameter whose effect on the data the term reproduces to 5 %
+                 # (relative residual of the least-squares match) is degenerate with it
+NULL_TOL = 1e-6  # directions of the weights with no effect on the data (singular value
+                 # relative to the largest); the position and velocity parts' shared
+                 # constant is pinned by construction (at_rest_row)
+PIN_WEIGHT = 1e3  # pin rows' size relative to the term's largest singular value
+STEP = 1e-4      # finite-difference step (of each weight's / free parameter's scale)
 
 
 @dataclass
@@ -87,6 +108,86 @@ def _one_start(problem):
     return dataclasses.replace(problem, settings=s)
 
 
+def _columns(pair, ds, base, params, backend):
+    """Forward-difference data Jacobian columns of ``params`` (per unit of
+    each one's scale) at ``base``."""
+    from .fitting import weighted_residuals
+    r0 = weighted_residuals(pair, ds, base, backend)[0]
+    cols = []
+    for q in params:
+        h = STEP * (abs(q.scale) or 1.0)
+        r = weighted_residuals(pair, ds, {**base, q.name: base[q.name] + h}, backend)[0]
+        cols.append((r - r0) / STEP)
+    return np.array(cols).T
+
+
+def degenerate_directions(Jg, Jf):
+    """Orthonormal rows (in the term's scaled weights) of the directions the
+    data cannot tell apart: the (near) null space of ``Jg`` and, for each
+    free parameter's column of ``Jf`` that the term reproduces to
+    ``PIN_TOL``, the least-squares weights that reproduce it."""
+    from scipy.linalg import orth
+    _, s, Vt = np.linalg.svd(Jg, full_matrices=False)
+    if s.size == 0 or s[0] == 0:
+        return np.zeros((0, Jg.shape[1])), 0.0
+    dirs = [Vt[i] for i in range(s.size) if s[i] < NULL_TOL * s[0]]
+    for j in np.asarray(Jf).T:
+        nj = np.linalg.norm(j)
+        if nj == 0:
+            continue
+        w = np.linalg.lstsq(Jg, j, rcond=NULL_TOL)[0]
+        if np.linalg.norm(Jg @ w - j) < PIN_TOL * nj and np.linalg.norm(w) > 0:
+            dirs.append(w / np.linalg.norm(w))
+    if not dirs:
+        return np.zeros((0, Jg.shape[1])), float(s[0])
+    return orth(np.array(dirs).T).T, float(s[0])
+
+
+def pin_rows(task):
+    """Penalty rows pinning the generic term's degenerate directions (module
+    doc) at the calibrated free parameters and zero weights: the term's
+    and the free parameters' data Jacobians by forward differences, one
+    simulation of every experiment per column."""
+    from ..errors import AcausalError
+    p, cand = task.problem, task.candidate
+    base = {**{q.name: q.start for q in task.free}, **{q.name: q.start for q in cand.params}}
+    try:
+        ds, pair = dataset_of(p), model_of(p, cand)
+        Jg = _columns(pair, ds, base, cand.params, p.settings.integrator)
+        Jf = _columns(pair, ds, base, task.free, p.settings.integrator)
+    except AcausalError:     # the fit reports the failure; nothing to pin
+        return np.zeros((0, len(cand.params))), 0.0
+    Q, s0 = degenerate_directions(Jg, Jf)
+    return PIN_WEIGHT * s0 * Q, s0
+
+
+def at_rest_row(ranges):
+    """The row that pins the velocity part's force at rest, f_v(0) = 0 (on
+    the weights over their scale, which is one for all of them): the
+    position and velocity parts share a constant, which this gives to the
+    position part. The data cannot tell them apart, but the finite-difference
+    Jacobian of an adaptive simulation only shows it to about 1e-3, above
+    ``NULL_TOL``. None when the velocity range does not reach 0."""
+    v_lo, v_hi = ranges[2], ranges[3]
+    if not v_lo <= 0.0 <= v_hi:
+        return None
+    return np.concatenate([np.zeros(N_X), hats(0.0, v_lo, v_hi, N_V)[0]])
+
+
+def _pinned(problem, cal, gens, ex, progress):
+    """The generic candidates with their degenerate directions pinned."""
+    import dataclasses
+    tasks = fit_tasks(problem, cal, [g[0] for g in gens])
+    out = []
+    for g, (rows, s0) in zip(gens, run_tasks(ex, pin_rows, tasks, "pinning", progress)):
+        rest = at_rest_row(g[1])
+        if rest is not None and s0 > 0:
+            rows = np.vstack([rows, PIN_WEIGHT * s0 * rest / np.linalg.norm(rest)])
+        P = np.vstack([np.asarray(g[0].penalty, float), rows])
+        out.append((dataclasses.replace(g[0], penalty=P),) + tuple(g[1:]))
+    return out
+
+
 def _term(r, n, c_hat, ranges, members):
     f = r.fit
     return Term(r.candidate.location, members, f.cost, st.aicc(f.cost, n, f.k, c_hat),
@@ -103,6 +204,7 @@ def locate(problem, cal, dec, rk, ex, progress=True, collect=None) -> Location:
     gens = generic_candidates(problem, cal.fit.n)
     if not gens:
         return Location(skipped="the model has no body node")
+    gens = _pinned(problem, cal, gens, ex, progress)
     tasks = fit_tasks(_one_start(problem), cal, [g[0] for g in gens])
     results = run_tasks(ex, fit_candidate, tasks, "locating", progress, collect)
     n = cal.fit.n

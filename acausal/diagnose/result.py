@@ -178,7 +178,8 @@ def details(d: Diagnosis) -> dict:
                      error=r.error or (r.fit.message if r.fit is not None else ""))
                 for r in dec.failed],
         located=[dict(node=t.node, members=list(t.members), S=num(t.S), aicc=num(t.aicc),
-                      heldout_rmse=num(t.heldout_rmse), values=t.values)
+                      heldout_rmse=num(t.heldout_rmse), values=t.values,
+                      ranges=list(t.ranges))
                  for t in (d.location.terms if d.location is not None else ())],
         decision=dec.decision, overdispersion=dec.c_hat, weak_evidence=rk.weak,
         timing=d.timing)

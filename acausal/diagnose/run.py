@@ -62,7 +62,7 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
             fits += members
             dec = stages.decide(ds, cal, fits, alpha)
         if pairs and stages.pairs_needed(dec):
-            fits += stages.fit(problem, cal, stages.pair_candidates(problem, dec), ex,
+            fits += stages.fit(problem, cal, stages.pair_candidates(problem, dec, ex=ex), ex,
                                progress, collect)
             dec = stages.decide(ds, cal, fits, alpha)
         cv = stages.cross_validate(problem, ds, cal, dec, ex, exact_cv, progress)

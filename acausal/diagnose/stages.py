@@ -201,27 +201,37 @@ def pairs_needed(dec) -> bool:
     return bool(dec.discrepancy and dec.rows and dec.c_hat > st.OVERDISPERSION)
 
 
-def pair_candidates(problem: Problem, dec, top=PAIR_TOP) -> tuple:
+def pair_candidates(problem: Problem, dec, top=PAIR_TOP, ex=None) -> tuple:
     """Pairs among the ``top`` best tested single candidates (two
     hypotheses, or one at two sites: the second's sub-model renamed), each
     parameter seeded from its single fit (its neutral value kept as the
-    prior)."""
+    prior); with an executor ``ex``, also the best single with each of the
+    ``PAIR_SCORED`` others that best explain what it leaves
+    (:mod:`.pairscore`)."""
     if load_library(problem.library).build_pair is None:
         return ()
-    singles = [r for r in dec.rows if "+" not in r.candidate.hypothesis
-               and r.starts.tested][:top]
-    out = []
-    for i, a in enumerate(singles):
-        for b in singles[i + 1:]:
-            ca, cb = a.candidate, b.candidate
-            if ca.location == cb.location and ca.hypothesis == cb.hypothesis:
-                continue
-            first = {p.name.split(".")[0] for p in ca.params}
-            params = tuple(p.moved(a.fit.values[p.name]) for p in ca.params) + tuple(
-                _renamed(p, first).moved(b.fit.values[p.name]) for p in cb.params)
-            out.append(Candidate(f"{ca.hypothesis}+{cb.hypothesis}",
-                                 f"{ca.location}+{cb.location}", params))
-    return tuple(out)
+    tested = [r for r in dec.rows if "+" not in r.candidate.hypothesis and r.starts.tested]
+    singles = tested[:top]
+    ab = [(a, b) for i, a in enumerate(singles) for b in singles[i + 1:]]
+    if singles and ex is not None:
+        from .pairscore import complements
+        ab += [(singles[0], b) for b in complements(problem, singles[0], tested[top:], ex,
+                                                    PAIR_SCORED, run_tasks)]
+    return tuple(_pair(a, b) for a, b in ab
+                 if not (a.candidate.location == b.candidate.location
+                         and a.candidate.hypothesis == b.candidate.hypothesis))
+
+
+PAIR_SCORED = 2       # + pairs of the best single with this many score-test complements
+
+
+def _pair(a, b) -> Candidate:
+    ca, cb = a.candidate, b.candidate
+    first = {p.name.split(".")[0] for p in ca.params}
+    params = tuple(p.moved(a.fit.values[p.name]) for p in ca.params) + tuple(
+        _renamed(p, first).moved(b.fit.values[p.name]) for p in cb.params)
+    return Candidate(f"{ca.hypothesis}+{cb.hypothesis}", f"{ca.location}+{cb.location}",
+                     params)
 
 
 def _renamed(p: Param, first) -> Param:

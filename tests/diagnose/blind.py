@@ -44,3 +44,33 @@ def named(out):
 def values(out):
     """{parameter: fitted value} over the named causes."""
     return {k: v["value"] for c in out["causes"] for k, v in c["parameters"].items()}
+
+
+def velocity_shape_error(term, law, v_max):
+    """How far the located term's velocity part is from the truth's extra
+    force ``law(v)`` (the force the truth adds on the body, along +s):
+    (relative RMS error, roughness ratio) over |v| <= v_max. Both are
+    compared after removing their least-squares constant and linear parts,
+    which the free parameters (a damper's coefficient) and the position
+    part's constant share with the term. Roughness: the RMS second
+    difference of the fitted part over that of the truth, on the knots."""
+    import numpy as np
+
+    from acausal.diagnose import generic
+    GENERIC, N_V, shape = generic.GENERIC, generic.N_V, generic.shape
+    sh = shape(term["values"], GENERIC.prefix, term["ranges"], n=401)
+    v, fv = sh["v"], sh["f_v"]
+    m = np.abs(v) <= v_max
+    v, fv = v[m], fv[m]
+    truth = np.array([law(x) for x in v])
+    A = np.vstack([np.ones_like(v), v]).T
+
+    def detrend(y):
+        return y - A @ np.linalg.lstsq(A, y, rcond=None)[0]
+    a, b = detrend(fv), detrend(truth)
+    err = float(np.sqrt(np.mean((a - b) ** 2)) / np.sqrt(np.mean(b ** 2)))
+    knots = np.linspace(term["ranges"][2], term["ranges"][3], N_V)
+    bw = np.array([term["values"][f"{GENERIC.prefix}.b{j}"] for j in range(N_V)])
+    tw = np.array([law(x) for x in knots])
+    rough = float(np.sqrt(np.mean(np.diff(bw, 2) ** 2)) / np.sqrt(np.mean(np.diff(tw, 2) ** 2)))
+    return err, rough
