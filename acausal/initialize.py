@@ -44,67 +44,81 @@ def initial_point(cm, p, d, cb, t0, starts=None):
             raise
 
 
-def _solve_initial(cm, p, d, cb, t0, starts=None):
-    """initial_point without the diagnosis of its failure."""
-    dae = cm.dae
-    n, ns = len(dae.y), dae.n_states
-    fixed = cm.fixed_starts(p, starts)   # list of (var index, value, name)
-    y0 = cm.guess_vector(p, starts)
-    # start Newton at the fixed start values of the states (a fixed velocity
-    # is the value of the slot der(x), which the guess vector leaves at 0): a
-    # steep law near 0 (regularised friction) can stall it far from them
-    _snap_fixed_states(cm, y0, fixed)
-    res_fn, observe = cb[0], cb[4]
-    sparse = n + ns >= SPARSE_MIN
-    fixed_jac = cm.fixed_jacobian(sparse=sparse)
-    r = np.zeros(n)
+class _InitialSystem:
+    """The initial equations at ``t0``: the residuals, one row per fixed
+    start value and one per imposed guess, over z = (y, y' of the states);
+    dense, or sparse from :data:`SPARSE_MIN` unknowns."""
 
-    def split(z):
-        y = z[:n]
-        yp = np.zeros(n)
-        yp[:ns] = z[n:]
+    def __init__(self, cm, p, d, cb, t0, starts):
+        self.cm, self.p, self.d, self.cb, self.t0 = cm, p, d, cb, t0
+        self.n, self.ns = len(cm.dae.y), cm.dae.n_states
+        self.fixed = cm.fixed_starts(p, starts)   # list of (var index, value, name)
+        y0 = cm.guess_vector(p, starts)
+        # start Newton at the fixed start values of the states (a fixed velocity
+        # is the value of the slot der(x), which the guess vector leaves at 0): a
+        # steep law near 0 (regularised friction) can stall it far from them
+        _snap_fixed_states(cm, y0, self.fixed)
+        self.z0 = np.concatenate([y0, np.zeros(self.ns)])
+        self.sparse = self.n + self.ns >= SPARSE_MIN
+        self.fixed_jac = cm.fixed_jacobian(sparse=self.sparse)
+        self.r = np.zeros(self.n)
+
+    def split(self, z):
+        y = z[:self.n]
+        yp = np.zeros(self.n)
+        yp[:self.ns] = z[self.n:]
         return y, yp
 
-    def residual(z, guess_rows):
-        y, yp = split(z)
-        res_fn(t0, y, yp, r)
-        o = observe(t0, y, yp)
-        f = [o[k] - v for k, v, _ in fixed]
-        gz = [z[k] - z0[k] for k in guess_rows]
-        return np.concatenate([r, f, gz])
+    def residual(self, z, guess_rows=()):
+        y, yp = self.split(z)
+        self.cb[0](self.t0, y, yp, self.r)
+        o = self.cb[4](self.t0, y, yp)
+        f = [o[k] - v for k, v, _ in self.fixed]
+        gz = [z[k] - self.z0[k] for k in guess_rows]
+        return np.concatenate([self.r, f, gz])
 
-    def jac(z, guess_rows):
-        y, yp = split(z)
-        F = fixed_jac(t0, *y, *yp, *p, *d) if fixed else None
-        return _initial_jacobian(cb, t0, y, yp, ns, F, guess_rows, sparse)
+    def jac(self, z, guess_rows=()):
+        y, yp = self.split(z)
+        F = self.fixed_jac(self.t0, *y, *yp, *self.p, *self.d) if self.fixed else None
+        return _initial_jacobian(self.cb, self.t0, y, yp, self.ns, F, guess_rows, self.sparse)
 
-    z0 = np.concatenate([y0, np.zeros(ns)])
-    guess_rows = _choose_guesses(jac(z0, []), ns, cm.state_guess_order())
+    def check(self, z):
+        """:func:`_check` of the point ``z`` (an InitializationError naming
+        what it violates)."""
+        _check(self.cm, self.residual(z), self.jac(z), z, self.fixed, self.n)
+
+    def consistent(self, z):
+        return _consistent(self.cm, self.residual(z), self.jac(z), z, self.fixed, self.n)
+
+
+def _solve_initial(cm, p, d, cb, t0, starts=None):
+    """initial_point without the diagnosis of its failure."""
+    sys_ = _InitialSystem(cm, p, d, cb, t0, starts)
+    z0 = sys_.z0
+    guess_rows = _choose_guesses(sys_.jac(z0), sys_.ns, cm.state_guess_order())
     # Newton from the guesses first: it converges to the solution nearest to
     # them (e.g. the assembly mode of a linkage its guesses describe). The
     # trust-region least squares is the fallback; its long steps (in
     # variables with small Jacobian columns, such as lengths in m) can reach
     # another solution.
-    z, checked = _first_newton(cb, t0, z0, guess_rows, fixed, residual, jac,
-                               lambda zz: _consistent(cm, residual(zz, []), jac(zz, []), zz,
-                                                      fixed, n))
+    z, checked = _first_newton(cb, t0, z0, guess_rows, sys_.fixed, sys_.residual, sys_.jac,
+                               sys_.consistent)
     if not checked:
-        sol = least_squares(residual, z0, jac=jac, args=(guess_rows,), method="trf",
-                            xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=200,
-                            x_scale="jac")
-        z = sol.x
-    y, yp = split(z)
+        z = least_squares(sys_.residual, z0, jac=sys_.jac, args=(guess_rows,), method="trf",
+                          xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=200,
+                          x_scale="jac").x
+    y, yp = sys_.split(z)
     violated = _violated_assertion(cm, cb, t0, y, yp)
     try:
         if not checked:   # (Newton's point has just passed this same check)
-            _check(cm, residual(z, []), jac(z, []), z, fixed, n)
+            sys_.check(z)
     except InitializationError as exc:
         if violated:
             raise InitializationError(f"{violated}; {exc}") from None
         raise
     if violated:
         raise InitializationError(violated)
-    _snap_fixed_states(cm, y, fixed)
+    _snap_fixed_states(cm, y, sys_.fixed)
     # least squares meets a fixed start only to ~1e-16 and leaves round-off
     # (1e-30) in unknowns that are exactly zero: impose the fixed states
     # exactly (a body that starts at rest must be exactly at rest) and
@@ -112,8 +126,7 @@ def _solve_initial(cm, p, d, cb, t0, starts=None):
     # its floor, so that a stuck friction mode (der(v) = 0) integrates an
     # exact zero and holds v = 0 exactly, not at 1e-78
     y, yp = reinitialize(cm, cb, t0, y, yp)
-    z = np.concatenate([y, yp[:ns]])
-    _check(cm, residual(z, []), jac(z, []), z, fixed, n)
+    sys_.check(np.concatenate([y, yp[:sys_.ns]]))
     return y, yp    # reinitialize has filled the algebraic rates
 
 
