@@ -29,6 +29,9 @@ class DAE:
     residuals: list    # sympy expressions, one per y slot
     origins: list      # Equation object (or description) per residual
     explicit: dict     # eliminated algebraic symbol -> expression of y/yp symbols
+    # per residual, the y slots its Jacobian row is taken over (None: all):
+    # a sensitivity model's iteration matrix keeps only its diagonal blocks
+    jacobian_columns: tuple = None
 
 
 def build_dae(g, dummies, params, values=None):

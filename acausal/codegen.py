@@ -265,17 +265,19 @@ class Sparsity:
                               shape=(self.n, self.n))
 
 
-def _jacobian_entries(res, ysyms, ypsyms):
+def _jacobian_entries(res, ysyms, ypsyms, columns=None):
     """Non-zero entries (i, j, dF_i/dy_j, dF_i/dy'_j) of the residuals'
     Jacobians, by differentiating each residual only with respect to the
-    unknowns it contains (work linear in the number of non-zeros). The last
-    few are kept: the C generator (:mod:`acausal.codegen_c`) asks again for
-    the same residuals right after this module."""
-    return list(_entries(tuple(res), tuple(ysyms), tuple(ypsyms)))
+    unknowns it contains (work linear in the number of non-zeros), and,
+    with ``columns`` (:attr:`acausal.causalize.DAE.jacobian_columns`), only
+    over the slots ``columns[i]`` of row ``i``. The last few are kept: the C
+    generator (:mod:`acausal.codegen_c`) asks again for the same residuals
+    right after this module."""
+    return list(_entries(tuple(res), tuple(ysyms), tuple(ypsyms), columns))
 
 
 @functools.lru_cache(maxsize=4)
-def _entries(res, ysyms, ypsyms):
+def _entries(res, ysyms, ypsyms, columns):
     index = {s: ("y", j) for j, s in enumerate(ysyms)}
     index.update({s: ("yp", j) for j, s in enumerate(ypsyms) if s is not None})
     out = []
@@ -283,7 +285,7 @@ def _entries(res, ysyms, ypsyms):
         cols = {}
         for s in r.free_symbols:
             hit = index.get(s)
-            if hit is not None:
+            if hit is not None and (columns is None or hit[1] in columns[i]):
                 cols.setdefault(hit[1], {})[hit[0]] = diff(r, s)
         for j in sorted(cols):
             dy = cols[j].get("y", sp.S.Zero)
@@ -345,7 +347,7 @@ def generate(dae, params, discretes, roots, observed, fixed_rows=()):
     ysyms = [_real(f"y{i}") for i in range(n)]
     ypsyms = [_real(f"yp{i}") if dae.yp[i] is not None else None for i in range(n)]
     cj = sp.Symbol("cj")
-    entries = _jacobian_entries(res, ysyms, ypsyms)
+    entries = _jacobian_entries(res, ysyms, ypsyms, dae.jacobian_columns)
     sparsity = _sparsity(n, entries)
     jy = [(i, j, dy) for i, j, dy, _ in entries if dy != 0]
     jyp = [(i, j, dyp) for i, j, _, dyp in entries if dyp != 0]

@@ -72,14 +72,14 @@ def _function(name, extra_args, decl, body):
     return [head, "{", "  (void)t; (void)y; (void)yp; (void)pd;"] + decl + body + ["}", ""]
 
 
-def _jacs_entries(res, ysyms, ypsyms, n):
+def _jacs_entries(res, ysyms, ypsyms, n, columns=None):
     """(expressions, targets) of ``dF/dy`` and ``dF/dy'`` as two row-major
     ``n`` x ``n`` arrays (what the Python ``jacs`` callback fills): the
     initialisation and the re-initialisation at events need them apart.
     The entries are the iteration matrix's (:func:`~acausal.codegen._jacobian_entries`,
     cached: no second differentiation)."""
     exprs, targets = [], []
-    for i, j, dy, dyp in _jacobian_entries(res, ysyms, ypsyms):
+    for i, j, dy, dyp in _jacobian_entries(res, ysyms, ypsyms, columns):
         if dy != 0:
             exprs.append(dy)
             targets.append(f"Jy[{i * n + j}]")
@@ -146,7 +146,8 @@ def generate_c(cm):
               for i in range(n)]
     cj = sp.Symbol("cj", real=True)
     jac, targets = [], []
-    for i, j, dy, dyp in _jacobian_entries(res, ysyms, ypsyms):
+    columns = dae.jacobian_columns
+    for i, j, dy, dyp in _jacobian_entries(res, ysyms, ypsyms, columns):
         jac.append(dy + cj * dyp)
         targets.append(f"J[{j * n + i}]")
     decl = _decls(n, has_yp) + _pd_decls(len(cm.param_syms), len(cm.disc_syms))
@@ -162,5 +163,5 @@ def generate_c(cm):
     L += _function("acs_jacs", ", double* Jy, double* Jyp", decl,
                    [f"  memset(Jy, 0, sizeof(double) * {n * n});",
                     f"  memset(Jyp, 0, sizeof(double) * {n * n});"]
-                   + _body(*_jacs_entries(res, ysyms, ypsyms, n)))
+                   + _body(*_jacs_entries(res, ysyms, ypsyms, n, columns)))
     return CSource("\n".join(L), n, len(g), len(cm.param_syms) + len(cm.disc_syms))

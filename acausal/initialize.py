@@ -478,9 +478,8 @@ def _reinitialize(cm, cb, t, y, yp):
     return y, _algebraic_rates(cm, cb, t, y, yp)
 
 
-def _algebraic_rates(cm, cb, t, y, yp, solve=None):
-    """Fill y' of the algebraic slots with their true rates (``solve(J, b)``:
-    the linear solve, :func:`_solve_square` unless a caller knows better).
+def _algebraic_rates(cm, cb, t, y, yp):
+    """Fill y' of the algebraic slots with their true rates.
 
     IDA keeps every component, algebraic ones too, in its BDF history and
     error test; an algebraic unknown that moves (a holding force under a
@@ -505,7 +504,7 @@ def _algebraic_rates(cm, cb, t, y, yp, solve=None):
     if count is not None:   # these are not solver step attempts
         count[:] = saved
     rhs = -((rp - rm) / (2 * dt) + Jy_states @ yp[:ns])
-    sol = (solve or _solve_square)(J, rhs)
+    sol = _solve_square(J, rhs)
     if np.all(np.isfinite(sol)):
         yp[ns:] = sol[:n - ns]
     return yp

@@ -116,9 +116,12 @@ class SensitivityModel:
         yp_all = list(dae.yp) + [s for j in range(m) for s in Sp[j]]
         res_all = list(dae.residuals) + [rows[i][j] for j in range(m) for i in range(n)]
         org_all = list(dae.origins) + [dae.origins[i] for j in range(m) for i in range(n)]
+        block = self.order // n                   # block of each augmented position
+        same = [tuple(np.flatnonzero(block == b).tolist()) for b in range(m + 1)]
         self.dae = DAE([y_all[k] for k in self.order], [yp_all[k] for k in self.order],
                        ns * (1 + m), [res_all[k] for k in self.order],
-                       [org_all[k] for k in self.order], dae.explicit)
+                       [org_all[k] for k in self.order], dae.explicit,
+                       tuple(frozenset(same[b]) for b in block))
         self.disc_syms = list(cm.disc_syms) + self._sd_syms
         roots = [cm.resolve(e.expr) for e in cm.events] + \
             [cm.resolve(a.expr) for a in cm.assertions]
@@ -136,8 +139,19 @@ class SensitivityModel:
 
     def _generate(self, lin, roots):
         """The augmented system's generated callbacks (:func:`acausal.codegen.generate`):
-        its residuals, exact Jacobian, the base roots and the observed
-        variables followed by their sensitivities."""
+        its residuals, the diagonal blocks of its Jacobian (see below), the
+        base roots and the observed variables followed by their
+        sensitivities.
+
+        The iteration matrix keeps only the diagonal blocks: each is the base
+        model's (``F_y + cj F_y'``), and the blocks coupling a parameter's
+        rows to the base unknowns (second derivatives of the residuals,
+        most of the generation's work) are left out, as IDAS's simultaneous
+        corrector does: Newton's error in the sensitivities then vanishes
+        one iteration after the base unknowns' (the neglected part is
+        nilpotent), and the sensitivities are those of the exact equations.
+        Where the coupling is needed (the algebraic rates after an event),
+        it is a directional difference (:meth:`SensRun.rates`)."""
         return generate(self.dae, self.base.param_syms, self.disc_syms, roots,
                         self.observed_exprs())
 
@@ -176,24 +190,27 @@ class SensitivityModel:
         variables, then their sensitivities per parameter."""
         return len(self.base.var_names) * (1 + self.m)
 
-    def block_solve(self, J, b):
-        """``J x = b`` for the augmented system's re-initialisation matrix
-        ``J`` (:func:`acausal.initialize._event_matrix`): block lower
-        triangular, each parameter's block depending only on its own
-        sensitivities and the base unknowns, with the base matrix on the
-        diagonal. One LU of the base block and forward substitution; a
-        dense solve of the whole is as exact in theory, but its pivoting
-        mixes blocks of very different scales (d/dp of a 1e-4 kg m^2
-        inertia) and loses all accuracy (rcond 1e-16 on the breaker)."""
+    def block_solve(self, J, b, coupling):
+        """``A x = b`` for the augmented system's re-initialisation matrix
+        ``A``, block lower triangular: each parameter's block depends only
+        on its own sensitivities and the base unknowns, with the base
+        matrix on the diagonal. ``J``: its diagonal blocks (the generated
+        Jacobian, :func:`acausal.initialize._event_matrix`);
+        ``coupling(x0)``: the off-diagonal blocks times the base block's
+        solution ``x0`` (rows of the whole vector). One solve of the base
+        block per block and forward substitution: a dense solve of the
+        whole would also mix blocks of very different scales (d/dp of a
+        1e-4 kg m^2 inertia; rcond 1e-16 on the breaker)."""
         from .initialize import _solve_square
-        if not isinstance(J, np.ndarray):
-            return _solve_square(J, b)      # sparse (large models): one solve
         rows, cols = self._event_blocks()
+        if not isinstance(J, np.ndarray):
+            J = J.toarray()
         x = np.empty_like(b)
         x0 = _solve_square(J[np.ix_(rows[0], cols[0])], b[rows[0]])
         x[cols[0]] = x0
+        c0 = coupling(x0)
         for r, c in zip(rows[1:], cols[1:]):
-            x[c] = _solve_square(J[np.ix_(r, c)], b[r] - J[np.ix_(r, cols[0])] @ x0)
+            x[c] = _solve_square(J[np.ix_(r, c)], b[r] - c0[r])
         return x
 
     def _event_blocks(self):
@@ -400,7 +417,7 @@ class SensRun:
         linear in ``(s_alg, s'_states)`` with the base iteration matrix, in
         one solve; with ``rates``, y' of every algebraic slot as
         :func:`acausal.initialize._algebraic_rates` gives it."""
-        from .initialize import _algebraic_rates, _jacobians, reinitialize
+        from .initialize import _jacobians, reinitialize
         sm, cm = self.sm, self.sm.base
         n, ns = sm.n, sm.ns
         cb = self.serve(cm, d_aug[:len(cm.disc_syms)])
@@ -423,8 +440,54 @@ class SensRun:
         Sp[:, :ns] = X[n - ns:].T
         Y, YP = sm.pack(y, S), sm.pack(yp, Sp)
         if rates:
-            YP = _algebraic_rates(sm, cba, t, Y, YP, sm.block_solve)
+            YP = self.rates(cba, t, Y, YP)
         return Y, YP
+
+    def rates(self, cb, t, Y, YP):
+        """``YP`` with y' of every algebraic slot of the augmented system
+        (callbacks ``cb``), as :func:`acausal.initialize._algebraic_rates`
+        gives it: ``J x = -(F_t + F_y(states) y'_states)`` for x = (y' of the
+        algebraic slots, y'' of the states), solved by blocks with the base
+        model's matrix ``J0`` (:meth:`SensitivityModel.block_solve`). The
+        right side, and the coupling of each parameter's rows to the base
+        block's solution, are directional central differences of the
+        augmented residual (the generated Jacobian has only the diagonal
+        blocks)."""
+        from .initialize import _event_matrix
+        sm = self.sm
+        N, nsa = len(sm.dae.y), sm.ns * (1 + sm.m)
+        if N == nsa:
+            return YP
+        Y, YP = np.asarray(Y, float), np.array(YP, dtype=float)
+        J, _ = _event_matrix(cb, t, Y, YP, nsa)
+        move = np.zeros(N)
+        move[:nsa] = YP[:nsa]
+        dt = 1e-6 * max(1.0, abs(t))
+        count = cb[5] if len(cb) > 5 else None
+        saved = list(count) if count is not None else None
+        rhs = -_central(lambda h: _residual(cb, t + h, Y + h * move, YP), dt)
+        x = sm.block_solve(J, rhs, lambda x0: self._coupling(cb, t, Y, YP, x0))
+        if count is not None:   # these are not solver step attempts
+            count[:] = saved
+        if np.all(np.isfinite(x)):
+            YP[nsa:] = x[:N - nsa]
+        return YP
+
+    def _coupling(self, cb, t, Y, YP, x0):
+        """(rows of the parameters' blocks) the augmented residual's
+        derivative along the base block's unknowns moved by ``x0`` (its
+        re-initialisation columns: the algebraic slots' y, the states' y')."""
+        sm = self.sm
+        N, nsa = len(sm.dae.y), sm.ns * (1 + sm.m)
+        rows, cols = sm._event_blocks()
+        v = np.zeros(N)                              # event-matrix column space
+        v[cols[0]] = x0
+        dY, dYP = np.zeros(N), np.zeros(N)
+        dY[nsa:] = v[:N - nsa]
+        dYP[:nsa] = v[N - nsa:]
+        base = np.concatenate([Y[nsa:], YP[:nsa]])
+        h = 1e-7 * (1.0 + np.max(np.abs(base))) / max(np.max(np.abs(x0)), 1e-300)
+        return _central(lambda e: _residual(cb, t, Y + e * dY, YP + e * dYP), h)
 
     # -- events ------------------------------------------------------------------
     def polish(self, t, Y, YP, d_aug):
@@ -479,7 +542,6 @@ class SensRun:
         before) at the point ``(t, Y, Y')`` with base observed values
         ``obs``: the new discrete sensitivities, the re-initialised point and
         the jump of the states' sensitivities. Returns (d, callbacks, Y, Y')."""
-        from .initialize import _algebraic_rates
         sm = self.sm
         nd = len(sm.base.disc_syms)
         Y, YP = self.polish(t, Y, YP, d_before)
@@ -493,7 +555,7 @@ class SensRun:
             y, S = sm.unpack(Y1)
             S[:, :ns] += jump
             Y1, YP1 = self.reinit(t, sm.pack(y, S), YP1, d_new, rates=False)
-        YP1 = _algebraic_rates(sm, cb, t, Y1, YP1, sm.block_solve)
+        YP1 = self.rates(cb, t, Y1, YP1)
         return d_new, cb, Y1, YP1
 
     def _action_sensitivities(self, events, t, Y, YP, d_before, obs, dtau):
@@ -558,6 +620,17 @@ class SensRun:
                 E[k] = v
         SD = SD.reshape(len(T), self.sm.m, len(self.sm.base.disc_syms))
         return Sensitivities(self.sm, self.p, T, Y, YP, D, SD, E)
+
+
+def _residual(cb, t, Y, YP):
+    r = np.zeros(len(Y))
+    cb[0](t, Y, YP, r)
+    return r
+
+
+def _central(f, h):
+    """(f(h) - f(-h)) / 2h."""
+    return (f(h) - f(-h)) / (2 * h)
 
 
 def _rates(sm, cb, t, Y, YP):
