@@ -16,7 +16,9 @@ principle: one graph, several backends, sensitivities from the same graph).
 The augmented unknowns are ordered states first (the states, then their
 sensitivities per parameter, then the algebraic unknowns and theirs), so
 everything that splits a DAE into states and algebraic unknowns works
-unchanged; the Jacobian is the exact one (block lower triangular).
+unchanged. The augmented system's Jacobian is block lower triangular; its
+iteration matrix keeps the diagonal blocks, each the base model's
+(:meth:`SensitivityModel._generate`: IDAS's simultaneous corrector).
 
 At the start the sensitivities follow from the consistent-initialisation
 equations by the implicit function theorem (:meth:`SensRun.start`). At an
