@@ -30,3 +30,36 @@ class ForwardDifferences:
             zz[i] += h
             J[:, i] = (np.asarray(self.fun(zz), float) - r0) / h
         return J
+
+
+class SecantDifferences:
+    """``jac`` for ``scipy.optimize.least_squares``: the forward differences
+    of ``fd`` (a :class:`ForwardDifferences`) at the first point, then
+    Broyden's rank-one (secant) update between two points the optimiser
+    asks a Jacobian at, as long as the last Jacobian predicted the step
+    between them well (``|dr - J dz| <= trust |dr|``); a fresh difference
+    Jacobian otherwise. ``fresh`` says whether the last one returned was a
+    difference Jacobian (the one a caller reports at the optimum should
+    be)."""
+
+    def __init__(self, fd, trust=0.3):
+        self.fd, self.trust = fd, float(trust)
+        self.z = self.r = self.J = None
+        self.fresh = False
+        self.updates = 0
+
+    def jac(self, z):
+        z = np.asarray(z, float)
+        fd = self.fd
+        r = fd._r if fd._z is not None and np.array_equal(z, fd._z) else fd(z)
+        if self.J is not None:
+            dz, dr = z - self.z, r - self.r
+            miss = dr - self.J @ dz
+            if dz @ dz > 0 and np.linalg.norm(miss) <= self.trust * np.linalg.norm(dr):
+                self.J = self.J + np.outer(miss, dz) / (dz @ dz)
+                self.z, self.r, self.fresh = z, r, False
+                self.updates += 1
+                return self.J
+        self.J = fd.jac(z)
+        self.z, self.r, self.fresh = z, r, True
+        return self.J

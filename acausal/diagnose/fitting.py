@@ -288,16 +288,22 @@ def refine(obj, x_start, lo, hi, sc, max_nfev, tol):
     Returns (x, jacobian in parameter units, ok, message); when the budget
     runs out the best point seen is kept and the Jacobian taken there."""
     fd = ForwardDifferences(lambda z: obj(z * sc), FD_STEP, hi / sc)
-    jac = fd.jac
-    if getattr(obj, "jacobian", "differences") == "sensitivities":
+    jac, secant = fd.jac, None
+    kind = getattr(obj, "jacobian", "differences")
+    if kind == "sensitivities":
         from ..calibrate import SensitivityJacobian
         jac = SensitivityJacobian(obj.jac_x, lambda z: z * sc, lambda z: sc, fd).jac
+    elif kind == "secant":
+        from ..differences import SecantDifferences
+        secant = SecantDifferences(fd)
+        jac = secant.jac
     obj.best_cost, obj.best_x = np.inf, None
     try:
         sol = optimize.least_squares(fd, x_start / sc, jac=jac, bounds=(lo / sc, hi / sc),
                                      x_scale=1.0, xtol=tol, ftol=tol, gtol=tol,
                                      max_nfev=max_nfev)
-        return sol.x * sc, sol.jac / sc, sol.status >= 0, str(sol.message)
+        J = sol.jac if secant is None or secant.fresh else fd.jac(sol.x)
+        return sol.x * sc, J / sc, sol.status >= 0, str(sol.message)
     except _OutOfTime as stop:
         obj.timed = False
         x = obj.best_x if obj.best_x is not None else x_start
