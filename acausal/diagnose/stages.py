@@ -453,6 +453,26 @@ def _pair_reasons(best, rows):
     return out
 
 
+AT_BOUND = 1e-6      # of a parameter's range: a fitted value this close to a bound is at it
+
+
+def _bound_reasons(best):
+    """A cause whose own parameter ran to a bound of its declared range
+    (other than its neutral value) is a law that cannot reach the data at a
+    plausible size: not named (blind case: a torque setting in above a speed
+    was named as power drag at the bound of its coefficient)."""
+    out = []
+    for p in best.candidate.params:
+        v, span = best.fit.values.get(p.name), p.high - p.low
+        if v is None or not math.isfinite(span) or span <= 0:
+            continue
+        for bound in (p.low, p.high):
+            if abs(v - bound) <= AT_BOUND * span and bound != p.prior:
+                out.append(f"the cause's parameter {p.name} ran to the bound {bound:.4g} of "
+                           f"its range: the law cannot follow the data at a plausible size")
+    return out
+
+
 def rank(ds, cal: Calibration, dec: Decision, cv: CrossValidation) -> Ranking:
     """Stage 6: exact held-out errors in, classes, weak-evidence rules; a
     cause is never named while a rival candidate is untested."""
@@ -474,7 +494,7 @@ def rank(ds, cal: Calibration, dec: Decision, cv: CrossValidation) -> Ranking:
             d_runner=None if runner is None else rows[runner].aicc - b.aicc,
             heldout_nominal=held0, heldout_best=b.heldout_rmse, ci_rel=_ci_rel(b),
             c_hat=dec.c_hat, coarse=_coarse(ds, cal.fit))
-        weak += _untested_reasons(untested, b) + _pair_reasons(b, rows)
+        weak += _untested_reasons(untested, b) + _pair_reasons(b, rows) + _bound_reasons(b)
     cause = best if (dec.discrepancy and rows and not weak) else None
     after = best if dec.discrepancy else None
     return Ranking(rows, classes, cause, after, runner, weak, untested, held0)

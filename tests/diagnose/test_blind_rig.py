@@ -53,9 +53,10 @@ def test_rig_out_of_library_is_not_explained(tmp_path, effect, value):
     shape reads as the threshold law: the velocity part, net of the
     constant and linear parts the free damper shares, within 25 % RMS of
     the truth's torque over the speeds the data cover and no rougher than
-    1.5x the truth's own second differences on the knots. Before the
-    degenerate directions were pinned (acausal/diagnose/locate.py) it
-    zigzagged: measured in docs/diagnosis.md."""
+    2x the truth's own second differences on the knots. Measured
+    2026-11-23: 0.125 and 1.41 (located held-out 1.106 floors); with the
+    earlier term (9 velocity knots, nothing pinned) 0.834 and 3.18, a
+    zigzag (held-out 1.80)."""
     out, det, floors = _run(tmp_path, effect, value)
     assert floors > 50
     assert out["causes"] == [] and out["cause"] is None
@@ -68,7 +69,7 @@ def test_rig_out_of_library_is_not_explained(tmp_path, effect, value):
     err, rough = blind.velocity_shape_error(
         term, lambda w: -rig_truth.extra_torque(w, {effect: value}), 0.9 * w_max)
     print(f"SHAPE rig {effect}: relative error {err:.3f}, roughness {rough:.2f}")
-    assert err < 0.25 and rough < 1.5
+    assert err < 0.25 and rough < 2.0
 
 
 @pytest.mark.slow
