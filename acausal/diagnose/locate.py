@@ -147,15 +147,15 @@ def pin_rows(task):
     """Penalty rows pinning the generic term's degenerate directions (module
     doc) at the calibrated free parameters and zero weights: the term's
     and the free parameters' data Jacobians by forward differences, one
-    simulation of every experiment per column."""
-    from ..errors import AcausalError
+    simulation of every experiment per column. Returns (rows, the term's
+    largest singular value); no rows when the term cannot be simulated."""
     p, cand = task.problem, task.candidate
     base = {**{q.name: q.start for q in task.free}, **{q.name: q.start for q in cand.params}}
     try:
         ds, pair = dataset_of(p), model_of(p, cand)
         Jg = _columns(pair, ds, base, cand.params, p.settings.integrator)
         Jf = _columns(pair, ds, base, task.free, p.settings.integrator)
-    except AcausalError:     # the fit reports the failure; nothing to pin
+    except Exception:  # noqa: BLE001 - the fit reports the failure; nothing to pin
         return np.zeros((0, len(cand.params))), 0.0
     Q, s0 = degenerate_directions(Jg, Jf)
     return PIN_WEIGHT * s0 * Q, s0

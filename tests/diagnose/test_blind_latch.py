@@ -67,7 +67,7 @@ def test_latch_two_causes_at_two_sites(tmp_path):
     """Quadratic drag on the latch and a rising coil force, both present
     (about 40 floors): both named, each at its site.
 
-    Fails (measured 2026-11-23, 167-200 s): no cause named, no wrong one.
+    Fails (measured 2026-11-23, 167-220 s, three runs): no cause named, no wrong one.
     The free ``latch_damper.d`` takes most of the latch's drag (4.27
     calibrated, 6.14 in the best single fit, position_dependent_force at
     the coil, k = 3070 for 3000), which leaves about 3.4 floors RMS of
