@@ -113,6 +113,15 @@ def fit_members(problem, cal, dec, ex, progress=True, collect=None) -> tuple:
 PARSIMONY = 2.0       # AICc units: an extra parameter that gains less is uninformative
 
 
+def _family_sites(candidate, index: FamilyIndex):
+    """The sorted (family, location) of a candidate's members (one, or two
+    for a pair): rows with equal keys differ only in their families' laws."""
+    if candidate.hypothesis is None:
+        return None
+    hs, ls = candidate.hypothesis.split("+"), candidate.location.split("+")
+    return tuple(sorted((index.family(h), loc) for h, loc in zip(hs, ls)))
+
+
 def prefer_simplest(rk, index: FamilyIndex):
     """The ranking with the named (and best) row moved to the member of the
     same family at the same site with the fewest parameters whose AICc is
@@ -121,17 +130,14 @@ def prefer_simplest(rk, index: FamilyIndex):
     parameters and model selection using Akaike's Information Criterion",
     J. Wildlife Management 74 (2010) 1175-1178; Burnham and Anderson 2002,
     sec. 2.6). Coulomb friction is then named rather than Coulomb + viscous
-    with a viscous term the data cannot see. Rows and classes are unchanged."""
+    with a viscous term the data cannot see. A pair is compared with the pairs
+    at the same sites whose members are of the same families. Rows and
+    classes are unchanged."""
     if rk.after is None:
         return rk
     best = rk.rows[rk.after]
-    hid, loc = best.candidate.key
-    if "+" in hid:
-        return rk
-    fam = index.family(hid)
-    mates = [i for i, r in enumerate(rk.rows) if r.candidate.location == loc
-             and "+" not in r.candidate.hypothesis
-             and index.family(r.candidate.hypothesis) == fam
+    sites = _family_sites(best.candidate, index)
+    mates = [i for i, r in enumerate(rk.rows) if _family_sites(r.candidate, index) == sites
              and r.aicc <= best.aicc + PARSIMONY and r.starts.tested]
     pick = min(mates, key=lambda i: (rk.rows[i].k, rk.rows[i].aicc), default=rk.after)
     if pick == rk.after:
