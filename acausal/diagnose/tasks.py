@@ -128,22 +128,6 @@ def window(ds: Dataset, frac: float) -> Dataset:
     return Dataset(ds.folder, out, ds.instrument)
 
 
-def window_rows(ds: Dataset, frac: float) -> np.ndarray:
-    """Which rows of the whole record's residual vector (the order of
-    :func:`.fitting.weighted_residuals`: per experiment its measures, then
-    each trace signal's samples) :func:`window` keeps."""
-    keep = []
-    for e in ds.experiments:
-        keep.extend([frac >= 1.0] * len(e.measures))
-        if e.trace is not None:
-            t = e.trace.time
-            rows = t <= t[0] + frac * (t[-1] - t[0]) * (1 + 1e-9) if frac < 1.0 else \
-                np.ones(t.size, bool)
-            for _ in e.trace.signals:
-                keep.extend(rows.tolist())
-    return np.asarray(keep, bool)
-
-
 # -- starting points ----------------------------------------------------------------------
 def lhs_values(params, n, seed=0):
     """``n`` Latin-hypercube points over the parameters' bounds: each
@@ -269,11 +253,12 @@ def _multistart(task: FitTask):
     lo, hi, sc = _bounds(params)
     ds = dataset_of(p)
     pair = model_of(p, cand)
-    first = _windows(ds, s)[0]           # starts are scored on the first window
-    obj = Objective(pair, window(ds, first), names, budget_s=task.budget_s,
-                    penalty=_penalty(cand), backend=s.integrator)
+    # starts are scored on the whole record: scored on the first window only,
+    # the stop rig's pair case lost its drag's family head (power_drag named)
+    obj = Objective(pair, ds, names, budget_s=task.budget_s, penalty=_penalty(cand),
+                    backend=s.integrator)
     pts = start_points(task)
-    scored = score_starts(obj, [x for x, _ in pts], lo, hi, _windowed(task.absorb, ds, first))
+    scored = score_starts(obj, [x for x, _ in pts], lo, hi, task.absorb)
     if not scored:
         return failed_fit(names, pts[0][0], obj, "every starting point failed"), Starts()
     picked = _pick(scored, len(cand.params), sc, s.refine)
@@ -283,16 +268,6 @@ def _multistart(task: FitTask):
     best, starts = _summary(fits, len(scored), cand.params, True, [x for _, x in picked])
     best = dataclasses.replace(best, n_sim=obj.n_sim + sum(f.n_sim for f in fits))
     return best, starts
-
-
-def _windowed(absorb, ds, frac):
-    """``absorb`` = (names, Jacobian of the whole record) with the rows of the
-    window ``frac`` only (None stays None)."""
-    if absorb is None or not absorb[0]:
-        return absorb
-    J = np.asarray(absorb[1], float)
-    rows = window_rows(ds, frac)
-    return (absorb[0], J[rows]) if rows.size == J.shape[0] else None
 
 
 def calibrate_nominal(task: FitTask) -> CandidateFit:

@@ -30,20 +30,11 @@ def test_stop_strong_single_cause(tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=False, reason="the drag is named as its family's power law "
-                   "(v|v|^(n-1)), not as quadratic drag (docstring)")
 def test_stop_two_causes_at_two_sites(tmp_path):
     """Quadratic drag on the slider and a hardening spring, both present:
-    both named, each at its site.
-
-    Fails since session 5's fit changes (first-window scoring of starts,
-    FIT_TOL 1e-5, meeting refinements; measured 2026-11-23, 156-169 s at
-    load 1-2): named power_drag at slider + hardening_spring at spring,
-    held-out 36.7 -> 1.004, the right sites and families; the pair of the
-    drag family's head (quadratic_damping + hardening_spring) was not among
-    the pair fits, so families.prefer_simplest (which now compares pairs
-    too) has nothing simpler to pick. Before those changes both were named
-    as asserted here."""
+    both named, each at its site. (Scoring each candidate's starts on the
+    first window only lost this case: power_drag was named for the drag;
+    the starts are scored on the whole record again.)"""
     eff = {"drag": 0.3, "hardening": 2e5}
     out, det, floors = blind.run_case(STOP, stop_truth, tmp_path, eff, name="stop pair")
     assert blind.named(out) == {("quadratic_damping", "slider"),
