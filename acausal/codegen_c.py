@@ -95,7 +95,9 @@ def _observe(cm, names, real, decl, ysyms, ypsyms):
     expression has no C form, and the caller keeps the Python one (the
     residual and root functions decide whether the backend can run)."""
     obs = cm.observed_exprs()
-    exprs = [replace_shared(e, real) for e in names.rename(obs, "an observed variable")]
+    exprs = names.rename(obs, "an observed variable")
+    if real:
+        exprs = [replace_shared(e, real) for e in exprs]
     try:
         body = _body(exprs, [f"o[{i}]" for i in range(len(exprs))])
         fixjac = _fixjac(cm, exprs, ysyms, ypsyms)
@@ -135,8 +137,9 @@ def generate_c(cm):
     g = names.rename(roots, "an event")
     # (Names' symbols are real already: then there is nothing to replace)
     real = {s: r for s in names.allowed if (r := sp.Symbol(s.name, real=True)) is not s}
-    res = [replace_shared(r, real) for r in res]
-    g = [replace_shared(e, real) for e in g]
+    if real:
+        res = [replace_shared(r, real) for r in res]
+        g = [replace_shared(e, real) for e in g]
     # the symbols as they stand in the expressions, found by name (whatever
     # assumptions Names gives them)
     by_name = {v.name: v for v in real.values()}

@@ -199,20 +199,24 @@ class SensitivityModel:
         matrix on the diagonal. ``J``: its diagonal blocks (the generated
         Jacobian, :func:`acausal.initialize._event_matrix`);
         ``coupling(x0)``: the off-diagonal blocks times the base block's
-        solution ``x0`` (rows of the whole vector). One solve of the base
-        block per block and forward substitution: a dense solve of the
-        whole would also mix blocks of very different scales (d/dp of a
-        1e-4 kg m^2 inertia; rcond 1e-16 on the breaker)."""
+        solution ``x0`` (rows of the whole vector). Forward substitution
+        with the base block (every diagonal block is the base model's
+        matrix): one solve for the base block, one with a right-hand side
+        per parameter for the rest; a dense solve of the whole would also
+        mix blocks of very different scales (d/dp of a 1e-4 kg m^2
+        inertia; rcond 1e-16 on the breaker)."""
         from .initialize import _solve_square
         rows, cols = self._event_blocks()
         if not isinstance(J, np.ndarray):
             J = J.toarray()
+        J0 = J[np.ix_(rows[0], cols[0])]
         x = np.empty_like(b)
-        x0 = _solve_square(J[np.ix_(rows[0], cols[0])], b[rows[0]])
+        x0 = _solve_square(J0, b[rows[0]])
         x[cols[0]] = x0
         c0 = coupling(x0)
-        for r, c in zip(rows[1:], cols[1:]):
-            x[c] = _solve_square(J[np.ix_(r, c)], b[r] - c0[r])
+        X = _solve_square(J0, np.column_stack([b[r] - c0[r] for r in rows[1:]]))
+        for j, c in enumerate(cols[1:]):
+            x[c] = X[:, j]
         return x
 
     def _event_blocks(self):
