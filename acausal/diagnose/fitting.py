@@ -453,6 +453,25 @@ def _penalty_rows(f: Fit, penalty):
     return J, P @ (x / sc)
 
 
+def effective_k(f: Fit, penalty=None) -> float:
+    """The number of parameters a (penalised) fit spends: the trace of its
+    hat matrix, tr[J (J'J + Jp'Jp)^+ J'] (the effective degrees of freedom of
+    a penalised least-squares fit; Hastie & Tibshirani, Generalized Additive
+    Models, 1990, sec. 3.5). It is ``f.k`` for an unpenalised fit of full
+    rank; a direction pinned by a stiff penalty row counts about zero, and a
+    smoothing penalty counts a fraction of each weight it ties."""
+    if f.k == 0 or f.jacobian.size == 0:
+        return 0.0
+    Jp, _ = _penalty_rows(f, penalty)
+    J = f.jacobian
+    # with [J; Jp] = U S V' the data rows of the hat matrix are U_J U_J'
+    # (U_J = U's first n rows): its trace is |U_J|^2, with no normal equations
+    # to square a stiff pin row's condition number
+    U, s, _ = np.linalg.svd(np.vstack([J, Jp]), full_matrices=False)
+    keep = s > s[0] * max(U.shape) * np.finfo(float).eps
+    return float(np.sum(U[:J.shape[0], keep] ** 2))
+
+
 def heldout_rms(loo: dict) -> float:
     """RMS of all held-out residuals (noise-floor units)."""
     r = np.concatenate([np.atleast_1d(v) for v in loo.values()]) if loo else np.zeros(0)

@@ -29,11 +29,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import stats as st
-from .fitting import heldout_rms
+from .fitting import effective_k, heldout_rms
 from .generic import GENERIC, N_V, N_X, SMOOTH, hats, penalty, shape
 from .problem import Candidate, Param
 from .stages import fit_tasks, run_tasks
-from .tasks import dataset_of, fit_candidate, model_of
+from .tasks import dataset_of, fit_candidate, model_of, penalty_of
 
 MARGIN = 10.0    # AICc units by which the generic term must beat the library
 PIN_TOL = 0.05   # a free parameter whose effect on the data the term reproduces to 5 %
@@ -189,8 +189,12 @@ def _pinned(problem, cal, gens, ex, progress):
 
 
 def _term(r, n, c_hat, ranges, members):
+    """The fitted term; its AICc counts the parameters the fit spends
+    (:func:`.fitting.effective_k`): pinned directions and the smoothing
+    penalty's ties are not free parameters."""
     f = r.fit
-    return Term(r.candidate.location, members, f.cost, st.aicc(f.cost, n, f.k, c_hat),
+    k = effective_k(f, penalty_of(r.candidate))
+    return Term(r.candidate.location, members, f.cost, st.aicc(f.cost, n, k, c_hat),
                 heldout_rms(r.loo), ranges, shape(f.values, GENERIC.prefix, ranges),
                 dict(f.values))
 

@@ -223,7 +223,7 @@ def fit_candidate(task: FitTask) -> CandidateFit:
     t0 = time.perf_counter()
     try:
         fit, starts = _multistart(task)
-        loo = linear_loo(fit, _penalty(task.candidate)) if fit.ok else {}
+        loo = linear_loo(fit, penalty_of(task.candidate)) if fit.ok else {}
         return CandidateFit(task.candidate, fit, loo, None, time.perf_counter() - t0, starts)
     except Exception as exc:  # noqa: BLE001 - a candidate that cannot be built is reported
         return CandidateFit(task.candidate, None, {}, f"{type(exc).__name__}: {exc}",
@@ -255,7 +255,7 @@ def _multistart(task: FitTask):
     pair = model_of(p, cand)
     # starts are scored on the whole record: scored on the first window only,
     # the stop rig's pair case lost its drag's family head (power_drag named)
-    obj = Objective(pair, ds, names, budget_s=task.budget_s, penalty=_penalty(cand),
+    obj = Objective(pair, ds, names, budget_s=task.budget_s, penalty=penalty_of(cand),
                     backend=s.integrator)
     pts = start_points(task)
     scored = score_starts(obj, [x for x, _ in pts], lo, hi, task.absorb)
@@ -263,7 +263,7 @@ def _multistart(task: FitTask):
         return failed_fit(names, pts[0][0], obj, "every starting point failed"), Starts()
     picked = _pick(scored, len(cand.params), sc, s.refine)
     refiner = Refiner(pair, ds, names, lo, hi, sc, _windows(ds, s), s, task.budget_s,
-                      _penalty(cand))
+                      penalty_of(cand))
     fits = refiner.all([x for _, x in picked])
     best, starts = _summary(fits, len(scored), cand.params, True, [x for _, x in picked])
     best = dataclasses.replace(best, n_sim=obj.n_sim + sum(f.n_sim for f in fits))
@@ -299,7 +299,9 @@ def calibrate_nominal(task: FitTask) -> CandidateFit:
     return CandidateFit(task.candidate, best, loo, None, time.perf_counter() - t0, starts)
 
 
-def _penalty(cand):
+def penalty_of(cand):
+    """(rows P, scales) of a candidate's penalty on its own parameters (the
+    generic term's smoothing and pins), or None."""
     if cand.penalty is None:
         return None
     return np.asarray(cand.penalty, float), np.array([abs(p.scale) or 1.0 for p in cand.params])

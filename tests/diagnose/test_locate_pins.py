@@ -1,6 +1,7 @@
 """The located term's degenerate directions (acausal/diagnose/locate.py,
 degenerate_directions): closed-form cases on small Jacobians."""
 import numpy as np
+import pytest
 
 from acausal.diagnose.locate import PIN_TOL, degenerate_directions
 
@@ -33,3 +34,33 @@ def test_a_partly_reproduced_free_parameter_is_not_pinned():
     other *= 3 * PIN_TOL * np.linalg.norm(j) / np.linalg.norm(other)
     Q, _ = degenerate_directions(Jg, (j + other)[:, None])
     assert Q.shape == (0, 4)
+
+
+def _fit(J, names=None):
+    from acausal.diagnose.fitting import Fit
+    names = names or [f"w{i}" for i in range(J.shape[1])]
+    return Fit(names, {n: 0.0 for n in names}, 0.0, np.zeros(J.shape[0]), J, [], [])
+
+
+def test_effective_k_of_an_unpenalised_fit_is_its_parameter_count():
+    from acausal.diagnose.fitting import effective_k
+    J = np.random.default_rng(2).normal(size=(50, 4))
+    assert effective_k(_fit(J)) == pytest.approx(4.0, abs=1e-10)
+
+
+def test_effective_k_drops_pinned_directions_and_counts_ridge_in_closed_form():
+    """Ridge regression's degrees of freedom sum d^2/(d^2 + lam) over J's
+    singular values d (Hastie & Tibshirani 1990); a stiff pin row removes
+    about one."""
+    from acausal.diagnose.fitting import effective_k
+    rng = np.random.default_rng(3)
+    J = rng.normal(size=(60, 5))
+    lam = 7.0
+    d = np.linalg.svd(J, compute_uv=False)
+    ridge = np.sqrt(lam) * np.eye(5)
+    got = effective_k(_fit(J), (ridge, np.ones(5)))
+    assert got == pytest.approx(float(np.sum(d ** 2 / (d ** 2 + lam))), rel=1e-10)
+    pin = 1e6 * d[0] * np.array([[1.0, -1.0, 0.0, 0.0, 0.0]]) / np.sqrt(2)
+    assert effective_k(_fit(J), (pin, np.ones(5))) == pytest.approx(4.0, abs=1e-6)
+    scaled = effective_k(_fit(J), (pin, np.full(5, 3.0)))   # scales divide the rows
+    assert scaled == pytest.approx(4.0, abs=1e-5)
