@@ -122,6 +122,8 @@ def main(argv=None):
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--library", default=None)
     ap.add_argument("--quick", action="store_true", help="fewer optimiser steps")
+    ap.add_argument("--resume", action="store_true", help="keep the cases already in the "
+                    "--out .json and run only the others (the table says so)")
     ap.add_argument("--out", default=None, help="the Markdown table (rewritten after every "
                     "case, marked partial until all are done; every case's outcome in "
                     "the .json beside it)")
@@ -133,8 +135,12 @@ def main(argv=None):
     hyps, unsited = _sited(args.model, hyps, args.library)
     effects = [float(x) for x in args.effects.split(",")]
     jobs = job_list(args, hyps, effects)
-    t0 = time.perf_counter()
-    results = []
+    n_all = len(jobs)
+    results, wall0 = _done(args) if args.resume else ([], 0.0)
+    done = {(r["hyp"], r["effect"], r["seed"]) for r in results}
+    jobs = [j for j in jobs if (j[1], j[2], j[3]) not in done]
+    t0 = time.perf_counter() - wall0
+    commit = _commit()
     with cf.ProcessPoolExecutor(args.workers) as ex:
         futs = [ex.submit(run_case, *j) for j in jobs]
         for k, f in enumerate(cf.as_completed(futs)):
@@ -143,14 +149,37 @@ def main(argv=None):
             except Exception as exc:  # noqa: BLE001 - report and go on
                 print(f"case failed: {type(exc).__name__}: {exc}", file=sys.stderr)
                 continue
+            r["commit"] = commit
             results.append(r)
-            print(f"[{k + 1}/{len(jobs)}] {r['hyp']} effect {r['effect']:g} seed {r['seed']}"
+            print(f"[{len(results)}/{n_all}] {r['hyp']} effect {r['effect']:g} seed {r['seed']}"
                   f" at {r['location']} (achieved {r['achieved']:.2f}): right={r['right']} "
                   f"named={r['named']} "
                   f"cause={r['cause']} ({r['wall_s']:.0f} s)", file=sys.stderr)
-            _write(args, results, hyps, effects, time.perf_counter() - t0, len(jobs), unsited)
-    table = _write(args, results, hyps, effects, time.perf_counter() - t0, len(jobs), unsited)
+            _write(args, results, hyps, effects, time.perf_counter() - t0, n_all, unsited)
+    table = _write(args, results, hyps, effects, time.perf_counter() - t0, n_all, unsited)
     print(table)
+
+
+def _commit():
+    import subprocess
+    try:
+        return subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
+                              capture_output=True, text=True, timeout=10).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        return ""
+
+
+def _done(args):
+    """(cases, wall time) already in the --out .json (resumed runs add up
+    their wall times; the cases may come from earlier code: the table's
+    JSON keeps each case's commit when it was recorded)."""
+    import json
+    path = os.path.splitext(args.out or "")[0] + ".json"
+    if not args.out or not os.path.exists(path):
+        return [], 0.0
+    with open(path) as f:
+        d = json.load(f)
+    return list(d["cases"]), float(d.get("wall_s", 0.0))
 
 
 def _write(args, results, hyps, effects, wall, n_jobs, unsited=()):
