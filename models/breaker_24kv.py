@@ -164,12 +164,24 @@ def release_experiment(model, **options):
 
 
 def t_first_contact(res):
-    return ct.impacts(res, "contact")[0].t_onset
+    imps = ct.impacts(res, "contact")
+    if not imps:
+        raise ValueError(f"the armature never touched the hook by t = {res.t[-1]:.6g} s")
+    return imps[0].t_onset
+
+
+def t_release(res):
+    """The release time; a run that ends without it says where the hook got to."""
+    times = res.event_times("release")
+    if not len(times):
+        raise ValueError(f"the hook did not reach its release angle: the run ended at "
+                         f"t = {res.t[-1]:.6g} s with hook.phi = {res['hook.phi'][-1]:.6g} rad")
+    return times[0]
 
 
 # the measures of this file; the variants add their own to these
 MEASURES = {
-    "thrt": Measure(lambda res: res.event_times("release")[0] - t_first_contact(res),
+    "thrt": Measure(lambda res: t_release(res) - t_first_contact(res),
                     "s", display="ms", desc="trigger hook response time"),
     "contact_period": Measure(lambda res: ct.contact_period(res, "contact"), "s",
                               display="ms", desc="duration of the first impact"),
@@ -205,7 +217,7 @@ def plot(res, path):
     from acausal.plot import plot_result
     t0 = t_first_contact(res)
     imp = ct.impacts(res, "contact")[0]
-    t_rel = res.event_times("release")[0]
+    t_rel = t_release(res)
     s3 = float(res["hook.s3"][0])
     return plot_result(
         res, ["contact.fc", "hook.phi", "hook.body.w", "armature.mass.v"], path,

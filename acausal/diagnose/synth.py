@@ -28,10 +28,12 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 from scipy import optimize
 
-from ..errors import UsageError
+from ..errors import AcausalError, UsageError
 from ..data import Dataset, Experiment, Instrument, Trace, write_dataset
 from ..modelfile import compile_file, evaluate_measures
 from .library import load_library
+
+TOO_STRONG = 1e6   # the effect [floors] of a magnitude at which the run fails
 
 
 @dataclass
@@ -214,8 +216,13 @@ def _solve_effect(pair, free, values, spec, sign, target, conds, ref, measures, 
                          f"[{spec.low}, {spec.high}]")
 
     def eff(logm):
+        # a magnitude at which the mechanism no longer completes its run (a
+        # measure or the simulation fails) is stronger than any target
         v = sign * math.exp(logm)
-        runs = _simulate(pair, {**free, **values, spec.name: v}, conds)
+        try:
+            runs = _simulate(pair, {**free, **values, spec.name: v}, conds)
+        except AcausalError:
+            return TOO_STRONG
         return _effect(runs, ref, measures, traces, floors, rate) - target
 
     top = math.log(limit)
