@@ -146,11 +146,13 @@ class Event:
     ``observer=True`` marks an event whose action only records values
     (discrete values that no equation uses, such as a peak force): IDA does
     not stop for it, the action runs on the state IDA located, and the
-    integration goes on undisturbed.
+    integration goes on undisturbed. ``log=False`` leaves the event out of
+    ``res.events`` (bookkeeping that is no physical event, such as a
+    planar joint deciding at the start whether it drives its loop).
     """
 
     def __init__(self, name, expr, direction=0, action=None, *, terminal=False,
-                 recheck=False, observer=False):
+                 recheck=False, observer=False, log=True):
         if direction not in (-1, 0, 1):
             raise ModelError(f"event {name}: direction must be -1, 0 or +1")
         self.name = name
@@ -160,6 +162,7 @@ class Event:
         self.terminal = terminal
         self.recheck = recheck
         self.observer = observer
+        self.log = log
         self.owner = None  # set by flattening: the component path
 
 

@@ -505,9 +505,7 @@ def _observers(run, cb, seg, d):
         before = list(d)
         taus = run.sens.event_times(te, root.y, root.yp, d, obs) if run.sens else None
         for i in obs:
-            if taus is not None:
-                run.sens.note(len(run.events), taus[i])
-            _log_event(run, te, cm.events[i])
+            _log_event(run, te, cm.events[i], taus[i] if taus is not None else None)
             cm.events[i].action(state)
         for j, (a, b) in enumerate(zip(before, d)):
             if a != b:
@@ -540,9 +538,7 @@ def _handle(run, cb, t, y, yp, d, fired):
             raise SolverError(f"{a.owner}: {a.message} (at t = {t:.6g} s)", t=t,
                               component=a.owner, result=run.result("failed", a.message))
         ev = cm.events[i]
-        if taus is not None:
-            run.sens.note(len(run.events), taus[i])
-        _log_event(run, t, ev)
+        _log_event(run, t, ev, taus[i] if taus is not None else None)
         if ev.action is not None:
             ev.action(state)
         if ev.terminal:
@@ -582,9 +578,7 @@ def _event_iteration(run, cb, t, y, yp, d, initial=False):
         for i in checks:
             ev = cm.events[i]
             if (ev.direction < 0 and g[i] < 0) or (ev.direction > 0 and g[i] > 0):
-                if run.sens is not None:
-                    run.sens.note(len(run.events), run.sens.dtau)
-                _log_event(run, t, ev)
+                _log_event(run, t, ev, run.sens.dtau if run.sens is not None else None)
                 fired.append(ev)
                 if ev.action is not None:
                     ev.action(state)
@@ -596,13 +590,18 @@ def _event_iteration(run, cb, t, y, yp, d, initial=False):
                           + ", ".join(sorted({cm.events[i].owner for i in checks})), t=t)
 
 
-def _log_event(run, t, ev):
-    """Record an event; a ChatteringError when this same event (one root of
+def _log_event(run, t, ev, dtau=None):
+    """Record an event in ``res.events`` (with its time's sensitivity
+    ``dtau`` in a sensitivity run), unless it is bookkeeping
+    (``Event(log=False)``); a ChatteringError when this same event (one root of
     one component) has fired CHATTER_COUNT times within CHATTER_SPAN of the
     run's span: its mode logic toggles without time advancing (Zeno). Many
     different roots firing at one instant (199 contacts of a Newton's
     cradle closing at t = 0) are not chattering: each fires once."""
-    run.events.append((t, ev.name))
+    if ev.log:
+        if dtau is not None:
+            run.sens.note(len(run.events), dtau)
+        run.events.append((t, ev.name))
     run.event_log.append((t, ev.owner))
     times = run.firings.get((ev.owner, ev.name))
     if times is None:

@@ -137,4 +137,4 @@ def arm_event(joint):
         s[flag] = 1 if drives(s.cm, path, coord) else 0
 
     return Event(f"{path}.decide_drives", Piecewise((1, Eq(flag, -1)), (-1, True)), +1,
-                 decide, recheck=True)
+                 decide, recheck=True, log=False)
