@@ -36,12 +36,36 @@ class DAE:
 
 def build_dae(g, dummies, params, values=None):
     """``params``: the set of parameter symbols (constant coefficients)."""
+    states, yp_sym, eqs, unknowns = _index1_system(g, dummies)
+    yp_set = set(yp_sym.values())
+    explicit, residuals, origins, implicit_alg = {}, {}, {}, []
+    for block in _blt(eqs, unknowns):
+        _causalize_block(block, eqs, unknowns, yp_set, params, values,
+                         (explicit, residuals, origins, implicit_alg))
+    # order residuals to y slots: state i <-> unknown i (its derivative),
+    # algebraic slots follow
+    y = [g.vsym[j] for j in states] + implicit_alg
+    yp = [yp_sym[j] for j in states] + [None] * len(implicit_alg)
+    idx = {u: k for k, u in enumerate(unknowns)}
+    res = [residuals.get(k) for k in range(len(states))] + [residuals[idx[u]]
+                                                            for u in implicit_alg]
+    org = [origins.get(k) for k in range(len(states))] + [origins[idx[u]]
+                                                          for u in implicit_alg]
+    # states whose derivative was solved explicitly are not possible (yp are
+    # never made explicit), so every state row has a residual
+    return DAE(y, yp, len(states), res, org, explicit)
+
+
+def _index1_system(g, dummies):
+    """The index-1 system after state selection: (state nodes, state node ->
+    its derivative's symbol in yp, equations as (expr, origin), unknowns).
+    It keeps every equation and every derivative of it (the dummy
+    derivatives are its extra algebraic unknowns)."""
     nv = len(g.vsym)
     states = [j for j in range(nv) if g.vder[j] != -1 and g.vder[j] not in dummies]
     deriv_of_state = {g.vder[j]: j for j in states}
     # y slots: states first, then every other node that is not the plain
     # derivative of a state (those live in yp).
-    y_nodes = list(states)
     aux_eqs, yp_sym = [], {}
     for j in states:
         d = g.vder[j]
@@ -52,62 +76,45 @@ def build_dae(g, dummies, params, values=None):
         else:
             yp_sym[j] = g.vsym[d]
     alg_nodes = [j for j in range(nv) if j not in set(states) and j not in deriv_of_state]
-    # the index-1 system keeps every equation and every derivative of it
-    # (the dummy derivatives are its extra algebraic unknowns)
-    eqs = [(g.eexpr[i], g.eorig[i]) for i in range(len(g.eexpr))]
-    eqs += aux_eqs
+    eqs = [(g.eexpr[i], g.eorig[i]) for i in range(len(g.eexpr))] + aux_eqs
     unknowns = [yp_sym[j] for j in states] + [g.vsym[j] for j in alg_nodes]
     if len(eqs) != len(unknowns):
         raise StructuralError(f"internal: index-1 system has {len(eqs)} equations for "
                               f"{len(unknowns)} unknowns after state selection")
-    blocks = _blt(eqs, unknowns)
-    explicit, residuals, origins, implicit_alg = {}, {}, {}, []
-    yp_set = set(yp_sym.values())
-    for block in blocks:
-        if len(block) == 1:
-            (ei, ui), = block
-            expr = _subs(eqs[ei][0], explicit)
-            u = unknowns[ui]
-            sol = _solve_linear(expr, u, params, values)
-            if sol is not None and u not in yp_set:
-                explicit[u] = sol
-                continue
-            residuals[ui] = expr
-            origins[ui] = eqs[ei][1]
-            if u not in yp_set:
-                implicit_alg.append(u)
-            continue
-        exprs = [_subs(eqs[ei][0], explicit) for ei, _ in block]
-        us = [unknowns[ui] for _, ui in block]
-        sol = _solve_linear_block(exprs, us, params, values)
-        if sol is not None:
-            for (ei, ui), u, v in zip(block, us, sol):
-                if u in yp_set:
-                    residuals[ui] = u - v
-                    origins[ui] = eqs[ei][1]
-                else:
-                    explicit[u] = v
-            continue
-        for ei, ui in block:
-            residuals[ui] = _subs(eqs[ei][0], explicit)
-            origins[ui] = eqs[ei][1]
-            if unknowns[ui] not in yp_set:
-                implicit_alg.append(unknowns[ui])
-    # order residuals to y slots: state i <-> unknown i (its derivative),
-    # algebraic slots follow
-    y = [g.vsym[j] for j in states] + implicit_alg
-    yp = [yp_sym[j] for j in states] + [None] * len(implicit_alg)
-    idx = {u: k for k, u in enumerate(unknowns)}
-    res, org = [], []
-    for k in range(len(states)):
-        res.append(residuals[k] if k in residuals else None)
-        org.append(origins.get(k))
-    for u in implicit_alg:
-        res.append(residuals[idx[u]])
-        org.append(origins[idx[u]])
-    # states whose derivative was solved explicitly are not possible (yp are
-    # never made explicit), so every state row has a residual
-    return DAE(y, yp, len(states), res, org, explicit)
+    return states, yp_sym, eqs, unknowns
+
+
+def _causalize_block(block, eqs, unknowns, yp_set, params, values, out):
+    """One BLT block: unknowns solved explicitly where the block is linear
+    in them (never a state derivative), else residuals. ``out`` =
+    (explicit, residuals, origins, implicit_alg), filled in place."""
+    explicit, residuals, origins, implicit_alg = out
+    if len(block) == 1:
+        (ei, ui), = block
+        expr = _subs(eqs[ei][0], explicit)
+        u = unknowns[ui]
+        sol = _solve_linear(expr, u, params, values)
+        if sol is not None and u not in yp_set:
+            explicit[u] = sol
+            return
+        residuals[ui], origins[ui] = expr, eqs[ei][1]
+        if u not in yp_set:
+            implicit_alg.append(u)
+        return
+    exprs = [_subs(eqs[ei][0], explicit) for ei, _ in block]
+    us = [unknowns[ui] for _, ui in block]
+    sol = _solve_linear_block(exprs, us, params, values)
+    if sol is not None:
+        for (ei, ui), u, v in zip(block, us, sol):
+            if u in yp_set:
+                residuals[ui], origins[ui] = u - v, eqs[ei][1]
+            else:
+                explicit[u] = v
+        return
+    for ei, ui in block:
+        residuals[ui], origins[ui] = _subs(eqs[ei][0], explicit), eqs[ei][1]
+        if unknowns[ui] not in yp_set:
+            implicit_alg.append(unknowns[ui])
 
 
 def _subs(expr, explicit):
