@@ -133,52 +133,9 @@ def eliminate_aliases(flat):
     """Apply parameter bindings and remove alias equations."""
     psubs = bind_parameters(flat)
     unknowns = [info.symbol for info in flat.variables.values()]
-    uset = set(unknowns)
-    eqs = []
-    for eq in flat.equations:
-        expr = eq.expr.xreplace(psubs) if psubs else eq.expr
-        eqs.append((eq, expr))
-
-    differentiated = set()
-    for _, expr in eqs:
-        for s in expr.free_symbols:
-            if is_der(s):
-                differentiated.add(base_and_order(s)[0])
-
-    def priority(sym):
-        if sym == _UnionFind.CONST:
-            return 100
-        info = flat.variables[sym.name]
-        score = 0
-        if sym in differentiated:
-            score += 8
-        if info.start.fixed:
-            score += 4
-        if not _is_port_var(flat, sym):
-            score += 2
-        return score - 1e-3 * sym.name.count(".")
-
-    uf = _UnionFind(priority)
-    kept = []
-    for eq, expr in eqs:
-        form = _alias_form(expr, uset)
-        if form is None:
-            kept.append((eq, expr))
-            continue
-        x, a, y, b = form
-        if y == _UnionFind.CONST:
-            status = uf.union(x, sp.Integer(1), y, b)
-        else:
-            status = uf.union(x, a, y, b)
-        if status == "not-alias":
-            kept.append((eq, expr))
-        elif status is not None:
-            what = "contradicts" if status == "inconsistent" else "repeats"
-            raise StructuralError(
-                f"the model is over-determined: {eq.describe()} {what} other equations "
-                f"(the same relation is imposed twice; e.g. two fixed supports connected "
-                f"to each other, or a connection made twice)", excess=[eq], component=eq.origin)
-
+    eqs = [(eq, eq.expr.xreplace(psubs) if psubs else eq.expr) for eq in flat.equations]
+    uf = _UnionFind(_priority(flat, eqs))
+    kept = _union_aliases(uf, eqs, set(unknowns))
     aliases, subs = {}, {}
     for x in unknowns:
         r, s, o = uf.find(x)
@@ -198,6 +155,47 @@ def eliminate_aliases(flat):
         out.append(type(eq)(e, eq.origin, eq.label))
     remaining = [x for x in unknowns if x not in aliases]
     return Reduced(out, remaining, aliases, psubs, subs)
+
+
+def _priority(flat, eqs):
+    """Which member of an alias set stays (the highest score): one that is
+    differentiated, then one with a fixed start, then one that is not a
+    connector variable, then the shortest path."""
+    differentiated = {base_and_order(s)[0] for _, expr in eqs for s in expr.free_symbols
+                      if is_der(s)}
+
+    def priority(sym):
+        if sym == _UnionFind.CONST:
+            return 100
+        info = flat.variables[sym.name]
+        score = 8 * (sym in differentiated) + 4 * bool(info.start.fixed) \
+            + 2 * (not _is_port_var(flat, sym))
+        return score - 1e-3 * sym.name.count(".")
+
+    return priority
+
+
+def _union_aliases(uf, eqs, uset):
+    """Merge every alias equation's two sides in ``uf``; returns the other
+    equations. An alias that contradicts or repeats others raises."""
+    kept = []
+    for eq, expr in eqs:
+        form = _alias_form(expr, uset)
+        if form is None:
+            kept.append((eq, expr))
+            continue
+        x, a, y, b = form
+        status = uf.union(x, sp.Integer(1), y, b) if y == _UnionFind.CONST \
+            else uf.union(x, a, y, b)
+        if status == "not-alias":
+            kept.append((eq, expr))
+        elif status is not None:
+            what = "contradicts" if status == "inconsistent" else "repeats"
+            raise StructuralError(
+                f"the model is over-determined: {eq.describe()} {what} other equations "
+                f"(the same relation is imposed twice; e.g. two fixed supports connected "
+                f"to each other, or a connection made twice)", excess=[eq], component=eq.origin)
+    return kept
 
 
 def _der_n(x, k):
