@@ -390,9 +390,7 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, prof
     jac, exact = _jacobian_choice(jacobian, fd, path, dataset, names, signals, sc, n_sim)
     sol = optimize.least_squares(fd, sc.z0, jac=jac, bounds=(sc.zlo, sc.zhi),
                                  xtol=1e-12, ftol=1e-12, gtol=1e-12)
-    kind = "finite differences" if exact is None else "sensitivities"
-    if exact is not None and exact.fallbacks:
-        kind += f" ({exact.fallbacks} of {exact.calls} by finite differences)"
+    kind = _jacobian_kind(exact)
     xs = sc.to_x(sol.x)
     values = dict(zip(names, xs.tolist()))
     dof = max(n_res - len(names), 0)
@@ -401,17 +399,31 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, prof
     out = Calibration("least_squares", values, ci, corr, raw, float(2 * sol.cost), dof,
                       n_sim[0], jacobian=kind)
     if profile != "none" and names:
-        # in the fit's own variables (log for a positive range, value/scale
-        # otherwise), so that the profiles' Wald intervals are the ones above
-        out.profile_ci95 = profiles(
-            _no_evidence_on_failure(path, dataset, names, signals, n_res, n_sim), xs, names,
-            every=profile == "all", bounds=(sc.lo, sc.hi),
-            log=sc.logp, scale=sc.scale,
-            dispersion=max(2 * sol.cost / dof, 1.0) if dof > 0 else 1.0,
-            dof=dof or None, jacobian=sol.jac, fd_step=FD_STEP, inner_max_nfev=20,
-            inner_tol=1e-6, crossing_tol=1e-2)
+        out.profile_ci95 = _profile_intervals(path, dataset, names, signals, n_res, n_sim,
+                                              sol, sc, xs, dof, profile == "all")
         out.n_sim = n_sim[0]
     return out
+
+
+def _jacobian_kind(exact):
+    """What gave the Jacobian (``Calibration.jacobian``)."""
+    if exact is None:
+        return "finite differences"
+    if exact.fallbacks:
+        return f"sensitivities ({exact.fallbacks} of {exact.calls} by finite differences)"
+    return "sensitivities"
+
+
+def _profile_intervals(path, dataset, names, signals, n_res, n_sim, sol, sc, xs, dof, every):
+    """Profile-likelihood intervals at the optimum ``sol``, in the fit's own
+    variables (log for a positive range, value/scale otherwise), so that the
+    profiles' Wald intervals are those of :func:`_linear_intervals`."""
+    return profiles(
+        _no_evidence_on_failure(path, dataset, names, signals, n_res, n_sim), xs, names,
+        every=every, bounds=(sc.lo, sc.hi), log=sc.logp, scale=sc.scale,
+        dispersion=max(2 * sol.cost / dof, 1.0) if dof > 0 else 1.0,
+        dof=dof or None, jacobian=sol.jac, fd_step=FD_STEP, inner_max_nfev=20,
+        inner_tol=1e-6, crossing_tol=1e-2)
 
 
 def _fit_bounds(mf, entries, bounds):
