@@ -25,6 +25,7 @@ outside a margin of 10 units.
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -71,21 +72,36 @@ def start_columns(task: ScreenTask):
     return r0, np.array(cols).T
 
 
-def predicted_cost(r0, J_own, J_free) -> float:
-    """min over d of |r0 + [J_free J_own] d|^2 (nan if the shapes differ)."""
+def predicted_step(r0, J_own, J_free):
+    """(S_pred, d) with d = argmin |r0 + [J_free J_own] d|^2 and S_pred its
+    value ((nan, None) if the shapes differ or a value is not finite)."""
     if J_own.shape[0] != r0.size or (J_free.size and J_free.shape[0] != r0.size):
-        return float("nan")
+        return float("nan"), None
     A = np.hstack([J_free, J_own]) if J_free.size else J_own
     if not (np.all(np.isfinite(A)) and np.all(np.isfinite(r0))):
-        return float("nan")
+        return float("nan"), None
     d = np.linalg.lstsq(A, -r0, rcond=None)[0]
     r = r0 + A @ d
-    return float(r @ r)
+    return float(r @ r), d
+
+
+def predicted_cost(r0, J_own, J_free) -> float:
+    """min over d of |r0 + [J_free J_own] d|^2 (nan if the shapes differ)."""
+    return predicted_step(r0, J_own, J_free)[0]
+
+
+def _stepped(cand, d_own):
+    """The candidate with its parameters' starts moved by the predicted step
+    (per unit of scale; clipped to the bounds); their neutral values stay
+    the priors, so the fit scores both starts."""
+    return dataclasses.replace(cand, params=tuple(
+        q.moved(q.start + float(x) * (abs(q.scale) or 1.0)) for q, x in zip(cand.params, d_own)))
 
 
 def screened(problem, cal, dec, cands, ex, run_tasks) -> list:
     """The candidates of ``cands`` whose predicted AICc comes within reach of
-    the best row's, most promising first (module doc)."""
+    the best row's, most promising first, each with the predicted step as a
+    second start (module doc)."""
     if not cands or not dec.rows:
         return []
     f0 = cal.fit
@@ -98,9 +114,17 @@ def screened(problem, cal, dec, cands, ex, run_tasks) -> list:
     for c, o in zip(cands, outs):
         if o is None:
             continue
-        S = predicted_cost(o[0], o[1], f0.jacobian)
+        S, d = predicted_step(o[0], o[1], f0.jacobian)
         a = st.aicc(S, f0.n, f0.k + len(c.params), dec.c_hat) if np.isfinite(S) else np.inf
         if a < reach:
-            scored.append((a, c))
+            scored.append((a, _stepped(c, d[f0.k:])))
     scored.sort(key=lambda t: t[0])
     return [c for _, c in scored[:MAX_FITS]]
+
+
+def one_start(problem):
+    """The problem with one refinement from the best of its few scored
+    starts (no Latin hypercube): a screened member starts where the step
+    predicts, so a multi-start is not needed to find its basin."""
+    s = dataclasses.replace(problem.settings, lhs=0, refine=1)
+    return dataclasses.replace(problem, settings=s)
