@@ -52,6 +52,24 @@ class FitTask:
     absorb: tuple | None = None
     budget_s: float | None = None
 
+    @property
+    def cost(self) -> float:
+        """Expected cost, for ordering: simulations per least-squares step
+        (one per fitted parameter, plus one) times the model's relative cost."""
+        return (len(self.free) + len(self.candidate.params) + 1) * relative_cost(
+            self.problem, self.candidate)
+
+
+def relative_cost(problem: Problem, candidate: Candidate) -> float:
+    """A candidate model's simulation cost relative to the nominal model's:
+    its hypotheses' declared ``relative_cost`` (1 when they declare none;
+    the largest of a pair's)."""
+    if candidate.hypothesis is None:
+        return 1.0
+    hyps = load_library(problem.library).HYPOTHESES
+    return max(float(getattr(hyps.get(h), "relative_cost", 1.0))
+               for h in candidate.hypothesis.split("+"))
+
 
 @dataclass
 class Starts:
@@ -432,6 +450,11 @@ class LooTask:
     held: str
     max_nfev: int
     budget_s: float | None = None
+
+    @property
+    def cost(self) -> float:
+        """Expected cost, for ordering (see :attr:`FitTask.cost`)."""
+        return (len(self.params) + 1) * relative_cost(self.problem, self.candidate)
 
 
 @dataclass
