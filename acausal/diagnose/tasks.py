@@ -339,16 +339,18 @@ class _Met(Exception):
         self.index = index
 
 
-def agree_tolerance(fit: Fit, names, sc):
+def agree_tolerance(fit: Fit, names, sc, last=False):
     """Per parameter: how far a point may lie from ``fit``'s and be the same
     point: one standard error of ``fit`` (a quarter of its 95 % interval),
-    at least :data:`AGREE_X` and at most :data:`AGREE_CAP` of the scale
-    (a direction the window does not determine, such as an effect that acts
-    only later in the record, keeps the starts apart)."""
+    at least :data:`AGREE_X` of the scale, and on a window before the
+    ``last`` at most :data:`AGREE_CAP` of it (a direction such a window does
+    not determine, such as an effect that acts only later in the record,
+    keeps the starts apart; on the whole record no later data can)."""
     se = np.array([(fit.ci95[n][1] - fit.ci95[n][0]) / 4 if n in fit.ci95 else 0.0
                    for n in names])
     se = np.nan_to_num(se, nan=0.0, posinf=np.inf)
-    return np.minimum(AGREE_CAP * sc, np.maximum(AGREE_X * sc, AGREE_SE * se))
+    tol = np.maximum(AGREE_X * sc, AGREE_SE * se)
+    return tol if last else np.minimum(AGREE_CAP * sc, tol)
 
 
 def same_point(x, cost, fit: Fit, names, tol) -> bool:
@@ -399,7 +401,7 @@ class Refiner:
         obj = Objective(self.pair, window(self.ds, w), self.names, budget_s=self.budget_s,
                         penalty=self.penalty, backend=s.integrator, jacobian=s.jacobian,
                         max_evals=full if w >= 1.0 else max(3, full // 3))
-        tols = [agree_tolerance(t, self.names, self.sc) for t in targets]
+        tols = [agree_tolerance(t, self.names, self.sc, w >= 1.0) for t in targets]
         obj.watch = self._watch(targets, tols) if targets else None
         try:
             fit = finish(obj, *refine_or_keep(obj, x, self.lo, self.hi, self.sc, s.max_nfev,
