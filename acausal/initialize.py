@@ -272,6 +272,11 @@ def _newton(fun, jac, z, max_iter=50):
         dz = _lstsq_scaled(jac(z), -r)
         step = 1.0
         for _ in range(30):
+            if np.all(np.abs(step * dz) <= 1e-13 * (1 + np.abs(z))):
+                # a step this short is below the convergence test's own size
+                # (below): z is converged; do not spend up to 30 residuals
+                # halving a step that round-off no longer lets reduce |r|
+                return z
             z2 = z + step * dz
             r2 = fun(z2)
             n2 = np.linalg.norm(r2)

@@ -176,6 +176,7 @@ class Objective:
         self.best_cost, self.best_x = np.inf, None
         self.timed = True
         self.recent = OrderedDict()   # x bytes -> weighted_residuals output (RECENT last)
+        self.watch = None             # watch(x, data cost) after each evaluation (may raise)
 
     def params(self, x):
         return {**self.fixed, **dict(zip(self.names, np.asarray(x, float).tolist()))}
@@ -202,6 +203,8 @@ class Objective:
             if self.size is None:
                 raise
             vec = np.full(self.size, PENALTY)
+        if self.watch is not None:
+            self.watch(np.asarray(x, float), float(vec @ vec))
         if self.penalty is not None:
             P, sc = self.penalty
             vec = np.concatenate([vec, P @ (np.asarray(x, float)[-P.shape[1]:] / sc)])

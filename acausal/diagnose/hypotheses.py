@@ -108,6 +108,7 @@ class Hypothesis:
     prefix = "hyp"
     distinguishing_experiment = ""
     fixed = {}          # name -> default of parameters added but not fitted
+    relative_cost = 1.0  # a simulation's cost against the nominal model's (task ordering)
 
     # -- interface ------------------------------------------------------------------
     def candidates(self, graph):
@@ -421,6 +422,9 @@ class FlexibleLink(Hypothesis):
     prefix = "hyp_fl"
     site_kinds = ("body",)
     fixed = {"T0": 1e-5, "r": 0.1, "zeta": 0.1}
+    # a new node and a stiff link (a degree of freedom, short time scales): its
+    # runs took 1.5-3x the nominal model's on the breaker (benchmarks/diagnose_speed.py)
+    relative_cost = 2.0
     law = ("the component is moved to a new node of mass r*m joined to the body (left "
            "with (1-r)*m) by a spring-damper with local period T_link = sqrt(T0^2 + T^2): "
            "k = 4 pi^2 m_red / T_link^2, d = 2 zeta_eff sqrt(k m_red), m_red = r (1-r) m, "

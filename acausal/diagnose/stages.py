@@ -105,10 +105,10 @@ def run_tasks(ex, fn, tasks, desc, progress, collect=None):
     plugs in here: results depend only on their task); a ``collect`` with
     ``get(task)`` (:class:`.resume.FitStore`) also gives the results of
     tasks that finished in an earlier, interrupted run, which are not
-    submitted again."""
+    submitted again. Tasks are submitted longest first (:func:`longest_first`)."""
     lookup = getattr(collect, "get", None)
     out = [lookup(t) if lookup is not None else None for t in tasks]
-    todo = [i for i, r in enumerate(out) if r is None]
+    todo = longest_first([i for i, r in enumerate(out) if r is None], tasks)
     futures = [ex.submit(fn, tasks[i]) for i in todo]
     index = {id(f): i for i, f in zip(todo, futures)}
     bar = None
@@ -127,6 +127,15 @@ def run_tasks(ex, fn, tasks, desc, progress, collect=None):
         if bar is not None:
             bar.close()
     return out
+
+
+def longest_first(indices, tasks):
+    """``indices`` of ``tasks`` ordered by decreasing expected cost (a task's
+    ``cost`` attribute, 1 without one; ties keep their order): the pool
+    hands tasks out in submission order, so the longest ones no longer
+    start last and leave a worker idle at the end of a stage (Graham's
+    longest-processing-time-first list scheduling)."""
+    return sorted(indices, key=lambda i: -float(getattr(tasks[i], "cost", 1.0)))
 
 
 # -- stage 1: calibrate ---------------------------------------------------------------------

@@ -52,6 +52,24 @@ class FitTask:
     absorb: tuple | None = None
     budget_s: float | None = None
 
+    @property
+    def cost(self) -> float:
+        """Expected cost, for ordering: simulations per least-squares step
+        (one per fitted parameter, plus one) times the model's relative cost."""
+        return (len(self.free) + len(self.candidate.params) + 1) * relative_cost(
+            self.problem, self.candidate)
+
+
+def relative_cost(problem: Problem, candidate: Candidate) -> float:
+    """A candidate model's simulation cost relative to the nominal model's:
+    its hypotheses' declared ``relative_cost`` (1 when they declare none;
+    the largest of a pair's)."""
+    if candidate.hypothesis is None:
+        return 1.0
+    hyps = load_library(problem.library).HYPOTHESES
+    return max(float(getattr(hyps.get(h), "relative_cost", 1.0))
+               for h in candidate.hypothesis.split("+"))
+
 
 @dataclass
 class Starts:
@@ -307,8 +325,43 @@ def penalty_of(cand):
     return np.asarray(cand.penalty, float), np.array([abs(p.scale) or 1.0 for p in cand.params])
 
 
-AGREE_X = 1e-2      # two refinements meet: every parameter within this many scales ...
+AGREE_X = 1e-2      # two refinements meet: every parameter within this many scales,
+AGREE_SE = 1.0      # ... or within this many standard errors of the earlier fit (the data
+AGREE_CAP = 0.1     # ... cannot tell the points apart), but never more than this many scales;
 # ... and S within max(0.5, 1e-3 S) (the converged-start rule of _summary)
+
+
+class _Met(Exception):
+    """A refinement reached the point of an earlier one (raised inside the optimiser)."""
+
+    def __init__(self, index):
+        super().__init__(index)
+        self.index = index
+
+
+def agree_tolerance(fit: Fit, names, sc, last=False):
+    """Per parameter: how far a point may lie from ``fit``'s and be the same
+    point: one standard error of ``fit`` (a quarter of its 95 % interval),
+    at least :data:`AGREE_X` of the scale, and on a window before the
+    ``last`` at most :data:`AGREE_CAP` of it (a direction such a window does
+    not determine, such as an effect that acts only later in the record,
+    keeps the starts apart; on the whole record no later data can)."""
+    se = np.array([(fit.ci95[n][1] - fit.ci95[n][0]) / 4 if n in fit.ci95 else 0.0
+                   for n in names])
+    se = np.nan_to_num(se, nan=0.0, posinf=np.inf)
+    tol = np.maximum(AGREE_X * sc, AGREE_SE * se)
+    return tol if last else np.minimum(AGREE_CAP * sc, tol)
+
+
+def same_point(x, cost, fit: Fit, names, tol) -> bool:
+    """The point ``x`` with data cost ``cost`` is ``fit``'s (S within the
+    converged-start tolerance, every parameter within ``tol``)."""
+    if not (fit.ok and np.isfinite(fit.cost) and np.isfinite(cost)):
+        return False
+    if abs(cost - fit.cost) > max(0.5, 1e-3 * min(cost, fit.cost)):
+        return False
+    xb = np.array([fit.values[n] for n in names])
+    return bool(np.all(np.abs(np.asarray(x, float) - xb) <= tol))
 
 
 @dataclass
@@ -318,12 +371,15 @@ class Refiner:
     third of the evaluations each), of one model on one dataset.
 
     :meth:`all` refines several starts. A later start whose refinement
-    meets an earlier one's on a window before the last (the same point: S
-    within the converged-start tolerance, every parameter within
-    :data:`AGREE_X` of its scale) would follow it from there: it takes that
-    refinement's final fit (as converged, with only its own simulations
-    counted) instead of repeating the longer windows. Refinements that do
-    not meet are carried to the end as before."""
+    meets an earlier one's on a window (the same point: S within the
+    converged-start tolerance, every parameter within one standard error of
+    the earlier fit or :data:`AGREE_X` of its scale, at most
+    :data:`AGREE_CAP` of it: :func:`agree_tolerance`) would follow it from
+    there: it takes that refinement's final fit (as converged, with only its
+    own simulations counted) instead of repeating the rest. The meeting is
+    checked at every evaluation of the optimiser, not only at the end of a
+    window, so a later start stops as soon as it reaches an earlier point.
+    Refinements that do not meet are carried to the end as before."""
 
     pair: tuple
     ds: object
@@ -336,15 +392,32 @@ class Refiner:
     budget_s: float | None = None
     penalty: object = None
 
-    def window_fit(self, w, x):
-        """The fit on window ``w`` from ``x``."""
+    def window_fit(self, w, x, targets=()):
+        """(fit on window ``w`` from ``x``, index of the ``targets`` fit it
+        met or None, simulations it ran); the fit is None when an
+        evaluation met a target."""
         s = self.settings
         full = s.evals_per_param * (len(self.names) + 1)
         obj = Objective(self.pair, window(self.ds, w), self.names, budget_s=self.budget_s,
                         penalty=self.penalty, backend=s.integrator, jacobian=s.jacobian,
                         max_evals=full if w >= 1.0 else max(3, full // 3))
-        return finish(obj, *refine_or_keep(obj, x, self.lo, self.hi, self.sc, s.max_nfev,
-                                           s.tol), self.lo)
+        tols = [agree_tolerance(t, self.names, self.sc, w >= 1.0) for t in targets]
+        obj.watch = self._watch(targets, tols) if targets else None
+        try:
+            fit = finish(obj, *refine_or_keep(obj, x, self.lo, self.hi, self.sc, s.max_nfev,
+                                              s.tol), self.lo)
+        except _Met as met:
+            return None, met.index, obj.n_sim
+        met = next((j for j, (t, tol) in enumerate(zip(targets, tols)) if same_point(
+            [fit.values[n] for n in self.names], fit.cost, t, self.names, tol)), None)
+        return fit, met, fit.n_sim
+
+    def _watch(self, targets, tols):
+        def watch(x, cost):
+            for j, (t, tol) in enumerate(zip(targets, tols)):
+                if same_point(x, cost, t, self.names, tol):
+                    raise _Met(j)
+        return watch
 
     def path(self, x, earlier=()):
         """The per-window fits from ``x`` (the last on the whole record), or
@@ -352,26 +425,15 @@ class Refiner:
         counts this path's own simulations on every window."""
         out, n_sim = [], 0
         for i, w in enumerate(self.windows):
-            fit = self.window_fit(w, x)
-            n_sim += fit.n_sim
-            out.append(fit)
-            met = next((p for p in earlier if i < len(p) - 1 and self.meets(fit, p[i])), None)
+            fit, met, used = self.window_fit(w, x, [p[i] for p in earlier])
+            n_sim += used
             if met is not None:
-                out = list(met[:i]) + [fit] + list(met[i + 1:])
+                out = list(earlier[met])
                 break
+            out.append(fit)
             x = np.array([fit.values[n] for n in self.names])
         out[-1] = dataclasses.replace(out[-1], n_sim=n_sim)
         return out
-
-    def meets(self, a: Fit, b: Fit) -> bool:
-        """``a`` and ``b`` (fits on the same window) are the same point."""
-        if not (a.ok and b.ok and np.isfinite(a.cost) and np.isfinite(b.cost)):
-            return False
-        if abs(a.cost - b.cost) > max(0.5, 1e-3 * min(a.cost, b.cost)):
-            return False
-        xa = np.array([a.values[n] for n in self.names])
-        xb = np.array([b.values[n] for n in self.names])
-        return bool(np.all(np.abs(xa - xb) <= AGREE_X * self.sc))
 
     def all(self, starts):
         """The final fit of each start's path, in order."""
@@ -390,6 +452,11 @@ class LooTask:
     held: str
     max_nfev: int
     budget_s: float | None = None
+
+    @property
+    def cost(self) -> float:
+        """Expected cost, for ordering (see :attr:`FitTask.cost`)."""
+        return (len(self.params) + 1) * relative_cost(self.problem, self.candidate)
 
 
 @dataclass
