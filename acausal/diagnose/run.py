@@ -43,7 +43,7 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
     called as each fit result arrives (a checkpoint store plugs in there).
     ``generic``: locate a discrepancy the library does not explain
     (:mod:`.locate`); ``pairs``: search pairs of causes when the best single
-    one leaves misfit (:func:`.stages.pair_candidates`); ``families``: fit
+    one leaves misfit (:func:`.stages.search_pairs`); ``families``: fit
     the other members of a competitive family (:mod:`.families`);
     ``profile``: profile-likelihood intervals where the linearised ones fail
     the check (:mod:`.intervals`); ``design``: the next experiment that

@@ -23,6 +23,7 @@ from ..calibrate import model_dataset
 from ..data import DataError
 from ..errors import AcausalError, DiagnosisError  # noqa: F401  (DiagnosisError re-exported)
 from ..modelfile import compile_file
+from . import pairsearch as ps
 from . import stats as st
 from .fitting import heldout_rms
 from .library import load_library
@@ -244,7 +245,6 @@ def search_pairs(problem: Problem, cal, dec, ex, progress=True, collect=None):
     pairs among the best singles (:func:`pair_candidates`) fitted, and the
     best single's pairs with every other candidate at another site
     screened, the best few fitted in full (:mod:`.pairsearch`)."""
-    from . import pairsearch as ps
     top = pair_candidates(problem, dec)
     if not top and load_library(problem.library).build_pair is None:
         return (), 0
