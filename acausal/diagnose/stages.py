@@ -476,20 +476,17 @@ def _untested_reasons(untested, best):
             for r in untested if r is not best][:3]
 
 
-def _acted_in_pairs(rows) -> set:
-    """Keys (hypothesis, location) of single causes whose parameters left
-    their neutral values in a fitted pair: untested alone (a free parameter
-    stood in for them), tested beside another cause."""
-    out = set()
-    for r in rows:
-        if "+" not in r.candidate.hypothesis:
-            continue
-        params = {p.name: p for p in r.candidate.params}
-        for h, loc, names in r.candidate.members():
-            if any(abs(r.fit.values[n] - params[n].prior) > 1e-3 * (abs(params[n].scale) or 1.0)
-                   for n in names):
-                out.add((h, loc))
-    return out
+def _acted_in(best) -> set:
+    """Keys (hypothesis, location) of the members of a best pair whose
+    parameters left their neutral values in it: a member that was not
+    tested alone (a free parameter stood in for it) acted there, and is
+    not a rival of the pair it belongs to."""
+    if best is None or "+" not in best.candidate.hypothesis:
+        return set()
+    params = {p.name: p for p in best.candidate.params}
+    return {(h, loc) for h, loc, names in best.candidate.members()
+            if any(abs(best.fit.values[n] - params[n].prior)
+                   > 1e-3 * (abs(params[n].scale) or 1.0) for n in names)}
 
 
 def _pair_reasons(best, rows):
@@ -541,7 +538,7 @@ def rank(ds, cal: Calibration, dec: Decision, cv: CrossValidation) -> Ranking:
     classes = st.equivalence_classes(
         [dict(aicc=r.aicc, heldout_rmse=r.heldout_rmse) for r in rows]) if rows else []
     runner = classes[1][0] if len(classes) > 1 else None
-    acted = _acted_in_pairs(rows)
+    acted = _acted_in(rows[0] if rows else None)
     untested = tuple(r for r in rows if not r.starts.tested and r.candidate.key not in acted)
     weak = []
     best = 0 if rows else None
