@@ -42,7 +42,7 @@ SCREEN_NFEV = 8       # least-squares iterations of a screening fit (the budget 
 
 
 @dataclass(frozen=True)
-class ScreenTask:
+class PairScreenTask:
     """Screen ``pair`` (the best single first, its parameters seeded from
     its fit; the partner second, at neutral) with the free parameters
     ``free`` (Param, start = the best single's fit); ``absorb`` = (names,
@@ -65,7 +65,7 @@ class Screened:
     error: str | None = None
 
 
-def screen_starts(task: ScreenTask, n_first: int):
+def screen_starts(task: PairScreenTask, n_first: int):
     """The starts over free + pair parameters: everything at its seed, the
     partner at neutral, then at :data:`SCREEN_LHS` points over its bounds."""
     params = list(task.free) + list(task.pair.params)
@@ -79,7 +79,7 @@ def screen_starts(task: ScreenTask, n_first: int):
     return out
 
 
-def screen_pair(task: ScreenTask) -> Screened:
+def screen_pair(task: PairScreenTask) -> Screened:
     """The screening fit of one pair (module doc); never raises."""
     p, pair = task.problem, task.pair
     params = list(task.free) + list(pair.params)
@@ -101,11 +101,11 @@ def screen_pair(task: ScreenTask) -> Screened:
 
 
 def screen_tasks(problem: Problem, best, pairs) -> list:
-    """One :class:`ScreenTask` per pair candidate (the best single first)."""
+    """One :class:`PairScreenTask` per pair candidate (the best single first)."""
     f = best.fit
     free = tuple(q.moved(f.values[q.name]) for q in problem.free)
     absorb = (list(f.names), f.jacobian)
-    return [ScreenTask(problem, c, free, absorb) for c in pairs]
+    return [PairScreenTask(problem, c, free, absorb) for c in pairs]
 
 
 def full_tasks(problem: Problem, cal, screened, budget) -> list:

@@ -8,7 +8,8 @@ simulation (the blind pair cases in test_blind_*.py run the search)."""
 import numpy as np
 
 from acausal.diagnose.fitting import Fit
-from acausal.diagnose.pairsearch import SCREEN_LHS, Screened, ScreenTask, keep, screen_starts
+from acausal.diagnose.pairsearch import SCREEN_LHS, PairScreenTask, Screened, keep, \
+    screen_starts
 from acausal.diagnose.problem import Candidate, Param, Problem
 from acausal.diagnose.stages import Row, _acted_in, partners
 from acausal.diagnose.tasks import Starts
@@ -63,7 +64,8 @@ def test_screening_starts_move_only_the_partner():
     pair = Candidate("h+g", "a+b", (Param("hyp_h.k", 2.0, 0.0, 10.0, 1.0, 0.0),
                                     Param("hyp_g.c", 0.0, -5.0, 5.0, 0.5, 0.0)))
     free = (Param("k.c", 51.0, 10.0, 100.0, 50.0, 50.0),)
-    task = ScreenTask(Problem("m.py", "", "lib", free), pair, free, ([], np.zeros((0, 0))))
+    task = PairScreenTask(Problem("m.py", "", "lib", free), pair, free,
+                          ([], np.zeros((0, 0))))
     pts = screen_starts(task, n_first=1)
     assert len(pts) == 1 + SCREEN_LHS
     assert list(pts[0]) == [51.0, 2.0, 0.0]
