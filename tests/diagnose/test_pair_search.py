@@ -8,8 +8,13 @@ simulation (the blind pair cases in test_blind_*.py run the search)."""
 import numpy as np
 
 from acausal.diagnose.fitting import Fit
-from acausal.diagnose.pairsearch import SCREEN_LHS, PairScreenTask, Screened, keep, \
-    screen_starts
+from acausal.diagnose.pairsearch import (
+    SCREEN_LHS,
+    PairScreenTask,
+    Screened,
+    keep,
+    screen_starts,
+)
 from acausal.diagnose.problem import Candidate, Param, Problem
 from acausal.diagnose.stages import Row, _acted_in, partners
 from acausal.diagnose.tasks import Starts
