@@ -24,6 +24,7 @@ from dataclasses import dataclass
 
 from .library import load_library
 from .problem import Candidate, Param
+from .screen import one_start, screened
 from .stages import fit_tasks, run_tasks
 from .tasks import fit_candidate
 
@@ -92,22 +93,47 @@ def member_candidates(problem, dec, index: FamilyIndex, done=()) -> list:
 
 def fit_members(problem, cal, dec, ex, progress=True, collect=None) -> tuple:
     """Stage: the other members of each competitive family, fitted at the
-    head's site with the free parameters starting from the head's fit (only
-    when a discrepancy is found: on data the model explains there is no
-    cause class to refine)."""
+    head's site with the free parameters starting from the head's fit, and
+    the members elsewhere that a one-step score screen finds promising
+    (:mod:`.screen`; only when a discrepancy is found: on data the model
+    explains there is no cause class to refine)."""
     if not dec.discrepancy:
         return ()
     index = family_index(problem.library)
     done = {r.candidate.key for r in dec.rows} | {r.candidate.key for r in dec.failed}
     pairs = member_candidates(problem, dec, index, done)
-    if not pairs:
-        return ()
     tasks = fit_tasks(problem, cal, [c for c, _ in pairs])
     tasks = [dataclasses.replace(t, free=tuple(p.moved(head.fit.values[p.name])
                                                for p in t.free))
              for t, (_, head) in zip(tasks, pairs)]
+    rest = other_members(problem, dec, index, done | {c.key for c, _ in pairs})
+    tasks += fit_tasks(one_start(problem), cal, screened(problem, cal, dec, rest, ex,
+                                                         run_tasks))
+    if not tasks:
+        return ()
     return tuple(run_tasks(ex, fit_candidate, tasks, "fitting family members", progress,
                            collect))
+
+
+def other_members(problem, dec, index: FamilyIndex, done) -> list:
+    """Every non-head member at every site where its head was fitted (the
+    user's choice of hypotheses and locations holds), not in ``done``
+    (keys), each from its own start."""
+    lib = load_library(problem.library)
+    graph = lib.graph_of(problem.model_path)
+    sites = {(index.family(r.candidate.hypothesis), r.candidate.location) for r in dec.rows
+             if r.candidate.hypothesis in index.of and index.is_head(r.candidate.hypothesis)}
+    out = []
+    for fam, ms in index.members.items():
+        for mid in ms[1:]:
+            h = lib.HYPOTHESES.get(mid)
+            if h is None:
+                continue
+            for loc in h.candidates(graph):
+                if (mid, loc) not in done and (fam, loc) in sites:
+                    out.append(Candidate(mid, loc, tuple(_seeded(s, {}, "")
+                                                         for s in h.params(graph, loc))))
+    return out
 
 
 PARSIMONY = 2.0       # AICc units: an extra parameter that gains less is uninformative

@@ -831,10 +831,13 @@ class ContactLaw(Hypothesis):
                 and graph.param(s.component, "e") < 0.999]
 
     def params(self, graph, location):
-        e0 = graph.param(graph.site("contact", location).component, "e")
-        return [self._spec("de", max(-0.5, 0.05 - e0), 1 - e0, "1",
+        comp = graph.site("contact", location).component
+        e0 = graph.param(comp, "e")
+        low, high = max(-0.5, 0.05 - e0), 1 - e0
+        de0 = min(max(_same_damping(comp.law, self.target, e0) - e0, low), high)
+        return [self._spec("de", low, high, "1",
                            f"change of the restitution of {location} under the {self.target} "
-                           "law", scale=0.05)]
+                           "law", initial=de0, scale=0.05)]
 
     def _extend(self, model, graph, hyp, location, vals):
         c = model.find(location)
@@ -844,6 +847,20 @@ class ContactLaw(Hypothesis):
 
 
 CONTACT_LAWS = ("hunt_crossley", "lankarani_nikravesh", "flores")
+
+
+def _same_damping(law, target, e):
+    """The restitution under ``target`` whose damping factor chi equals the
+    model's (``law`` at ``e``): where the member reproduces the nominal
+    contact, its neutral start (the laws' chi fall monotonically with e;
+    bisection on [0.01, 1])."""
+    from ..mechanics.contact import damping_chi
+    want = damping_chi(law, e)
+    lo, hi = 0.01, 1.0
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if damping_chi(target, mid) > want else (lo, mid)
+    return 0.5 * (lo + hi)
 
 
 HYPOTHESES = {h.id: h for h in (CoulombFriction(), QuadraticDamping(), ConstantLoad(),

@@ -536,7 +536,8 @@ def rank(ds, cal: Calibration, dec: Decision, cv: CrossValidation) -> Ranking:
                  for r in dec.rows)
     held0 = cv.heldout(NOMINAL.key, cal.nominal.loo)
     classes = st.equivalence_classes(
-        [dict(aicc=r.aicc, heldout_rmse=r.heldout_rmse) for r in rows]) if rows else []
+        [dict(aicc=r.aicc, heldout_rmse=r.heldout_rmse,
+              heldout=_heldout_vector(cv, r, ds)) for r in rows]) if rows else []
     runner = classes[1][0] if len(classes) > 1 else None
     acted = _acted_in(rows[0] if rows else None)
     untested = tuple(r for r in rows if not r.starts.tested and r.candidate.key not in acted)
@@ -553,6 +554,16 @@ def rank(ds, cal: Calibration, dec: Decision, cv: CrossValidation) -> Ranking:
     cause = best if (dec.discrepancy and rows and not weak) else None
     after = best if dec.discrepancy else None
     return Ranking(rows, classes, cause, after, runner, weak, untested, held0)
+
+
+def _heldout_vector(cv, row, ds):
+    """The row's held-out residuals (exact where refitted, else linearised),
+    experiment by experiment in the dataset's order; None when one is missing."""
+    got = cv.exact.get(row.candidate.key) or row.loo
+    parts = [got.get(e.name) for e in ds.experiments]
+    if not got or any(p is None for p in parts):
+        return None
+    return np.concatenate([np.atleast_1d(p) for p in parts])
 
 
 # -- stage 7: extend ---------------------------------------------------------------------

@@ -159,26 +159,51 @@ def discrepancy_decision(chi2: dict, runs: list, lr: dict | None, alpha: float =
 
 def equivalence_classes(rows: list, threshold: float = EQUIVALENCE,
                         heldout_threshold: float = EQUIVALENCE_HELDOUT) -> list:
-    """Group ranked rows (dicts with ``aicc``, ``heldout_rmse``, sorted by
-    aicc) into classes: a row joins the class of the best remaining row when
-    its AICc is within ``threshold`` of it (Burnham and Anderson: below 4
-    units both models keep substantial support), or within
-    ``heldout_threshold`` (the end of their "considerably less support"
-    range) with a held-out error no worse (the two criteria disagree: the
-    data do not decide). Returns lists of row indices, the first class
-    containing the best row."""
+    """Group ranked rows (dicts with ``aicc``, ``heldout_rmse`` and,
+    optionally, ``heldout`` = the held-out residual vector; sorted by aicc)
+    into classes: a row joins the class of the best remaining row when its
+    AICc is within ``threshold`` of it (Burnham and Anderson: below 4 units
+    both models keep substantial support), or within ``heldout_threshold``
+    (the end of their "considerably less support" range) with a held-out
+    error no worse (:func:`heldout_no_worse`: the two criteria disagree or
+    one cannot tell them apart: the data do not decide). Returns lists of
+    row indices, the first class containing the best row."""
     left = list(range(len(rows)))
     classes = []
     while left:
-        head = left[0]
-        a0, h0 = rows[head]["aicc"], rows[head]["heldout_rmse"]
+        head = rows[left[0]]
         cls = [i for i in left
-               if rows[i]["aicc"] - a0 <= threshold
-               or (rows[i]["aicc"] - a0 <= heldout_threshold
-                   and rows[i]["heldout_rmse"] <= h0 * (1 + 1e-9))]
+               if rows[i]["aicc"] - head["aicc"] <= threshold
+               or (rows[i]["aicc"] - head["aicc"] <= heldout_threshold
+                   and heldout_no_worse(rows[i], head))]
         classes.append(cls)
         left = [i for i in left if i not in cls]
     return classes
+
+
+HELDOUT_Z = 1.645     # one-sided 5 %: a held-out error this many standard errors worse is worse
+
+
+def heldout_no_worse(row: dict, best: dict) -> bool:
+    """Is ``row``'s held-out error no worse than ``best``'s? With both
+    held-out residual vectors (``heldout``, the same data in the same
+    order): a paired test on the squared errors, d_i = e_row,i^2 -
+    e_best,i^2, worse when mean(d) exceeds ``HELDOUT_Z`` standard errors,
+    the error of the mean widened for the lag-1 autocorrelation of d
+    (traces: n_eff = n (1 - rho)/(1 + rho); Diebold and Mariano, 1995, J.
+    Bus. Econ. Stat. 13:253, for comparing forecast errors). Without them,
+    a plain comparison of the RMS values."""
+    a, b = row.get("heldout"), best.get("heldout")
+    if a is None or b is None or len(a) != len(b) or len(a) < 3:
+        return row["heldout_rmse"] <= best["heldout_rmse"] * (1 + 1e-9)
+    d = np.asarray(a, float) ** 2 - np.asarray(b, float) ** 2
+    if not np.all(np.isfinite(d)):
+        return False
+    rho = _lag1(d)
+    rho = 0.0 if not math.isfinite(rho) else min(max(rho, 0.0), 0.99)
+    n_eff = d.size * (1 - rho) / (1 + rho)
+    se = float(np.std(d, ddof=1)) / math.sqrt(max(n_eff, 1.0))
+    return float(np.mean(d)) <= HELDOUT_Z * se
 
 
 def akaike_weights(aiccs) -> np.ndarray:

@@ -199,3 +199,34 @@ def test_confidence_of_a_positive_parameter_is_on_its_logarithm():
     assert ci["b1"] == pytest.approx((beta[1] * np.exp(-w), beta[1] * np.exp(w)), rel=1e-9)
     assert ci["b1"][0] > 0 and beta[1] - ci["b1"][0] < ci["b1"][1] - beta[1]
     assert ci["b0"][0] == pytest.approx(beta[0] - sps.t.ppf(0.975, 28) * sd[0], rel=1e-9)
+
+
+def test_heldout_no_worse_is_a_paired_test_with_autocorrelation():
+    rng = np.random.default_rng(5)
+    e = rng.normal(size=600)
+    b = dict(aicc=0.0, heldout_rmse=0.0, heldout=e + 0.2 * rng.normal(size=600))
+    tie = dict(aicc=4.5, heldout_rmse=0.0, heldout=e + 0.2 * rng.normal(size=600))
+    assert st.heldout_no_worse(tie, b)                  # equally good, other noise
+    assert not st.heldout_no_worse(dict(tie, heldout=1.3 * b["heldout"]), b)
+    # the same squared-error differences (mean 0.08, sd 0.52): in random
+    # order they are significant (z about 3.8); as one slow drift they are
+    # a handful of independent values (lag-1 correlation near 1)
+    one = dict(aicc=0.0, heldout_rmse=0.0, heldout=np.ones(600))
+    d = np.sort(0.08 + 0.9 * rng.uniform(-1.0, 1.0, 600))
+    assert st.heldout_no_worse(dict(tie, heldout=np.sqrt(1.0 + d)), one)
+    assert not st.heldout_no_worse(dict(tie, heldout=np.sqrt(1.0 + rng.permutation(d))), one)
+    # without residual vectors: the plain comparison of RMS values
+    assert st.heldout_no_worse(dict(aicc=1, heldout_rmse=1.0), dict(aicc=0, heldout_rmse=1.0))
+    assert not st.heldout_no_worse(dict(aicc=1, heldout_rmse=1.01),
+                                   dict(aicc=0, heldout_rmse=1.0))
+
+
+def test_equivalence_class_takes_a_rival_whose_heldout_error_is_no_worse_within_noise():
+    rng = np.random.default_rng(6)
+    e = rng.normal(size=500)
+    best = e + 0.2 * rng.normal(size=500)
+    rows = [dict(aicc=0.0, heldout_rmse=1.0, heldout=best),
+            dict(aicc=4.1, heldout_rmse=1.0, heldout=best[::-1]),   # the same errors
+            dict(aicc=5.0, heldout_rmse=1.4, heldout=1.4 * best),   # clearly worse
+            dict(aicc=30.0, heldout_rmse=0.9, heldout=0.9 * best)]  # too far by AICc
+    assert st.equivalence_classes(rows) == [[0, 1], [2], [3]]
