@@ -43,7 +43,7 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
     called as each fit result arrives (a checkpoint store plugs in there).
     ``generic``: locate a discrepancy the library does not explain
     (:mod:`.locate`); ``pairs``: search pairs of causes when the best single
-    one leaves misfit (:func:`.stages.pair_candidates`); ``families``: fit
+    one leaves misfit (:func:`.stages.search_pairs`); ``families``: fit
     the other members of a competitive family (:mod:`.families`);
     ``profile``: profile-likelihood intervals where the linearised ones fail
     the check (:mod:`.intervals`); ``design``: the next experiment that
@@ -62,8 +62,9 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
             fits += members
             dec = stages.decide(ds, cal, fits, alpha)
         if pairs and stages.pairs_needed(dec):
-            fits += stages.fit(problem, cal, stages.pair_candidates(problem, dec, ex=ex), ex,
-                               progress, collect)
+            got, clock["pair_screen_n_sim"] = _timed(clock, "pairs_s", stages.search_pairs,
+                                                     problem, cal, dec, ex, progress, collect)
+            fits += got
             dec = stages.decide(ds, cal, fits, alpha)
         cv = stages.cross_validate(problem, ds, cal, dec, ex, exact_cv, progress)
         rk = stages.rank(ds, cal, dec, cv)
@@ -83,7 +84,8 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
     if views:
         from .views import views as make_views
         shown = make_views(problem, cal, rk)
-    n_sim = cal.fit.n_sim + sum(r.fit.n_sim for r in fits if r.fit is not None)
+    n_sim = cal.fit.n_sim + sum(r.fit.n_sim for r in fits if r.fit is not None) + clock.get(
+        "pair_screen_n_sim", 0)
     timing = dict(fit_s=t_fit, cv_s=t_cv, n_candidates=len(cands), n_sim=n_sim,
                   total_s=time.perf_counter() - t0, **clock)
     return Diagnosis(problem, ds, cal, len(cands), dec, cv, rk, extended, shown,

@@ -36,7 +36,7 @@ from .fitting import weighted_residuals
 from .problem import Candidate, Problem
 from .tasks import dataset_of, model_of
 
-STEP = 1e-2       # of each parameter's scale (a score, as in .pairscore)
+STEP = 1e-2       # of each parameter's scale (a score only: the fits' own step is 1e-3)
 MARGIN = 10.0     # AICc units within which a predicted member is fitted, or ...
 SHARE = 0.2       # ... this share of the best candidate's AICc gain over the nominal
 MAX_FITS = 4      # screened members fitted at most

@@ -23,6 +23,7 @@ from ..calibrate import model_dataset
 from ..data import DataError
 from ..errors import AcausalError, DiagnosisError  # noqa: F401  (DiagnosisError re-exported)
 from ..modelfile import compile_file
+from . import pairsearch as ps
 from . import stats as st
 from .fitting import heldout_rms
 from .library import load_library
@@ -189,7 +190,7 @@ def fit_tasks(problem: Problem, cal: Calibration, cands) -> list:
     f0 = cal.fit
     free = tuple(Param(p.name, f0.values[p.name], p.low, p.high, p.scale, p.prior)
                  for p in problem.free)
-    budget = max(BUDGET_MIN_S, BUDGET_FACTOR * cal.nominal.wall_s)
+    budget = _budget(cal)
     absorb = (list(f0.names), f0.jacobian)
     return [FitTask(problem, c, free, absorb, budget) for c in cands]
 
@@ -210,35 +211,75 @@ def pairs_needed(dec) -> bool:
     return bool(dec.discrepancy and dec.rows and dec.c_hat > st.OVERDISPERSION)
 
 
-def pair_candidates(problem: Problem, dec, top=PAIR_TOP, ex=None) -> tuple:
+def pair_candidates(problem: Problem, dec, top=PAIR_TOP) -> tuple:
     """Pairs among the ``top`` best tested single candidates (two
     hypotheses, or one at two sites: the second's sub-model renamed), each
     parameter seeded from its single fit (its neutral value kept as the
-    prior); with an executor ``ex``, also the best single with each of the
-    ``PAIR_SCORED`` others that best explain what it leaves
-    (:mod:`.pairscore`)."""
+    prior). The best single's pairs with every other candidate are
+    screened by :func:`search_pairs` (:mod:`.pairsearch`)."""
     if load_library(problem.library).build_pair is None:
         return ()
-    tested = [r for r in dec.rows if "+" not in r.candidate.hypothesis and r.starts.tested]
-    singles = tested[:top]
+    singles = _singles(dec)[:top]
     ab = [(a, b) for i, a in enumerate(singles) for b in singles[i + 1:]]
-    if singles and ex is not None:
-        from .pairscore import complements
-        ab += [(singles[0], b) for b in complements(problem, singles[0], tested[top:], ex,
-                                                    PAIR_SCORED, run_tasks)]
     return tuple(_pair(a, b) for a, b in ab
                  if not (a.candidate.location == b.candidate.location
                          and a.candidate.hypothesis == b.candidate.hypothesis))
 
 
-PAIR_SCORED = 2       # + pairs of the best single with this many score-test complements
+def _singles(dec):
+    return [r for r in dec.rows if "+" not in r.candidate.hypothesis and r.starts.tested]
 
 
-def _pair(a, b) -> Candidate:
+def partners(dec, done) -> tuple:
+    """The best tested single's pairs with every other single candidate at
+    another site (tested alone or not: a free parameter may have absorbed
+    it), the partner at its neutral value; pairs whose key is in ``done``
+    are left out."""
+    singles = _singles(dec)
+    if not singles:
+        return ()
+    best = singles[0]
+    out = []
+    for r in dec.rows:
+        if "+" in r.candidate.hypothesis or r.candidate.location == best.candidate.location:
+            continue
+        c = _pair(best, r, neutral=True)
+        if c.key not in done:
+            out.append(c)
+    return tuple(out)
+
+
+def search_pairs(problem: Problem, cal, dec, ex, progress=True, collect=None):
+    """Stage 3b: (fits of the pairs, simulations spent screening): the
+    pairs among the best singles (:func:`pair_candidates`) fitted, and the
+    best single's pairs with every other candidate at another site
+    screened, the best few fitted in full (:mod:`.pairsearch`)."""
+    top = pair_candidates(problem, dec)
+    if not top and load_library(problem.library).build_pair is None:
+        return (), 0
+    tasks = fit_tasks(problem, cal, top)
+    others = partners(dec, {c.key for c in top})
+    screened = run_tasks(ex, ps.screen_pair, ps.screen_tasks(problem, _singles(dec)[0], others),
+                         "screening pairs", progress, collect) if others else []
+    best = _singles(dec)[0] if others else None
+    tasks += ps.full_tasks(problem, cal, ps.keep(best, screened) if best else [],
+                           tasks[0].budget_s if tasks else _budget(cal))
+    fits = run_tasks(ex, fit_candidate, tasks, "fitting pairs", progress, collect)
+    return tuple(fits), sum(r.n_sim for r in screened)
+
+
+def _budget(cal):
+    return max(BUDGET_MIN_S, BUDGET_FACTOR * cal.nominal.wall_s)
+
+
+def _pair(a, b, neutral=False) -> Candidate:
+    """The pair of rows ``a`` and ``b``, seeded from their fits (``b`` at
+    its neutral values when ``neutral``)."""
     ca, cb = a.candidate, b.candidate
     first = {p.name.split(".")[0] for p in ca.params}
     params = tuple(p.moved(a.fit.values[p.name]) for p in ca.params) + tuple(
-        _renamed(p, first).moved(b.fit.values[p.name]) for p in cb.params)
+        _renamed(p, first).moved(p.prior if neutral else b.fit.values[p.name])
+        for p in cb.params)
     return Candidate(f"{ca.hypothesis}+{cb.hypothesis}", f"{ca.location}+{cb.location}",
                      params)
 
@@ -444,6 +485,19 @@ def _untested_reasons(untested, best):
             for r in untested if r is not best][:3]
 
 
+def _acted_in(best) -> set:
+    """Keys (hypothesis, location) of the members of a best pair whose
+    parameters left their neutral values in it: a member that was not
+    tested alone (a free parameter stood in for it) acted there, and is
+    not a rival of the pair it belongs to."""
+    if best is None or "+" not in best.candidate.hypothesis:
+        return set()
+    params = {p.name: p for p in best.candidate.params}
+    return {(h, loc) for h, loc, names in best.candidate.members()
+            if any(abs(best.fit.values[n] - params[n].prior)
+                   > 1e-3 * (abs(params[n].scale) or 1.0) for n in names)}
+
+
 def _pair_reasons(best, rows):
     """A pair is named only when it beats each of its single members by
     STRONG AICc units and by held-out error."""
@@ -494,7 +548,8 @@ def rank(ds, cal: Calibration, dec: Decision, cv: CrossValidation) -> Ranking:
         [dict(aicc=r.aicc, heldout_rmse=r.heldout_rmse,
               heldout=_heldout_vector(cv, r, ds)) for r in rows]) if rows else []
     runner = classes[1][0] if len(classes) > 1 else None
-    untested = tuple(r for r in rows if not r.starts.tested)
+    acted = _acted_in(rows[0] if rows else None)
+    untested = tuple(r for r in rows if not r.starts.tested and r.candidate.key not in acted)
     weak = []
     best = 0 if rows else None
     if dec.discrepancy and rows:

@@ -1,0 +1,86 @@
+"""The pair search's partners (acausal/diagnose/pairsearch.py, stages.partners):
+the best tested single is paired with every other candidate at another site,
+tested alone or not, the partner at its neutral value; the screened pairs
+kept for full fits are the lowest in S below the best single; the
+screening's starts move only the partner; a member of the best pair that
+was not tested alone but acted in the pair is not its rival. Pure data, no
+simulation (the blind pair cases in test_blind_*.py run the search)."""
+import numpy as np
+
+from acausal.diagnose.fitting import Fit
+from acausal.diagnose.pairsearch import (
+    SCREEN_LHS,
+    PairScreenTask,
+    Screened,
+    keep,
+    screen_starts,
+)
+from acausal.diagnose.problem import Candidate, Param, Problem
+from acausal.diagnose.stages import Row, _acted_in, partners
+from acausal.diagnose.tasks import Starts
+
+
+def _row(hid, loc, values, tested=True, cost=1.0):
+    cand = Candidate(hid, loc, tuple(Param(k, 0.0, -10.0, 10.0, 1.0, 0.0)
+                                     for k in values if k.startswith("hyp")))
+    names = list(values)
+    fit = Fit(names, dict(values), cost, np.zeros(3), np.zeros((3, len(names))), [], [])
+    return Row(cand, fit, Starts(tested=tested), {}, 0.0, 1.0, 1.0)
+
+
+class _Dec:
+    def __init__(self, rows):
+        self.rows, self.failed = tuple(rows), ()
+
+
+def test_the_best_single_meets_every_candidate_at_another_site():
+    dec = _Dec([_row("constant_load", "m1", {"k.c": 52.0, "hyp_cl.F": 1.5}, tested=False),
+                _row("position_dependent_force", "coil", {"k.c": 51.0, "hyp_pf.k": 3.0}),
+                _row("coulomb_friction", "m1", {"k.c": 55.0, "hyp_cf.F": 0.0}, tested=False),
+                _row("quadratic_damping", "coil", {"k.c": 50.0, "hyp_qd.c": 0.2}),
+                _row("constant_load", "m2", {"k.c": 50.0, "hyp_cl.F": 4.0}),
+                _row("a+b", "m1+m2", {"k.c": 50.0, "hyp_a.x": 1.0, "hyp_b.y": 1.0})])
+    got = partners(dec, done={("position_dependent_force+constant_load", "coil+m2")})
+    # the best *tested* single leads; the same site and pairs already done are left out
+    assert [(c.hypothesis, c.location) for c in got] == [
+        ("position_dependent_force+constant_load", "coil+m1"),
+        ("position_dependent_force+coulomb_friction", "coil+m1")]
+    first, second = got[1].params
+    assert (first.name, first.start, first.prior) == ("hyp_pf.k", 3.0, 0.0)  # seeded from its fit
+    assert (second.name, second.start) == ("hyp_cf.F", 0.0)                # partner at neutral
+    # one hypothesis at two sites: the partner's sub-model is renamed
+    again = partners(_Dec([_row("constant_load", "m1", {"hyp_cl.F": 1.0}),
+                           _row("constant_load", "m2", {"hyp_cl.F": 2.0})]), done=set())
+    assert [p.name for p in again[0].params] == ["hyp_cl.F", "hyp_cl2.F"]
+    assert [p.start for p in again[0].params] == [1.0, 0.0]
+
+
+def test_screened_pairs_kept_lowest_first_and_below_the_best_single():
+    best = _row("h", "a", {"hyp_h.k": 1.0}, cost=100.0)
+    c = Candidate("h+g", "a+b", ())
+    got = [Screened(c, 90.0, {}, 6), Screened(c, 20.0, {}, 6), Screened(c, 150.0, {}, 6),
+           Screened(c, 5.0, {}, 6, error="ValueError: no"), Screened(c, np.inf, {}, 0),
+           Screened(c, 50.0, {}, 6)]
+    assert [r.cost for r in keep(best, got, n=2)] == [20.0, 50.0]
+    assert [r.cost for r in keep(best, got, n=9)] == [20.0, 50.0, 90.0]
+
+
+def test_screening_starts_move_only_the_partner():
+    pair = Candidate("h+g", "a+b", (Param("hyp_h.k", 2.0, 0.0, 10.0, 1.0, 0.0),
+                                    Param("hyp_g.c", 0.0, -5.0, 5.0, 0.5, 0.0)))
+    free = (Param("k.c", 51.0, 10.0, 100.0, 50.0, 50.0),)
+    task = PairScreenTask(Problem("m.py", "", "lib", free), pair, free,
+                          ([], np.zeros((0, 0))))
+    pts = screen_starts(task, n_first=1)
+    assert len(pts) == 1 + SCREEN_LHS
+    assert list(pts[0]) == [51.0, 2.0, 0.0]
+    for x in pts[1:]:
+        assert list(x[:2]) == [51.0, 2.0] and x[2] != 0.0 and -5.0 <= x[2] <= 5.0
+
+
+def test_a_member_of_the_best_pair_untested_alone_is_not_its_rival():
+    pair = _row("h+g", "a+b", {"k.c": 1.0, "hyp_h.k": 2.0, "hyp_g.c": 0.3})
+    assert _acted_in(pair) == {("h", "a"), ("g", "b")}
+    stayed = _row("h+g", "a+b", {"k.c": 1.0, "hyp_h.k": 2.0, "hyp_g.c": 0.0})
+    assert _acted_in(stayed) == {("h", "a")}
+    assert _acted_in(_row("h", "a", {"hyp_h.k": 2.0})) == set()
