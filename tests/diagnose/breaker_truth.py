@@ -38,7 +38,7 @@ from acausal.compile import compile_model
 from acausal.data import Dataset, Experiment, Instrument, Trace, write_dataset
 from acausal.mechanics.rotational import Torque
 from acausal.mechanics.translational import Force
-from acausal.modelfile import load_model_file
+from acausal.modelfile import compile_file, load_model_file
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 BREAKER = os.path.abspath(os.path.join(HERE, "..", "..", "models", "breaker_24kv.py"))
@@ -87,6 +87,8 @@ def _add(m, eff):
 def truth_model(effect=None, value=None):
     """(ModelFile, CompiledModel) of the breaker with the hidden effects."""
     eff = _effects(effect, value)
+    if not eff:               # the model file as every command compiles it (shared)
+        return compile_file(BREAKER)
     key = repr(sorted(eff.items()))
     if key not in _CACHE:
         mf = load_model_file(BREAKER)
@@ -96,11 +98,11 @@ def truth_model(effect=None, value=None):
     return _CACHE[key]
 
 
-def simulate(v, effect=None, value=None):
+def simulate(v, effect=None, value=None, backend=None):
     mf, cm = truth_model(effect, value)
     opts = mf.experiment.run_options(dense=True)
     opts.update(rtol=1e-10, atol=1e-13)
-    return cm.simulate(params={"v_impact": float(v)}, **opts)
+    return cm.simulate(params={"v_impact": float(v)}, backend=backend, **opts)
 
 
 def _grid(res):

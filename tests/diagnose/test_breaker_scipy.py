@@ -16,16 +16,22 @@ import breaker_scipy  # noqa: E402
 import breaker_truth  # noqa: E402
 
 
-def _agreement(v, effect=None):
-    ind, ref = breaker_scipy.simulate(v, effect), breaker_truth.simulate(v, effect)
+def _agreement(v, effect=None, backend=None, rtol=1e-10):
+    ind = breaker_scipy.simulate(v, effect, rtol=rtol)
+    ref = breaker_truth.simulate(v, effect, backend=backend)
     t = ref.t[ref.t < ind.t_release]
     errs = [np.max(np.abs(ind.at(t, s) - ref[s][:t.size])) / np.max(np.abs(ref[s]))
             for s in breaker_scipy.SIGNALS]
     return errs, ind.t_release - ref.t[-1]
 
 
+@pytest.mark.slow
 def test_independent_breaker_agrees_with_the_compiled_model():
-    errs, dt = _agreement(3.8)
+    """On the reference backend, and the scipy side at rtol 1e-8 (3.5e-9
+    relative measured, the release to 7e-12 s); the cases below run the
+    default backend at rtol 1e-10. Slow tier: 4 s in a fresh test run (it
+    compiles the breaker first), and the default tier is near its budget."""
+    errs, dt = _agreement(3.8, backend="sundae", rtol=1e-8)
     assert max(errs) < 1e-7
     assert abs(dt) < 1e-9
 
