@@ -72,7 +72,8 @@ def test_breaker_two_causes_at_two_sites(tmp_path):
     hook.body tau 0.986 and k 19998, hook.bh back to 0.2192, held-out
     35.7 -> 0.966; the pairs with a constant load at the hook and at the
     main shaft next (23 and 44 AICc units behind); screening 2304
-    simulations of 24510."""
+    simulations of 24510. On the independent scipy data (breaker_scipy.py,
+    2026-11-23): the same pair, held-out 35.66 -> 0.966, 248 s at load 1.5-2."""
     out, det, floors = _run(tmp_path, {"hook_coulomb": 1.0, "coil_slope": 2e4},
                             name="breaker pair")
     assert len(out["causes"]) == 2
