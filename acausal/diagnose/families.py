@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 from .library import load_library
 from .problem import Candidate, Param
-from .screen import one_start, screened
+from .screen import screened
 from .stages import fit_tasks, run_tasks
 from .tasks import fit_candidate
 
@@ -107,8 +107,9 @@ def fit_members(problem, cal, dec, ex, progress=True, collect=None) -> tuple:
                                                for p in t.free))
              for t, (_, head) in zip(tasks, pairs)]
     rest = other_members(problem, dec, index, done | {c.key for c, _ in pairs})
-    tasks += fit_tasks(one_start(problem), cal, screened(problem, cal, dec, rest, ex,
-                                                         run_tasks))
+    # a screened member starts where the step predicts: one refinement suffices
+    tasks += fit_tasks(problem.one_start(), cal, screened(problem, cal, dec, rest, ex,
+                                                          run_tasks))
     if not tasks:
         return ()
     return tuple(run_tasks(ex, fit_candidate, tasks, "fitting family members", progress,

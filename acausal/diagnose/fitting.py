@@ -118,6 +118,25 @@ def weighted_residuals(model, dataset, params, backend=None):
     return np.asarray(vec, float), groups, signals
 
 
+def scaled_columns(model, dataset, base, params, step, backend=None, r0=None, inside=True):
+    """(residuals at ``base``, forward-difference columns of ``params`` per
+    unit of each one's scale): one simulation of every experiment per column
+    (and one for ``r0`` unless given). The step is ``step`` of the scale,
+    taken backwards where it would pass the parameter's upper bound when
+    ``inside``. A failed run raises its AcausalError."""
+    if r0 is None:
+        r0 = weighted_residuals(model, dataset, base, backend)[0]
+    cols = []
+    for q in params:
+        scale = abs(q.scale) or 1.0
+        h = step * scale
+        if inside and base[q.name] + h > q.high:
+            h = -h
+        r = weighted_residuals(model, dataset, {**base, q.name: base[q.name] + h}, backend)[0]
+        cols.append((r - r0) / (h / scale))
+    return r0, (np.array(cols).T if cols else np.zeros((r0.size, 0)))
+
+
 def weighted_jacobian(model, dataset, params, names, backend=None):
     """(vector, d vector / d params over ``names``) as
     :func:`weighted_residuals`, the Jacobian from one simulation per

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import stats as st
-from .fitting import effective_k, heldout_rms
+from .fitting import effective_k, heldout_rms, scaled_columns
 from .generic import GENERIC, N_V, N_X, SMOOTH, hats, penalty, shape
 from .problem import Candidate, Param
 from .stages import fit_tasks, run_tasks
@@ -99,28 +99,6 @@ def generic_candidates(problem, n=1):
     return out
 
 
-def _one_start(problem):
-    """The term is linear in its weights: it is refined from zero weights
-    (with the calibrated free parameters) only; Latin-hypercube splines are
-    random wiggles that cost a refinement each and start nowhere useful."""
-    import dataclasses
-    s = dataclasses.replace(problem.settings, lhs=0, refine=1)
-    return dataclasses.replace(problem, settings=s)
-
-
-def _columns(pair, ds, base, params, backend):
-    """Forward-difference data Jacobian columns of ``params`` (per unit of
-    each one's scale) at ``base``."""
-    from .fitting import weighted_residuals
-    r0 = weighted_residuals(pair, ds, base, backend)[0]
-    cols = []
-    for q in params:
-        h = STEP * (abs(q.scale) or 1.0)
-        r = weighted_residuals(pair, ds, {**base, q.name: base[q.name] + h}, backend)[0]
-        cols.append((r - r0) / STEP)
-    return np.array(cols).T
-
-
 def degenerate_directions(Jg, Jf):
     """Orthonormal rows (in the term's scaled weights) of the directions the
     data cannot tell apart: the (near) null space of ``Jg`` and, for each
@@ -152,9 +130,11 @@ def pin_rows(task):
     p, cand = task.problem, task.candidate
     base = {**{q.name: q.start for q in task.free}, **{q.name: q.start for q in cand.params}}
     try:
-        ds, pair = dataset_of(p), model_of(p, cand)
-        Jg = _columns(pair, ds, base, cand.params, p.settings.integrator)
-        Jf = _columns(pair, ds, base, task.free, p.settings.integrator)
+        ds, pair, b = dataset_of(p), model_of(p, cand), p.settings.integrator
+        # no step backwards at an upper bound here (the term's weights start
+        # at 0, far inside theirs); the residuals at the base are shared
+        r0, Jg = scaled_columns(pair, ds, base, cand.params, STEP, b, inside=False)
+        Jf = scaled_columns(pair, ds, base, task.free, STEP, b, r0, inside=False)[1]
     except Exception:  # noqa: BLE001 - the fit reports the failure; nothing to pin
         return np.zeros((0, len(cand.params))), 0.0
     Q, s0 = degenerate_directions(Jg, Jf)
@@ -209,7 +189,10 @@ def locate(problem, cal, dec, rk, ex, progress=True, collect=None) -> Location:
     if not gens:
         return Location(skipped="the model has no body node")
     gens = _pinned(problem, cal, gens, ex, progress)
-    tasks = fit_tasks(_one_start(problem), cal, [g[0] for g in gens])
+    # the term is linear in its weights: refined from zero weights (with the
+    # calibrated free parameters) only; Latin-hypercube splines are random
+    # wiggles that cost a refinement each and start nowhere useful
+    tasks = fit_tasks(problem.one_start(), cal, [g[0] for g in gens])
     results = run_tasks(ex, fit_candidate, tasks, "locating", progress, collect)
     n = cal.fit.n
     terms = sorted((_term(r, n, dec.c_hat, g[1], g[2]) for r, g in zip(results, gens) if r.ok),

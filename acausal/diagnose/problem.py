@@ -2,6 +2,7 @@
 how hard (no state: every stage takes these and returns a new dataclass)."""
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 from dataclasses import dataclass, field
@@ -149,3 +150,10 @@ class Problem:
     @property
     def free_names(self):
         return [p.name for p in self.free]
+
+    def one_start(self) -> "Problem":
+        """The problem with its fits refined once from the best of their few
+        scored starts (no Latin hypercube): for a candidate whose start
+        already lies in the right basin."""
+        return dataclasses.replace(self, settings=dataclasses.replace(
+            self.settings, lhs=0, refine=1))

@@ -32,7 +32,7 @@ import numpy as np
 
 from ..errors import AcausalError
 from . import stats as st
-from .fitting import weighted_residuals
+from .fitting import scaled_columns
 from .problem import Candidate, Problem
 from .tasks import dataset_of, model_of
 
@@ -58,18 +58,10 @@ def start_columns(task: ScreenTask):
     p, cand = task.problem, task.candidate
     base = {**dict(task.free), **{q.name: q.start for q in cand.params}}
     try:
-        ds, pair = dataset_of(p), model_of(p, cand)
-        r0 = weighted_residuals(pair, ds, base, p.settings.integrator)[0]
-        cols = []
-        for q in cand.params:
-            h = STEP * (abs(q.scale) or 1.0)
-            h = h if base[q.name] + h <= q.high else -h
-            r = weighted_residuals(pair, ds, {**base, q.name: base[q.name] + h},
-                                   p.settings.integrator)[0]
-            cols.append((r - r0) / (h / (abs(q.scale) or 1.0)))
+        return scaled_columns(model_of(p, cand), dataset_of(p), base, cand.params, STEP,
+                              p.settings.integrator)
     except AcausalError:
         return None
-    return r0, np.array(cols).T
 
 
 def predicted_step(r0, J_own, J_free):
@@ -83,11 +75,6 @@ def predicted_step(r0, J_own, J_free):
     d = np.linalg.lstsq(A, -r0, rcond=None)[0]
     r = r0 + A @ d
     return float(r @ r), d
-
-
-def predicted_cost(r0, J_own, J_free) -> float:
-    """min over d of |r0 + [J_free J_own] d|^2 (nan if the shapes differ)."""
-    return predicted_step(r0, J_own, J_free)[0]
 
 
 def _stepped(cand, d_own):
@@ -120,11 +107,3 @@ def screened(problem, cal, dec, cands, ex, run_tasks) -> list:
             scored.append((a, _stepped(c, d[f0.k:])))
     scored.sort(key=lambda t: t[0])
     return [c for _, c in scored[:MAX_FITS]]
-
-
-def one_start(problem):
-    """The problem with one refinement from the best of its few scored
-    starts (no Latin hypercube): a screened member starts where the step
-    predicts, so a multi-start is not needed to find its basin."""
-    s = dataclasses.replace(problem.settings, lhs=0, refine=1)
-    return dataclasses.replace(problem, settings=s)

@@ -386,9 +386,13 @@ class CrossValidation:
 
     exact: dict = field(default_factory=dict)
 
+    def residuals(self, key, linear):
+        """Experiment -> held-out residuals of ``key``: exact where refitted,
+        else ``linear`` (the linearised ones)."""
+        return self.exact.get(key) or linear
+
     def heldout(self, key, linear):
-        got = self.exact.get(key)
-        return heldout_rms(got) if got else heldout_rms(linear)
+        return heldout_rms(self.residuals(key, linear))
 
 
 def _loo_tasks(problem, ds, jobs, budget):
@@ -568,7 +572,7 @@ def rank(ds, cal: Calibration, dec: Decision, cv: CrossValidation) -> Ranking:
 def _heldout_vector(cv, row, ds):
     """The row's held-out residuals (exact where refitted, else linearised),
     experiment by experiment in the dataset's order; None when one is missing."""
-    got = cv.exact.get(row.candidate.key) or row.loo
+    got = cv.residuals(row.candidate.key, row.loo)
     parts = [got.get(e.name) for e in ds.experiments]
     if not got or any(p is None for p in parts):
         return None
