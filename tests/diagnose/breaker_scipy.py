@@ -3,8 +3,9 @@ written from the research report's equations (docs/breaker_model.md
 section 2) with scipy. It imports nothing of the project's compiler, model
 file or component library, so a bug there shows as a disagreement with
 this file (tests/diagnose/test_breaker_scipy.py) and cannot hide in the
-blind cases' data. The hidden effects are those of breaker_truth.py, and
-it offers the same interface (``simulate``, ``write``, ``effect_floors``).
+blind cases' data. The hidden effects are those of breaker_truth.py; it
+offers what tests/diagnose/blind.py's runner needs (``write``,
+``effect_floors``) and ``simulate``.
 
 Sign convention: docs/breaker_model.md section 1 (the report's own). The
 armature's position s starts at GAP0 and moves along -s at v_impact; the
@@ -61,6 +62,7 @@ RATE = 50e3
 NOISE = {"hook.phi": 5e-5, "armature.mass.s": 2e-6}
 RESOLUTION = {"hook.phi": 4.8e-5, "armature.mass.s": 1e-6}
 SIGNALS = ("hook.phi", "armature.mass.s")
+STATE = {"armature.mass.s": 0, "armature.mass.v": 1, "hook.phi": 2, "hook.body.w": 3}  # y's order
 
 
 def _theta3(t1):
@@ -161,12 +163,11 @@ class Run:
         self.t_release = self.t[-1]
 
     def __getitem__(self, name):
-        return {"armature.mass.s": self.y[0], "armature.mass.v": self.y[1],
-                "hook.phi": self.y[2], "hook.body.w": self.y[3]}[name]
+        return self.y[STATE[name]]
 
     def at(self, times, name):
         """``name`` at ``times`` from each segment's dense output."""
-        idx = {"armature.mass.s": 0, "armature.mass.v": 1, "hook.phi": 2, "hook.body.w": 3}[name]
+        idx = STATE[name]
         out = np.empty(len(times))
         for i, t in enumerate(times):
             p = next((q for q in self.pieces if t <= q.t[-1]), self.pieces[-1])

@@ -1,15 +1,11 @@
-"""Truth generator for blind cases on the breaker (models/breaker_24kv.py).
-
-NOT an independent simulator: an independent scipy truth of the breaker
-(armature, contact events, hook, four-bar and main shaft) was not written
-this session. The truth is the project's model file plus hidden effects
-written here, in the test folder, as laws of the mechanics library's
-generic sources (``Torque``/``Force`` with a law written in this file),
-never with the diagnosis library's hypothesis code
-(acausal/diagnose/hypotheses.py); the Hunt-Crossley case switches the
-model's contact from its Lankarani-Nikravesh damping to the Hunt-Crossley
-law. It therefore shares the compiler and the component library with the
-model it tests, and a bug there would not be caught by these cases.
+"""The breaker (models/breaker_24kv.py) with the blind cases' hidden
+effects, compiled by acausal: the reference the independent simulator
+(tests/diagnose/breaker_scipy.py, which writes the blind cases' data) is
+checked against in tests/diagnose/test_breaker_scipy.py. Until 2026-11-23
+it also wrote those data; it is not independent: the effects are laws of
+the mechanics library's generic sources (``Torque``/``Force`` with a law
+written in this file, never the diagnosis library's hypothesis code), so
+it shares the compiler and the component library with the model.
 
 Hidden effects (several at once as a dict {effect: value}):
 
@@ -23,31 +19,18 @@ Hidden effects (several at once as a dict {effect: value}):
 * ``hunt_crossley``: the contact's damping follows Hunt-Crossley
   (chi = 3 (1 - e) / 2) instead of the model's Lankarani-Nikravesh (value:
   the restitution e of the truth's law).
-
-The hook angle and the armature's position are sampled at RATE Hz from the
-first contact to the release, Gaussian noise added and rounded to the
-sensors' resolution: a finer instrument than tests/diagnose/test_diagnose.py's
-breaker set-up, so that effects within the library's bounds reach 50 floors.
 """
 import os
 
-import numpy as np
 import sympy as sp
 
 from acausal.compile import compile_model
-from acausal.data import Dataset, Experiment, Instrument, Trace, write_dataset
 from acausal.mechanics.rotational import Torque
 from acausal.mechanics.translational import Force
 from acausal.modelfile import compile_file, load_model_file
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 BREAKER = os.path.abspath(os.path.join(HERE, "..", "..", "models", "breaker_24kv.py"))
-V_IMPACT = (3.3, 3.5, 3.8, 4.0, 4.2, 4.5)
-RATE = 50e3
-# a 17-bit encoder on the hook (4.8e-5 rad counts) and a 1 um travel sensor
-NOISE = {"hook.phi": 5e-5, "armature.mass.s": 2e-6}
-RESOLUTION = {"hook.phi": 4.8e-5, "armature.mass.s": 1e-6}
-SIGNALS = ("hook.phi", "armature.mass.s")
 W_T = 40.0          # hook speed at which the threshold torque sets in [rad/s]
 GAP0 = 1e-6         # the armature's start position (models/breaker_24kv.py)
 _CACHE = {}
@@ -103,39 +86,3 @@ def simulate(v, effect=None, value=None, backend=None):
     opts = mf.experiment.run_options(dense=True)
     opts.update(rtol=1e-10, atol=1e-13)
     return cm.simulate(params={"v_impact": float(v)}, backend=backend, **opts)
-
-
-def _grid(res):
-    return np.arange(0.0, res.t[-1] + 1e-15, 1.0 / RATE)
-
-
-def write(folder, effect=None, value=None, seed=0, speeds=V_IMPACT):
-    """Write a dataset: one experiment per impact speed, both signals traced."""
-    rng = np.random.default_rng(seed)
-    exps = []
-    for i, v in enumerate(speeds):
-        res = simulate(v, effect, value)
-        t = _grid(res)
-        cols = {}
-        for s in SIGNALS:
-            z = np.interp(t, res.t, res[s]) + rng.normal(0.0, NOISE[s], t.shape)
-            cols[s] = RESOLUTION[s] * np.round(z / RESOLUTION[s])
-        exps.append(Experiment(f"B{i + 1}", {"v_impact": float(v)}, {}, Trace(t, cols)))
-    inst = {s: Instrument(s, RESOLUTION[s], NOISE[s]) for s in SIGNALS}
-    write_dataset(folder, Dataset(None, exps, inst),
-                  {"time": "ms", "hook.phi": "deg", "armature.mass.s": "mm"})
-    return folder
-
-
-def effect_floors(effect, value, speeds=V_IMPACT):
-    """RMS change the hidden effect makes to the sampled signals (on the
-    truth's grid; the nominal run held at its release state past its
-    release), in noise floors."""
-    acc = []
-    for v in speeds:
-        res, ref = simulate(v, effect, value), simulate(v)
-        t = _grid(res)
-        for s in SIGNALS:
-            floor = np.sqrt(NOISE[s] ** 2 + RESOLUTION[s] ** 2 / 12)
-            acc.append((np.interp(t, res.t, res[s]) - np.interp(t, ref.t, ref[s])) / floor)
-    return float(np.sqrt(np.mean(np.concatenate(acc) ** 2)))
