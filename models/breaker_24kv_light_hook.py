@@ -26,7 +26,8 @@ Run: ``acausal simulate models/breaker_24kv_light_hook.py --plot FILE``.
 """
 from breaker_24kv import CONDITIONS
 from breaker_24kv import (BH_CAL, FREE_PARAMETERS, K_CAL, MEASURES, build,
-                         release_experiment, t_first_contact)
+                         release_experiment, t_first_contact,
+                         t_release)
 
 from acausal import Measure
 from acausal.mechanics import contact as ct
@@ -55,7 +56,7 @@ def plot(res, path):
     from acausal.plot import plot_result
     t0 = t_first_contact(res)
     imp = ct.impacts(res, "contact")
-    t_rel = res.event_times("release")[0]
+    t_rel = t_release(res)
     s3 = float(res["hook.s3"][0])
     marks = [(i.t_release, f"contact {k + 1} end") for k, i in enumerate(imp)
              if i.t_release == i.t_release]

@@ -28,7 +28,8 @@ import math
 import sympy as sp
 from breaker_24kv import CONDITIONS
 from breaker_24kv import (BH_CAL, FREE_PARAMETERS, GAP0, K_CAL, MEASURES, MainShaft,
-                         THETA1_0, TriggerHook, release_experiment, t_first_contact)
+                         THETA1_0, TriggerHook, release_experiment, t_first_contact,
+                         t_release)
 
 from acausal import Measure, Model, guess
 from acausal.mechanics import contact as ct
@@ -116,7 +117,7 @@ def plot(res, path):
     from acausal.plot import plot_result
     t0 = t_first_contact(res)
     imp = ct.impacts(res, "contact")
-    t_rel = res.event_times("release")[0]
+    t_rel = t_release(res)
     s3 = float(res["hook.s3"][0])
     marks = [(i.t_release, f"contact {k + 1} end") for k, i in enumerate(imp)
              if i.t_release == i.t_release]

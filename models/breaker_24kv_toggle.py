@@ -39,7 +39,7 @@ import math
 
 from breaker_24kv import (BH_CAL, CONDITIONS, FREE_PARAMETERS, K_CAL, MEASURES, THETA1_0,
                           Armature, MainShaft, TriggerHook, release_experiment,
-                          t_first_contact)
+                          t_first_contact, t_release)
 from breaker_24kv_planar import TABLE1
 
 from acausal import Measure, Model
@@ -122,7 +122,7 @@ def plot(res, path):
     from acausal.plot import plot_result
     t0 = t_first_contact(res)
     imp = ct.impacts(res, "contact")[0]
-    t_rel = res.event_times("release")[0]
+    t_rel = t_release(res)
     return plot_result(
         res, ["contact.fc", "hook.phi", "cam.pin_a.axis.tau", "hook.body.w"], path,
         title=f"toggle latch, v_impact = {ct.impact_velocity(res, 'contact'):.2f} m/s: contact "

@@ -32,7 +32,8 @@ import math
 
 from breaker_24kv import CONDITIONS
 from breaker_24kv import (Armature, BH_CAL, FREE_PARAMETERS, K_CAL, MEASURES, MainShaft,
-                         THETA1_0, TriggerHook, release_experiment, t_first_contact)
+                         THETA1_0, TriggerHook, release_experiment, t_first_contact,
+                         t_release)
 
 from acausal import Measure, Model, guess
 from acausal.mechanics import contact as ct
@@ -129,7 +130,7 @@ def plot(res, path):
     import numpy as np
     from acausal.plot import plot_result
     t0 = t_first_contact(res)
-    t_rel = res.event_times("release")[0]
+    t_rel = t_release(res)
     s3 = float(res["hook.s3"][0])
     b1 = float(res["trip_lever.b1"][0])
     n1, n2 = ct.n_impacts(res, "contact"), ct.n_impacts(res, "latch_contact")
