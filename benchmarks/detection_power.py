@@ -62,7 +62,7 @@ def run_case(model, hyp, effect, seed, library, quick):
         _, _, cands = candidates(setup["path"], library, [hyp])
         locs = [l for h, l, _ in cands]
         loc = locs[int(rng.integers(len(locs)))]
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     with tempfile.TemporaryDirectory() as tmp:
         kw = {k: v for k, v in setup.items() if k != "path"}
         truth = synthesize(setup["path"], os.path.join(tmp, "data"), hypothesis=hyp,
@@ -80,7 +80,8 @@ def run_case(model, hyp, effect, seed, library, quick):
                 named=hyp is not None and out["cause"] == hyp and out["location"] == loc,
                 right=bool(right and out["discrepancy"]),
                 weak=out["discrepancy"] and out["cause"] is None,
-                cause=out["cause"], wall_s=time.perf_counter() - t0)
+                cause=out["cause"], wall_s=time.perf_counter() - t0,
+                cpu_s=time.process_time() - c0)
 
 
 def job_list(args, hyps, effects):
@@ -195,6 +196,15 @@ def _write(args, results, hyps, effects, wall, n_jobs, unsited=()):
     return table
 
 
+def _cpu_note(results):
+    """The cases' CPU time (this process; the diagnosis runs serially in it),
+    which a busy or niced run's wall time does not show."""
+    cpu = [r["cpu_s"] for r in results if r.get("cpu_s") is not None]
+    if not cpu:
+        return ""
+    return f"; CPU per case {np.mean(cpu):.0f} s (total {sum(cpu) / 60:.0f} min)"
+
+
 def render(results, hyps, effects, args, wall, n_jobs=None, unsited=()):
     n_jobs = len(results) if n_jobs is None else n_jobs
     L = [f"Detection power on `{args.model}` ({args.seeds} seeds per cell, "
@@ -213,7 +223,8 @@ def render(results, hyps, effects, args, wall, n_jobs=None, unsited=()):
     load = os.getloadavg()
     L.insert(1, f"Machine load (1/5/15 min) when written: {load[0]:.1f}/{load[1]:.1f}/"
              f"{load[2]:.1f} on {os.cpu_count()} CPUs; mean wall per case "
-             f"{np.mean([r['wall_s'] for r in results]) if results else float('nan'):.0f} s.")
+             f"{np.mean([r['wall_s'] for r in results]) if results else float('nan'):.0f} s"
+             + _cpu_note(results) + ".")
     L.append("| hypothesis | " + " | ".join(f"effect {e:g}" for e in effects) + " |")
     L.append("|---|" + "---|" * len(effects))
     for h in hyps:
