@@ -248,7 +248,7 @@ class CompiledModel:
         ``sparse``): the rows the initialisation adds for fixed starts
         (generated with the other callbacks, non-zeros only)."""
         n, ns = len(self.dae.y), self.dae.n_states
-        n_fixed = sum(1 for name in self.var_names if self.flat.variables[name].start.fixed)
+        n_fixed = len(self._start_plan()[0])
         npar = len(self.param_syms)
         fill = self._fixjac
 
@@ -304,13 +304,8 @@ class CompiledModel:
         ``starts`` (name -> value, see :meth:`split_overrides`) replaces the
         declared ones."""
         starts = starts or {}
-        out = []
-        for k, name in enumerate(self.var_names):
-            st = self.flat.variables[name].start
-            if st.fixed:
-                value = starts[name] if name in starts else self._eval_start(st.value, p)
-                out.append((k, float(value), name))
-        return out
+        return [(k, float(starts[name]) if name in starts else self._start_value(value, p),
+                 name) for k, name, value in self._start_plan()[0]]
 
     def guess_vector(self, p, starts=None):
         """Initial guess of y from the start values of the variables (with
@@ -318,22 +313,59 @@ class CompiledModel:
         alias ``x = sign*root + off``)."""
         starts = starts or {}
         y = np.zeros(len(self.dae.y))
-        for i, s in enumerate(self.dae.y):
-            base, k = base_and_order(s)
-            info = self.flat.variables.get(base.name)
-            if k != 0 or info is None:
-                continue
-            via = self._root_via.get(base)
-            if base.name in starts:
-                y[i] = starts[base.name]
+        for i, name, via, value, propagated in self._start_plan()[1]:
+            if name in starts:
+                y[i] = starts[name]
             elif via is not None and via[0] in starts:
-                y[i] = (starts[via[0]] - self._eval_start(via[2], p)) / via[1]
+                y[i] = (starts[via[0]] - self._start_value(via[2], p)) / via[1]
+            elif propagated is not None:
+                y[i] = propagated
             else:
-                st = self._root_starts.get(base, info.start)
-                y[i] = self._eval_start(st.value, p)
-                if base in self._propagated:
-                    y[i] = self._propagated[base]
+                y[i] = self._start_value(value, p)
         return y
+
+    def _start_plan(self):
+        """(fixed, slots), made once per model: ``fixed`` the (index in
+        var_names, name, start value) of each fixed start, ``slots`` the
+        (slot, variable name, alias (name, sign, offset) or None, start
+        value, propagated value or None) of each slot that is a variable
+        itself (not a derivative), for :meth:`fixed_starts` and
+        :meth:`guess_vector` (which run at every simulation's start). Start
+        values are floats, or expressions of parameters (evaluated then)."""
+        plan = self.__dict__.get("_start_plans")
+        if plan is None:
+            fixed = [(k, name, self._start_form(self.flat.variables[name].start.value))
+                     for k, name in enumerate(self.var_names)
+                     if self.flat.variables[name].start.fixed]
+            slots = []
+            for i, s in enumerate(self.dae.y):
+                base, k = base_and_order(s)
+                info = self.flat.variables.get(base.name)
+                if k != 0 or info is None:
+                    continue
+                via = self._root_via.get(base)
+                if via is not None:
+                    via = (via[0], via[1], self._start_form(via[2]))
+                st = self._root_starts.get(base, info.start)
+                slots.append((i, base.name, via, self._start_form(st.value),
+                              self._propagated.get(base)))
+            plan = self._start_plans = (fixed, slots)
+        return plan
+
+    @staticmethod
+    def _start_form(value):
+        """A start value as :meth:`_start_plan` keeps it: a float, or the
+        expression when it depends on parameters."""
+        if isinstance(value, sp.Basic) and not value.is_number:
+            return value
+        return float(value)
+
+    def _start_value(self, value, p):
+        """A start value as :meth:`_start_form` keeps it, at parameters ``p``."""
+        if type(value) is float:
+            return value
+        fn = self._start_fns.get(value)
+        return self._eval_start(value, p) if fn is None else float(fn(p))
 
     def state_guess_order(self):
         """State slots in the order their guesses are imposed when the fixed

@@ -15,24 +15,10 @@ class EventState:
 
     def _find(self, sym):
         name = getattr(sym, "name", sym)
-        for j, dsc in enumerate(self.cm.discretes):
-            if dsc.symbol.name == name:
-                return "d", j
-        if name in self._index():
-            return "v", self._index()[name]
-        for j, prm in enumerate(self.cm.params):
-            if prm.name == name:
-                return "p", j
-        for s, expr in self.cm._subs.items():   # a parameter bound to others
-            if s.name == name:
-                return "b", expr
-        raise ModelError(f"event action asked for {name!r}, which is not in the model")
-
-    def _index(self):
-        idx = getattr(self, "_idx", None)
-        if idx is None:
-            idx = self._idx = {n: k for k, n in enumerate(self.cm.var_names)}
-        return idx
+        hit = _names(self.cm).get(name)
+        if hit is None:
+            raise ModelError(f"event action asked for {name!r}, which is not in the model")
+        return hit
 
     def __getitem__(self, sym):
         kind, j = self._find(sym)
@@ -47,3 +33,22 @@ class EventState:
         if self.d[j] != value:
             self.d[j] = float(value)
             self.changed = True
+
+
+def _names(cm):
+    """name -> ("d", discrete index) | ("v", index in var_names) | ("p",
+    parameter index) | ("b", expression of a parameter bound to others),
+    made once per model; a name in several kinds resolves in that order."""
+    index = cm.__dict__.get("_event_names")
+    if index is None:
+        index = {}
+        for s, expr in cm._subs.items():
+            index[s.name] = ("b", expr)
+        for j, prm in enumerate(cm.params):
+            index[prm.name] = ("p", j)
+        for k, n in enumerate(cm.var_names):
+            index[n] = ("v", k)
+        for j, dsc in enumerate(cm.discretes):
+            index[dsc.symbol.name] = ("d", j)
+        cm._event_names = index
+    return index

@@ -85,24 +85,27 @@ class _InitialSystem:
     def check(self, z):
         """:func:`_check` of the point ``z`` (an InitializationError naming
         what it violates)."""
-        _check(self.cm, self.residual(z), self.jac(z), z, self.fixed, self.n)
+        if self._c_check(z) is not True:
+            _check(self.cm, self.residual(z), self.jac(z), z, self.fixed, self.n)
 
     def consistent(self, z):
-        return _consistent(self.cm, self.residual(z), self.jac(z), z, self.fixed, self.n)
+        ok = self._c_check(z)
+        if ok is NotImplemented:
+            return _consistent(self.cm, self.residual(z), self.jac(z), z, self.fixed, self.n)
+        return ok
+
+    def _c_check(self, z):
+        """The backend's own consistency test (``cb.init_check``, the compiled
+        backend's C: the same test), else NotImplemented."""
+        fast = getattr(self.cb, "init_check", None)
+        return NotImplemented if fast is None else fast(self.t0, z, self.fixed)
 
 
 def _solve_initial(cm, p, d, cb, t0, starts=None):
     """initial_point without the diagnosis of its failure."""
     sys_ = _InitialSystem(cm, p, d, cb, t0, starts)
     z0 = sys_.z0
-    guess_rows = _choose_guesses(sys_.jac(z0), sys_.ns, cm.state_guess_order())
-    # Newton from the guesses first: it converges to the solution nearest to
-    # them (e.g. the assembly mode of a linkage its guesses describe). The
-    # trust-region least squares is the fallback; its long steps (in
-    # variables with small Jacobian columns, such as lengths in m) can reach
-    # another solution.
-    z, checked = _first_newton(cb, t0, z0, guess_rows, sys_.fixed, sys_.residual, sys_.jac,
-                               sys_.consistent)
+    guess_rows, z, checked = _guesses_and_newton(cm, cb, t0, sys_, starts)
     if not checked:
         z = least_squares(sys_.residual, z0, jac=sys_.jac, args=(guess_rows,), method="trf",
                           xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=200,
@@ -128,6 +131,34 @@ def _solve_initial(cm, p, d, cb, t0, starts=None):
     y, yp = reinitialize(cm, cb, t0, y, yp)
     sys_.check(np.concatenate([y, yp[:sys_.ns]]))
     return y, yp    # reinitialize has filled the algebraic rates
+
+
+def _guesses_and_newton(cm, cb, t0, sys_, starts):
+    """(guess_rows, z, consistent(z)): the state guesses to impose
+    (:func:`_choose_guesses`) and Gauss-Newton from them (:func:`_first_newton`).
+
+    Which guesses make the Jacobian full rank is a matter of the model's
+    structure, the same at every parameter set in practice, while the rank
+    tests cost more than the Newton solve: the rows that gave a consistent
+    point are kept per model and set of fixed starts and tried first. A point
+    from them is consistent (the same check as always) or the rows are
+    chosen afresh from the Jacobian at the guesses."""
+    key = (tuple(k for k, _, _ in sys_.fixed), tuple(sorted(starts or ())))
+    memo = cm.__dict__.setdefault("_guess_rows", {})
+    kept = memo.get(key)
+    if kept is not None:
+        z, checked = _first_newton(cb, t0, sys_.z0, kept, sys_.fixed, sys_.residual,
+                                   sys_.jac, sys_.consistent)
+        if checked:
+            return kept, z, True
+    rows = _choose_guesses(sys_.jac(sys_.z0), sys_.ns, cm.state_guess_order())
+    if rows == kept:
+        return rows, z, False
+    z, checked = _first_newton(cb, t0, sys_.z0, rows, sys_.fixed, sys_.residual, sys_.jac,
+                               sys_.consistent)
+    if checked:
+        memo[key] = rows
+    return rows, z, checked
 
 
 def _first_newton(cb, t0, z0, guess_rows, fixed, residual, jac, consistent):

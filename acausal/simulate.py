@@ -100,7 +100,9 @@ class _Run:
         self.T.append(np.atleast_1d(np.asarray(t, float)))
         self.Y.append(np.atleast_2d(np.asarray(y, float)))
         self.YP.append(np.atleast_2d(np.asarray(yp, float)))
-        self.D.append(np.tile(np.asarray(d, float), (len(self.T[-1]), 1)))
+        D = np.empty((len(self.T[-1]), len(d)))
+        D[:] = d
+        self.D.append(D)
         if self.sens is not None:
             self.SD.append(np.tile(self.sens.sd_all.ravel(), (len(self.T[-1]), 1)))
         self.rows += len(self.T[-1])
@@ -114,7 +116,7 @@ class _Run:
         key = tuple(map(float, d))
         cb = self._cbs.get(key)
         if cb is None:
-            cb = self._cbs[key] = self.solver().callbacks(self.cm.callbacks(self.p, d), d)
+            cb = self._cbs[key] = self.solver().serve(self.cm, self.p, list(key))
         return cb
 
     def serve(self, model, d):
@@ -404,6 +406,10 @@ class _Watch:
             self.run.steps += self.counter[0]
             self.counter[0] = 0
             raise self._error(str(exc), float(tspan[0])) from None
+        finally:
+            # no cycle solver -> watch -> run -> solver: the run's IDA handle
+            # goes back to the backend's pool as soon as the run is dropped
+            solver.guard = None
 
     def check(self, t):
         """After a solver call that reached ``t``: limits, progress, next window."""

@@ -91,16 +91,13 @@ class SegmentSolver:
     def solve(self, cb, d, t, y, yp, tout, every_step):
         raise NotImplementedError
 
-    def callbacks(self, cb, d):
-        """The callbacks the hybrid loop uses between segments in mode ``d``
-        (initialisation, event actions, re-initialisation): ``cb`` itself,
-        or a backend's faster equivalent of it (same tuple, same results)."""
-        return cb
-
     def serve(self, model, p, d):
-        """The callbacks of ``model`` (this solver's, or one run beside it:
+        """The callbacks the hybrid loop uses between segments
+        (initialisation, event actions, re-initialisation) in mode ``d``:
+        those of ``model`` (this solver's, or one run beside it:
         a sensitivity run's base model, :mod:`acausal.sensitivity`) with
-        parameters ``p`` in mode ``d``, as :meth:`callbacks` serves them."""
+        parameters ``p``: the generated Python callbacks, or a backend's faster
+        equivalent of them (same tuple, same results)."""
         return model.callbacks(p, d)
 
 

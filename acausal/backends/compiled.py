@@ -187,6 +187,8 @@ class _Library:
         lib.acs_observe.argtypes = [ctypes.c_double, vp, vp, vp, vp]
         lib.acs_init_newton.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_double, vp, vp,
                                         ctypes.c_int, vp, vp, ctypes.c_int, vp, ctypes.c_int]
+        lib.acs_init_check.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_double, vp, vp,
+                                       ctypes.c_int, vp, vp]
         self.n_fixed = sum(1 for nm in cm.var_names if cm.flat.variables[nm].start.fixed)
         # the C observe serves the model's observe callback when it gives the
         # same values (a sensitivity model observes their sensitivities too,
@@ -312,13 +314,11 @@ class CompiledSolver(SegmentSolver):
         name = self.L.lib.acs_flag_name(flag)
         return _MESSAGES.get(flag, "IDA failed") + (f" ({name.decode()})" if name else "")
 
-    def callbacks(self, cb, d):
-        """``cb`` (mode ``d``'s generated callbacks) calling the compiled
-        library where it can: see :class:`CCallbacks`."""
-        return CCallbacks(self.L, self.cm, self.p, d, cb)
-
     def serve(self, model, p, d):
-        return CCallbacks(library(model), model, p, d, model.callbacks(p, d))
+        """Mode ``d``'s callbacks of ``model`` calling the compiled library;
+        its generated Python callbacks are made only if one of theirs is
+        called (the dense and sparse Jacobians, which IDA here takes from C)."""
+        return CCallbacks(library(model), model, p, d, lambda: model.callbacks(p, d))
 
 
 def _f64(a):
@@ -348,10 +348,13 @@ class CCallbacks(tuple):
     None where the Python version must run; ``init_newton(t, z0,
     guess_rows, fixed)`` the initialisation's Gauss-Newton in C (the same
     return as :func:`acausal.initialize._newton`, or NotImplemented where the
-    Python version must run). The observed variables (``cb[4]``, an array
-    here) are C too unless one has no C form."""
+    Python version must run); ``init_check(t, z, fixed)`` the consistency
+    test of :func:`acausal.initialize._check` in C (True, False, or
+    NotImplemented where the Python test must run). The observed variables (``cb[4]``, an array
+    here) are C too unless one has no C form. ``make()`` returns the mode's
+    generated Python callbacks; it is called only when one of those runs."""
 
-    def __new__(cls, L, cm, p, d, cb):
+    def __new__(cls, L, cm, p, d, make):
         lib, n, ns = L.lib, len(cm.dae.y), cm.dae.n_states
         pd = np.ascontiguousarray(np.concatenate([np.asarray(p, float),
                                                   np.asarray(d, float)]))
@@ -390,12 +393,33 @@ class CCallbacks(tuple):
                                        gk.ctypes.data, max_iter)
             return z if flag == 0 else (None if flag == 1 else NotImplemented)
 
+        def init_check(t, z, fixed):
+            if L.n_obs is None or len(fixed) != L.n_fixed:
+                return NotImplemented
+            z = _f64(z)
+            fk = np.array([k for k, _, _ in fixed] or [0], dtype=np.intc)
+            fv = np.array([v for _, v, _ in fixed] or [0.0], dtype=float)
+            ok = lib.acs_init_check(n, ns, float(t), z.ctypes.data, pdp, len(fixed),
+                                    fk.ctypes.data, fv.ctypes.data)
+            return NotImplemented if ok < 0 else bool(ok)
+
         def reinit(t, y, yp):
             y2, yp2 = np.array(y, dtype=float), np.array(yp, dtype=float)
             flag = lib.acs_reinit(n, ns, float(t), y2.ctypes.data, yp2.ctypes.data, pdp)
             return (y2, yp2) if flag == 0 else None
 
-        obs = cb[4] if L.n_obs is None else observe
-        self = super().__new__(cls, (res, cb[1], roots, jacs, obs) + tuple(cb[5:]))
+        made = []
+
+        def python(k):   # the generated Python callback k, made on first use
+            def call(*args):
+                if not made:
+                    made.append(make())
+                return made[0][k](*args)
+            return call
+
+        obs = python(4) if L.n_obs is None else observe
+        # count: the step attempts the Python residual sees (none here)
+        self = super().__new__(cls, (res, python(1), roots, jacs, obs, [0, None], python(6)))
         self.pd, self.reinit, self.init_newton = pd, reinit, init_newton
+        self.init_check = init_check
         return self

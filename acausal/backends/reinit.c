@@ -298,3 +298,33 @@ done:
   free(w);
   return flag;
 }
+
+/* The consistency test of acausal.initialize._check at z (length n + ns):
+ * every row i of the residuals and the fixed starts (no guess rows) has
+ * |r_i| <= 1e-7 (|J_i| . (|z| + 1e-12) + 1e-12) + 1e-10, written as that
+ * function writes it (a NaN row passes there and here). Returns 1 when it
+ * holds, 0 when not (the Python check then names the violation), -1 when
+ * out of memory. */
+int acs_init_check(int n, int ns, double t, const double* z, const double* pd, int nf,
+                   const int* fk, const double* fv) {
+  init_sys s;
+  int c = n + ns, m = n + nf, ok = 1;
+  s.n = n; s.ns = ns; s.m = m; s.c = c; s.nf = nf; s.ng = 0; s.t = t; s.pd = pd;
+  s.fv = fv; s.fk = fk; s.gk = NULL; s.z0 = z; s.nobs = acs_n_observed();
+  size_t words = 2 * (size_t)n + (size_t)s.nobs + 1 + 2 * (size_t)n * n
+                 + (size_t)(nf ? nf : 1) * c + (size_t)m * c + (size_t)m;
+  double* w = (double*)calloc(words, sizeof(double));
+  if (!w) return -1;
+  s.y = w; s.yp = s.y + n; s.o = s.yp + n; s.Jy = s.o + s.nobs + 1; s.Jyp = s.Jy + n * n;
+  s.F = s.Jyp + n * n;
+  double *J = s.F + (size_t)(nf ? nf : 1) * c, *r = J + (size_t)m * c;
+  init_residual(&s, z, r);
+  init_jacobian(&s, z, J);
+  for (int i = 0; i < m && ok; i++) {
+    double scale = 0.0;
+    for (int j = 0; j < c; j++) scale += fabs(J[(size_t)i * c + j]) * (fabs(z[j]) + 1e-12);
+    if (fabs(r[i]) > 1e-7 * (scale + 1e-12) + 1e-10) ok = 0;
+  }
+  free(w);
+  return ok;
+}

@@ -26,7 +26,7 @@ def model(request):
     _, cm = compile_file(os.path.join(ROOT, "models", "examples", request.param + ".py"))
     p, d = cm.param_vector({}), cm.discrete_start()
     py = cm.callbacks(p, d)
-    c = make_solver("compiled", cm, p, OPTS).callbacks(py, d)
+    c = make_solver("compiled", cm, p, OPTS).serve(cm, p, d)
     assert c.reinit is not None and c is not py
     return cm, p, d, py, c
 
