@@ -142,7 +142,13 @@ def _guesses_and_newton(cm, cb, t0, sys_, starts):
     tests cost more than the Newton solve: the rows that gave a consistent
     point are kept per model and set of fixed starts and tried first. A point
     from them is consistent (the same check as always) or the rows are
-    chosen afresh from the Jacobian at the guesses."""
+    chosen afresh from the Jacobian at the guesses.
+
+    Newton from the guesses comes first: it converges to the solution
+    nearest to them (e.g. the assembly mode of a linkage its guesses
+    describe). The trust-region least squares is the caller's fallback; its
+    long steps (in variables with small Jacobian columns, such as lengths in
+    m) can reach another solution."""
     key = (tuple(k for k, _, _ in sys_.fixed), tuple(sorted(starts or ())))
     memo = cm.__dict__.setdefault("_guess_rows", {})
     kept = memo.get(key)

@@ -337,6 +337,13 @@ def _into(fn, out, *args):
         out[...] = buf.reshape(np.shape(out))
 
 
+def _fixed_arrays(fixed):
+    """(indices, values) of the fixed starts ``fixed`` ((index, value, name)
+    triples) as the C initialisation takes them (one dummy entry when none)."""
+    return (np.array([k for k, _, _ in fixed] or [0], dtype=np.intc),
+            np.array([v for _, v, _ in fixed] or [0.0], dtype=float))
+
+
 class CCallbacks(tuple):
     """The callbacks tuple of one mode (``cm.callbacks(p, d)``, same order
     and signatures) with the residual, the root functions and the two
@@ -385,8 +392,7 @@ class CCallbacks(tuple):
             if L.n_obs is None or len(fixed) != L.n_fixed:
                 return NotImplemented
             z = np.array(z0, dtype=float)
-            fk = np.array([k for k, _, _ in fixed] or [0], dtype=np.intc)
-            fv = np.array([v for _, v, _ in fixed] or [0.0], dtype=float)
+            fk, fv = _fixed_arrays(fixed)
             gk = np.array(list(guess_rows) or [0], dtype=np.intc)
             flag = lib.acs_init_newton(n, ns, float(t), z.ctypes.data, pdp, len(fixed),
                                        fk.ctypes.data, fv.ctypes.data, len(guess_rows),
@@ -397,8 +403,7 @@ class CCallbacks(tuple):
             if L.n_obs is None or len(fixed) != L.n_fixed:
                 return NotImplemented
             z = _f64(z)
-            fk = np.array([k for k, _, _ in fixed] or [0], dtype=np.intc)
-            fv = np.array([v for _, v, _ in fixed] or [0.0], dtype=float)
+            fk, fv = _fixed_arrays(fixed)
             ok = lib.acs_init_check(n, ns, float(t), z.ctypes.data, pdp, len(fixed),
                                     fk.ctypes.data, fv.ctypes.data)
             return NotImplemented if ok < 0 else bool(ok)
