@@ -256,6 +256,8 @@ def _simplified_pivot(M, k, params, values, max_ops=30, max_tries=6):
             a = M[i, j]
             if a == 0 or a.count_ops() > max_ops or not a.has(sp.sin, sp.cos):
                 continue
+            if _moves(a, params, values):
+                continue
             tries += 1
             if tries > max_tries:
                 return best
@@ -267,6 +269,27 @@ def _simplified_pivot(M, k, params, values, max_ops=30, max_tries=6):
             if np.isfinite(v) and v > 1e-12 and (best is None or v > best[0]):
                 best = (v, i, j)
     return best
+
+
+_PROBES = (0.37, -1.13, 2.71)   # offsets [SI] added to every variable in _moves
+
+
+def _moves(a, params, values, rtol=1e-8):
+    """Whether ``a`` visibly changes when its variables (the symbols that are
+    not parameters) move from their start values by each of ``_PROBES``,
+    parameters held: then no identity can make it parameters-only, and
+    ``trigsimp`` (about a second on a four-bar's entry) need not try. An
+    entry that evaluates to no finite number is not judged (False)."""
+    moving = ordered(a.free_symbols - params)
+    base = dict(values or {})
+    v0 = _numeric(a, base)
+    if not moving or not np.isfinite(v0):
+        return False
+    for d in _PROBES:
+        v = _numeric(a, {**base, **{s: float(base.get(s, 0.0)) + d for s in moving}})
+        if np.isfinite(v) and abs(v - v0) > rtol * max(1.0, abs(v0)):
+            return True
+    return False
 
 
 def _blt(eqs, unknowns):
