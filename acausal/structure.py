@@ -17,6 +17,7 @@ import scipy.sparse as sps
 from scipy.sparse.csgraph import maximum_bipartite_matching
 import sympy as sp
 
+from .blas import single_threaded
 from .errors import StructuralError
 from .fastdiff import diff
 from .symbols import base_and_order, der, ordered, total_derivative
@@ -266,10 +267,12 @@ def _select_columns(g, rows, cols, values, prefer_state):
     weights = np.array([(0.1 if prefer_state(g.vsym[j]) else 1.0)
                         / (1.0 + base_and_order(g.vsym[j])[1]) ** 2 for j in cols])
     scaled = np.nan_to_num(jac * weights, nan=1e-3)
-    _, _, piv = scipy.linalg.qr(scaled, pivoting=True)
-    chosen = [cols[k] for k in piv[:len(rows)]]
-    sub = np.nan_to_num(jac[:, [cols.index(c) for c in chosen]], nan=1.0)
-    if np.linalg.matrix_rank(sub) < len(rows):
+    with single_threaded(len(cols)):    # spinning BLAS threads: 50x slower under load
+        _, piv = scipy.linalg.qr(scaled, mode="r", pivoting=True)
+        chosen = [cols[k] for k in piv[:len(rows)]]
+        sub = np.nan_to_num(jac[:, [cols.index(c) for c in chosen]], nan=1.0)
+        full = np.linalg.matrix_rank(sub) == len(rows)
+    if not full:
         raise StructuralError(
             "cannot select states: the constraint Jacobian is singular at the start "
             "values (a kinematic loop at a dead centre, or redundant constraints): "
