@@ -116,15 +116,8 @@ def _build(cm):
     cc, libs = _compiler(), _sundials_libs()
     try:
         out = os.path.join(_cache_dir(), f"acs_{_key(cm, cc, libs)}.so")
-        if os.path.exists(out):
+        if not _once(out, lambda: _compile(cm, cc, libs, out)):
             return out, False
-        # one build per library: concurrent processes (sweep workers) wait for it
-        with open(out + ".lock", "w") as lock:
-            if fcntl is not None:
-                fcntl.flock(lock, fcntl.LOCK_EX)
-            if os.path.exists(out):
-                return out, False
-            _compile(cm, cc, libs, out)
     except OSError as exc:
         raise Unavailable(f"cannot write the compiled-library cache: {exc} "
                           "(set ACAUSAL_CACHE_DIR to a writable folder)") from None
@@ -145,15 +138,50 @@ def _compile(cm, cc, libs, out):
             fh.write(csrc.text)
         tmp_so = os.path.join(tmpdir, "lib.so")
         libdir = os.path.dirname(libs[0])
-        cmd = cc.split() + ["-O1", "-shared", "-fPIC", "-o", tmp_so, _DRIVER, _REINIT, model_c] + \
-            libs + [f"-Wl,-rpath,{libdir}", "-lm"]
-        proc = subprocess.run(cmd, capture_output=True, text=True)
-        if proc.returncode != 0:
-            raise Unavailable("the C compiler failed on the generated code: "
-                              + (proc.stderr.strip().splitlines() or ["?"])[-1])
+        objs = [_driver_object(cc, src) for src in (_DRIVER, _REINIT)]
+        _run_cc(cc.split() + ["-O1", "-shared", "-fPIC", "-o", tmp_so, model_c, *objs] + libs
+                + [f"-Wl,-rpath,{libdir}", "-lm"], "the generated code")
         os.replace(tmp_so, out)   # atomic: a reader never sees a partial file
     finally:
         shutil.rmtree(tmpdir, ignore_errors=True)
+
+
+def _run_cc(cmd, what):
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    if proc.returncode != 0:
+        raise Unavailable(f"the C compiler failed on {what}: "
+                          + (proc.stderr.strip().splitlines() or ["?"])[-1])
+
+
+def _driver_object(cc, src):
+    """The object file of one of the driver's C sources (the same for every
+    model: compiled once per cache, keyed by the compiler and the source
+    text), so that a model's build compiles only its own generated code."""
+    with open(src) as fh:
+        key = hashlib.sha256("\0".join([cc, fh.read()]).encode()).hexdigest()[:24]
+    out = os.path.join(_cache_dir(), f"{os.path.basename(src)[:-2]}_{key}.o")
+
+    def make():
+        tmp = f"{out}.{os.getpid()}.tmp.o"
+        _run_cc(cc.split() + ["-O1", "-fPIC", "-c", src, "-o", tmp], os.path.basename(src))
+        os.replace(tmp, out)    # atomic: a reader never sees a partial file
+    _once(out, make)
+    return out
+
+
+def _once(out, make):
+    """Make the file ``out`` with ``make()`` unless it exists; concurrent
+    processes (sweep workers) wait for one build. Returns whether it was
+    made now."""
+    if os.path.exists(out):
+        return False
+    with open(out + ".lock", "w") as lock:
+        if fcntl is not None:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+        if os.path.exists(out):
+            return False
+        make()
+    return True
 
 
 class _Library:
