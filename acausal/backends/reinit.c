@@ -158,6 +158,26 @@ typedef struct {
   double *y, *yp, *o, *r, *Jy, *Jyp, *F;
 } init_sys;
 
+/* The initial system's fields and its workspace, laid out once for
+ * acs_init_newton and acs_init_check: y, yp, the observed values, the two
+ * Jacobians and the fixed starts' rows (F), then the m x c Jacobian J (at
+ * s->F + max(nf, 1) * c) and ``extra`` words the caller lays out after J.
+ * Returns the block to free, or NULL when out of memory. */
+static double* init_alloc(init_sys* s, int n, int ns, double t, const double* pd, int nf,
+                          const int* fk, const double* fv, int ng, const int* gk,
+                          size_t extra) {
+  int c = n + ns, m = n + nf + ng;
+  s->n = n; s->ns = ns; s->m = m; s->c = c; s->nf = nf; s->ng = ng; s->t = t; s->pd = pd;
+  s->fv = fv; s->fk = fk; s->gk = gk; s->z0 = NULL; s->nobs = acs_n_observed();
+  size_t words = 2 * (size_t)n + (size_t)s->nobs + 1 + 2 * (size_t)n * n
+                 + (size_t)(nf ? nf : 1) * c + (size_t)m * c + extra;
+  double* w = (double*)calloc(words, sizeof(double));
+  if (!w) return NULL;
+  s->y = w; s->yp = s->y + n; s->o = s->yp + n; s->Jy = s->o + s->nobs + 1;
+  s->Jyp = s->Jy + (size_t)n * n; s->F = s->Jyp + (size_t)n * n;
+  return w;
+}
+
 static void split(init_sys* s, const double* z) {
   memcpy(s->y, z, sizeof(double) * s->n);
   memset(s->yp, 0, sizeof(double) * s->n);
@@ -254,14 +274,8 @@ int acs_init_newton(int n, int ns, double t, double* z, const double* pd, int nf
                     const int* fk, const double* fv, int ng, const int* gk, int max_iter) {
   init_sys s;
   int c = n + ns, m = n + nf + ng, flag = -1;
-  s.n = n; s.ns = ns; s.m = m; s.c = c; s.nf = nf; s.ng = ng; s.t = t; s.pd = pd;
-  s.fv = fv; s.fk = fk; s.gk = gk; s.nobs = acs_n_observed();
-  size_t words = 2 * (size_t)n + (size_t)s.nobs + 1 + 2 * (size_t)n * n
-                 + (size_t)(nf ? nf : 1) * c + (size_t)m * c + 3 * (size_t)m + 4 * (size_t)c;
-  double* w = (double*)calloc(words, sizeof(double));
+  double* w = init_alloc(&s, n, ns, t, pd, nf, fk, fv, ng, gk, 3 * (size_t)m + 4 * (size_t)c);
   if (!w) return -1;
-  s.y = w; s.yp = s.y + n; s.o = s.yp + n; s.Jy = s.o + s.nobs + 1; s.Jyp = s.Jy + n * n;
-  s.F = s.Jyp + n * n;
   double *J = s.F + (size_t)(nf ? nf : 1) * c, *r = J + (size_t)m * c, *r2 = r + m,
          *b = r2 + m, *dz = b + m, *z2 = dz + c, *dcol = z2 + c, *z0 = dcol + c;
   memcpy(z0, z, sizeof(double) * c);
@@ -309,14 +323,9 @@ int acs_init_check(int n, int ns, double t, const double* z, const double* pd, i
                    const int* fk, const double* fv) {
   init_sys s;
   int c = n + ns, m = n + nf, ok = 1;
-  s.n = n; s.ns = ns; s.m = m; s.c = c; s.nf = nf; s.ng = 0; s.t = t; s.pd = pd;
-  s.fv = fv; s.fk = fk; s.gk = NULL; s.z0 = z; s.nobs = acs_n_observed();
-  size_t words = 2 * (size_t)n + (size_t)s.nobs + 1 + 2 * (size_t)n * n
-                 + (size_t)(nf ? nf : 1) * c + (size_t)m * c + (size_t)m;
-  double* w = (double*)calloc(words, sizeof(double));
+  double* w = init_alloc(&s, n, ns, t, pd, nf, fk, fv, 0, NULL, (size_t)m);
   if (!w) return -1;
-  s.y = w; s.yp = s.y + n; s.o = s.yp + n; s.Jy = s.o + s.nobs + 1; s.Jyp = s.Jy + n * n;
-  s.F = s.Jyp + n * n;
+  s.z0 = z;
   double *J = s.F + (size_t)(nf ? nf : 1) * c, *r = J + (size_t)m * c;
   init_residual(&s, z, r);
   init_jacobian(&s, z, J);
