@@ -70,6 +70,16 @@ class _Printer(NamedTemps, PythonCodePrinter):
     def _print_Heaviside(self, expr):
         return f"heaviside({self._print(expr.args[0])})"
 
+    def _print_Pow(self, expr, rational=False):
+        """A non-integer power other than a square root as ``pow(b, e)``:
+        Python's ``**`` of a negative float makes a complex number without
+        a word, ``pow`` (``math.pow``) raises, and the IEEE variant
+        (:func:`load`) gives NaN as C does."""
+        b, e = expr.args
+        if e.is_Integer or e in (sp.S.Half, -sp.S.Half) or not e.is_number:
+            return super()._print_Pow(expr, rational=rational)
+        return f"pow({self._print(b)}, {self._print(e)})"
+
 
 def _real(name):
     return sp.Symbol(name, real=True)
@@ -79,6 +89,36 @@ def _namespace():
     ns = {k: getattr(math, k) for k in dir(math) if not k.startswith("_")}
     ns.update(np=np, heaviside=lambda x: 1.0 if x > 0 else (0.5 if x == 0 else 0.0),
               Abs=abs, max=max, min=min)
+    return ns
+
+
+# Guarded domains (IEEE semantics). Common sub-expressions are computed before
+# the conditions that guard them: ``Piecewise((sqrt(x), x > 0), (0, True))``
+# with ``sqrt(x)`` shared evaluates ``sqrt(x)`` for every x. C gives NaN there
+# and the branch that is not taken drops it; Python's math raises. So each
+# generated callback runs on Python floats and, when that raises one of
+# _IEEE_ERRORS, is evaluated again by the same source on numpy float64 (NaN
+# and inf as in C, warnings off): the backends agree and the fast path stays.
+_IEEE_ERRORS = (ValueError, ZeroDivisionError, OverflowError)
+_NUMPY_NAMES = {"asin": "arcsin", "acos": "arccos", "atan": "arctan", "atan2": "arctan2",
+                "asinh": "arcsinh", "acosh": "arccosh", "atanh": "arctanh", "pow": "power"}
+
+
+def _fast_namespace():
+    ns = _namespace()
+    ns.update(_floats=lambda a: a.tolist(), _consts=lambda a: a, _ieee_errors=_IEEE_ERRORS,
+              _quiet=lambda: np.errstate(all="ignore"))
+    return ns
+
+
+def _ieee_namespace():
+    ns = _namespace()
+    for k in list(ns):
+        f = getattr(np, _NUMPY_NAMES.get(k, k), None)
+        if k in dir(math) and isinstance(f, np.ufunc):
+            ns[k] = f
+    ns.update(_floats=lambda a: np.asarray(a, dtype=float), _ieee_errors=(),
+              _consts=lambda a: np.asarray(a, dtype=float), _quiet=None)
     return ns
 
 
@@ -214,11 +254,27 @@ def _repeated(exprs):
     return order
 
 
-def _unpack(prefix, n, src, indent="        ", array=True):
+def _unpack(prefix, n, src, indent="        ", array=True, conv=None):
     if n == 0:
         return []
     names = ", ".join(f"{prefix}{i}" for i in range(n))
+    if conv:
+        return [f"{indent}{names}, = {conv}({src})"]
     return [f"{indent}{names}, = {src}{'.tolist()' if array else ''}"]
+
+
+_B = " " * 12      # the body of a guarded callback (inside its ``try``)
+
+
+def _guarded(header, pre, body, fallback, ret=False):
+    """A generated callback: ``header``, the lines ``pre``, then ``body``
+    (at :data:`_B`) inside ``try``; on one of the guarded-domain errors the
+    same callback of the IEEE variant (``fallback``, its call text) runs
+    instead (see :data:`_IEEE_ERRORS`)."""
+    call = f"{'return ' if ret else ''}{fallback}"
+    return ([header] + pre + ["        try:"] + (body or [_B + "pass"])
+            + ["        except _ieee_errors:", "            with _quiet():",
+               f"                {call}"])
 
 
 class Triplets:
@@ -357,37 +413,47 @@ def generate(dae, params, discretes, roots, observed, fixed_rows=()):
                                                              "a fixed start"))),
                            fixed_rows, ysyms, ypsyms, dae.n_states)
     npar, nd = len(params), len(discretes)
-    unpack = _unpack("y", n, "y") + _unpack("yp", n, "yp")
+    unpack = _unpack("y", n, "y", _B, conv="_floats") + _unpack("yp", n, "yp", _B, conv="_floats")
     L = ["def make(p, d):"]
-    L += _unpack("p", npar, "p", "    ", False) + _unpack("d", nd, "d", "    ", False)
-    L += ["    count = [0, None]  # step attempts: distinct times the residual sees"]
-    L += ["    def res(t, y, yp, r):"]
-    L += ["        if t != count[1]:", "            count[0] += 1", "            count[1] = t"]
-    L += unpack
-    L += _body(res, [f"r[{i}]" for i in range(n)])
-    reps, jprinted = _cse_print([e for _, _, e in jcomb])
-    L += ["    def jac(t, y, yp, r, cj, J):"] + unpack + reps
-    L += [f"        J[{i}, {j}] = {e}" for (i, j, _), e in zip(jcomb, jprinted)]
-    L += ["        pass"]
-    L += ["    def jac_csc(t, y, yp, r, cj, J):"] + unpack + reps
-    L += [f"        J[{csc_pos[i, j]}] = {e}" for (i, j, _), e in zip(jcomb, jprinted)]
-    L += ["        pass"]
-    L += ["    def roots(t, y, yp, g):"] + unpack
-    L += _body(g, [f"g[{i}]" for i in range(len(g))], symbols=names.code) or ["        pass"]
-    L += ["    def jacs(t, y, yp, Jy, Jyp):"] + unpack
-    L += _body([e for _, _, e in jy] + [e for _, _, e in jyp],
-               [f"Jy[{i}, {j}]" for i, j, _ in jy] + [f"Jyp[{i}, {j}]" for i, j, _ in jyp]) \
-        or ["        pass"]
-    L += ["    def observe(t, y, yp):"] + unpack
-    L += ["        o = [0.0] * %d" % len(obs)]
-    L += _body(obs, [f"o[{i}]" for i in range(len(obs))], symbols=names.code)
-    L += ["        return o"]
+    L += _unpack("p", npar, "p", "    ", conv="_consts")
+    L += _unpack("d", nd, "d", "    ", conv="_consts")
+    L += ["    count = [0, None]  # step attempts: distinct times the residual sees",
+          "    ieee = []",
+          "    def other(k):  # the IEEE variant's callback k (made at its first use)",
+          "        if not ieee:",
+          "            ieee.append(_make_ieee(p, d))",
+          "        return ieee[0][k]"]
+    L += _guarded("    def res(t, y, yp, r):",
+                  ["        if t != count[1]:", "            count[0] += 1",
+                   "            count[1] = t"],
+                  unpack + _body(res, [f"r[{i}]" for i in range(n)], _B),
+                  "other(0)(t, y, yp, r)")
+    reps, jprinted = _cse_print([e for _, _, e in jcomb], _B)
+    L += _guarded("    def jac(t, y, yp, r, cj, J):", [], unpack + reps + [
+        f"{_B}J[{i}, {j}] = {e}" for (i, j, _), e in zip(jcomb, jprinted)],
+        "other(1)(t, y, yp, r, cj, J)")
+    L += _guarded("    def jac_csc(t, y, yp, r, cj, J):", [], unpack + reps + [
+        f"{_B}J[{csc_pos[i, j]}] = {e}" for (i, j, _), e in zip(jcomb, jprinted)],
+        "other(6)(t, y, yp, r, cj, J)")
+    L += _guarded("    def roots(t, y, yp, g):", [], unpack + _body(
+        g, [f"g[{i}]" for i in range(len(g))], _B, symbols=names.code),
+        "other(2)(t, y, yp, g)")
+    L += _guarded("    def jacs(t, y, yp, Jy, Jyp):", [], unpack + _body(
+        [e for _, _, e in jy] + [e for _, _, e in jyp],
+        [f"Jy[{i}, {j}]" for i, j, _ in jy] + [f"Jyp[{i}, {j}]" for i, j, _ in jyp], _B),
+        "other(3)(t, y, yp, Jy, Jyp)")
+    L += _guarded("    def observe(t, y, yp):", [], unpack + [
+        f"{_B}o = [0.0] * {len(obs)}"] + _body(
+        obs, [f"o[{i}]" for i in range(len(obs))], _B, symbols=names.code) + [
+        f"{_B}return o"], "other(4)(t, y, yp)", ret=True)
     L += ["    return res, jac, roots, jacs, observe, count, jac_csc"]
-    L += ["def fixjac(t, y, yp, p, d, F):"]
-    L += _unpack("p", npar, "p", "    ", False) + _unpack("d", nd, "d", "    ", False)
-    L += _unpack("y", n, "y", "    ", False) + _unpack("yp", n, "yp", "    ", False)
-    L += _body([e for _, _, e in fixed], [f"F[{a}, {k}]" for a, k, _ in fixed], "    ")
-    L += ["    pass"]
+    L += _guarded("def fixjac(t, y, yp, p, d, F):", [], [
+        f"    {line}" for line in _unpack("p", npar, "p", "        ", conv="_consts")
+        + _unpack("d", nd, "d", "        ", conv="_consts")
+        + _unpack("y", n, "y", "        ", conv="_consts")
+        + _unpack("yp", n, "yp", "        ", conv="_consts")
+        + _body([e for _, _, e in fixed], [f"F[{a}, {k}]" for a, k, _ in fixed], "        ")],
+        "_fixjac_ieee(t, y, yp, p, d, F)")
     src = "\n".join(L) + "\n"
     make, fixjac = load(src)
     return Generated(src, make, fixjac, sparsity)
@@ -399,6 +465,10 @@ def load(src):
     _counter[0] += 1
     fname = f"<acausal-generated-{_counter[0]}>"
     linecache.cache[fname] = (len(src), None, src.splitlines(True), fname)
-    ns = _namespace()
-    exec(compile(src, fname, "exec"), ns)
+    code = compile(src, fname, "exec")
+    ieee = _ieee_namespace()
+    exec(code, ieee)
+    ns = _fast_namespace()
+    ns.update(_make_ieee=ieee["make"], _fixjac_ieee=ieee["fixjac"])
+    exec(code, ns)
     return ns["make"], ns["fixjac"]
