@@ -57,7 +57,8 @@ import sympy as sp
 
 from .backends import choose_linear_solver
 from .causalize import DAE
-from .codegen import Names, Sparsity, _body, _namespace, _unpack, generate, load
+from .codegen import (_IEEE_ERRORS, Names, Sparsity, _body, _ieee_namespace, _namespace,
+                      _unpack, generate, load)
 from .errors import ModelError, UsageError
 from .events import EventState
 from .fastdiff import diff
@@ -371,15 +372,21 @@ def _root_gradients(cm, roots, P, dyn):
     L += _unpack("p", len(cm.param_syms), "p", "    ", False)
     L += _unpack("d", len(cm.disc_syms), "d", "    ", False)
     L += _body(exprs, targets, "    ", symbols=names.code) + ["    pass"]
-    ns = _namespace()
-    exec(compile("\n".join(L) + "\n", "<acausal-root-gradients>", "exec"), ns)
-    fill = ns["rootgrad"]
+    code = compile("\n".join(L) + "\n", "<acausal-root-gradients>", "exec")
+    ns, ieee = _namespace(), _ieee_namespace()
+    exec(code, ns)
+    exec(code, ieee)
+    fill, fill_ieee = ns["rootgrad"], ieee["rootgrad"]
 
     def rootgrad(t, y, yp, p, d):
         G = (np.zeros((nr, n)), np.zeros((nr, n)), np.zeros(nr), np.zeros((nr, m)),
              np.zeros((nr, len(dyn))))
-        fill(t, list(map(float, y)), list(map(float, yp)), list(map(float, p)),
-             list(map(float, d)), *G)
+        try:
+            fill(t, list(map(float, y)), list(map(float, yp)), list(map(float, p)),
+                 list(map(float, d)), *G)
+        except _IEEE_ERRORS:      # a guarded domain: as the callbacks (acausal.codegen)
+            with np.errstate(all="ignore"):
+                fill_ieee(t, *(np.asarray(a, dtype=float) for a in (y, yp, p, d)), *G)
         return G
     return rootgrad
 

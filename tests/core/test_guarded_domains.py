@@ -61,3 +61,17 @@ def test_guarded_terms_inside_their_domain_follow_the_linear_spring():
                       params={"mass.v": 0.5})    # moving out: stretched from t = 0
     w = math.sqrt(100.0)
     assert np.allclose(res["mass.s"], 0.1 + 0.5 / w * np.sin(w * res.t), atol=1e-8)
+
+
+def test_sensitivities_through_guarded_terms():
+    """The sensitivity model's generated code is guarded too. Stretched from
+    t = 0 (s0 = L): s = L + (s0 - L) cos(w t) + v/w sin(w t), w = sqrt(c/m),
+    so d s/d L = 1 - cos(w t) and d s/d c = v (t cos(w t)/w - sin(w t)/w^2)
+    / (2 w m)."""
+    cm = compile_model(_model(), cache=False)
+    res = cm.simulate(t_end=0.3, rtol=1e-10, atol=1e-13, params={"mass.v": 0.5},
+                      sensitivities=["spring.L", "spring.c"])
+    t, w, v = res.t, 10.0, 0.5
+    dsdc = v * (t * np.cos(w * t) / w - np.sin(w * t) / w**2) / (2 * w)
+    assert np.allclose(res.sensitivity("mass.s", "spring.L"), 1 - np.cos(w * t), atol=1e-7)
+    assert np.allclose(res.sensitivity("mass.s", "spring.c"), dsdc, atol=1e-8)
