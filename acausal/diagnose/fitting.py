@@ -430,8 +430,8 @@ def confidence(f: Fit, level=0.95, positive=()) -> dict:
         if name in positive and v > 0:
             # the columns of Js are derivatives per relative change, i.e. per
             # unit of log(value): s / scale is the standard deviation of log(value)
-            w = q * s / scale
-            out[name] = (float(v * np.exp(-w)), float(v * np.exp(w)))
+            w = min(q * s / scale, 700.0)    # exp(700) ~ 1e304: open above, not an overflow
+            out[name] = (float(v * np.exp(-w)), float(v * np.exp(w)) if w < 700 else np.inf)
         else:
             out[name] = (float(v - q * s), float(v + q * s))
     return out
