@@ -1,29 +1,56 @@
 """Anchors: the breaker (models/breaker_24kv.py, from its start just before
-first contact to the hook's release, rtol 1e-8) in CasADi's IDAS on the same
-equations, against each acausal backend, in one run. Prints the time per
+first contact to the hook's release, rtol 1e-8) in the best outside engines
+on the same equations, against each acausal backend, in one interleaved run:
+CasADi IDAS and CVODES, scipy's solve_ivp and diffrax. Prints the time per
 simulation, the ratios and the THRT agreement. Target (issue 10): the
 fastest acausal backend <= 2x CasADi IDAS.
 
-CasADi is a benchmark-only extra (``pip install 'acausal[casadi]'``).
+The outside engines are benchmark-only extras (``pip install
+'acausal[bench]'``: CasADi, JAX and diffrax); one that is not installed is
+skipped with a line saying so. Every engine starts from acausal's
+consistent initial point (computed once, outside the timing), integrates
+acausal's reduced DAE converted from sympy, and applies acausal's own event
+actions (a few Python operations per event); each is what a competent user
+of that engine would write for this hybrid system:
 
-The CasADi side is what a user of CasADi would write for this hybrid DAE:
-CasADi 3.8's IDAS plugin does not locate zero crossings (casadi#3682,
-casadi#4393: its ``zero``/``transition`` events are ignored by IDAS), so each
-mode is integrated over a grid of output times, the first sign change of
-the mode's root functions (with their directions) is found on the grid and
-refined by Illinois iterations on the end time of an integration from the
-last grid point before it; the event actions are acausal's own (a few
-Python operations per event). The DAE is acausal's reduced DAE, converted
-from sympy to CasADi SX (F(t, y, y') = 0 in semi-explicit form: x' = w,
-0 = F(t, x, z, w)); parameters and discrete values are integrator
-parameters, so one integrator serves every mode. It starts from acausal's
-consistent initial point (computed once, outside the timing).
+* CasADi IDAS: the semi-explicit DAE x' = w, 0 = F(t, x, z, w) in SX;
+  parameters and discrete values are integrator parameters, so one
+  integrator serves every mode. CasADi 3.8's IDAS plugin does not locate
+  zero crossings (casadi#3682, casadi#4393: its ``zero``/``transition``
+  events are ignored by IDAS), so each mode is integrated over a grid of
+  output times, the first sign change of the mode's root functions (with
+  their directions) is found on the grid and refined by Illinois iterations
+  on the end time of an integration from the last grid point before it.
+* CasADi CVODES: the explicit ODE x' = w(t, x, z(x)) (:func:`explicit_form`:
+  the breaker's reduced DAE is explicit in the accelerations; its algebraic
+  unknowns, the four-bar's coupler and main-shaft angles, are fixed by the
+  nonlinear position closure, solved by Newton steps unrolled in the SX
+  graph). CVODES's own events in CasADi 3.8 fire on falling crossings only
+  and need the actions as CasADi functions (casadi#4393), so it shares
+  IDAS's grid-located mode loop. Adams with functional iteration (the
+  default, ``--cvodes``) was faster here than BDF (7.4 against 9.3 ms).
+  Each CasADi engine has an "events given" row: one integration per mode
+  to the known event times, the lower bound of any run of that engine.
+* scipy ``solve_ivp`` (LSODA, DOP853; ``--scipy``), its own event location
+  (terminal events with directions), the same explicit ODE in plain Python.
+* diffrax (JAX on the CPU, float64): the explicit ODE in jax.numpy, one
+  ``jax.jit``-compiled ``diffeqsolve`` per mode segment with a
+  ``diffrax.Event`` of the root functions (directions, optimistix Newton
+  for the root time); Tsit5 by default (``--diffrax``): Dopri5 took about
+  the same time, Dopri8 6x and Kvaerno5 (implicit) 30x as long. Timed warm;
+  its compile time (13-45 s on 2 loaded cores) is the "first run" line
+  printed before the table.
+
+The ODE engines reach the same THRT to a few 1e-10 s (the same rtol and
+per-state absolute tolerances; CVODES takes one absolute tolerance, so its
+states are scaled by theirs, which gives the same error weights).
 
     python benchmarks/anchors.py [--repeat N] [--no-jit] [--cpu]
+        [--scipy LSODA,DOP853] [--diffrax Tsit5] [--cvodes adams|bdf]
 
-``--cpu`` times CPU seconds of this process instead of wall time (every
-engine here is single-threaded): steadier on a shared machine. The load
-average is printed with the table.
+``--cpu`` times CPU seconds of this process instead of wall time (the engines
+are single-threaded, except that XLA may use a second thread for JAX):
+steadier on a shared machine. The load average is printed with the table.
 """
 import argparse
 import os
@@ -433,6 +460,23 @@ class _OdeHybrid:
         return events
 
 
+def python_form(cm, roots):
+    """The explicit form as plain-Python ``math`` functions of (t, x, z, p):
+    a Newton step on the position closure (its 2x2 solve written out by
+    sympy), x', and the root functions ``roots`` (with x' as a last
+    argument)."""
+    dae, ns = cm.dae, cm.dae.n_states
+    w_expr, cons = explicit_form(cm)
+    za = list(dae.y[ns:])
+    g = sp.Matrix(cons)
+    step = sp.Matrix(za) - g.jacobian(za).LUsolve(g)
+    args = [t_sym, list(dae.y[:ns]), za, list(cm.param_syms) + list(cm.disc_syms)]
+    mods = [{"PosPow": lambda x, e: x ** e if x > 0 else 0.0}, "math"]
+    return (sp.lambdify(args, list(step), modules=mods, cse=True),
+            sp.lambdify(args, w_expr, modules=mods, cse=True),
+            sp.lambdify(args + [list(dae.yp[:ns])], roots, modules=mods, cse=True))
+
+
 class ScipyODE(_OdeHybrid):
     """scipy.integrate.solve_ivp on x' = w(t, x, z(x)) in plain Python: the
     same sympy equations as scalar ``math`` code (``sympy.lambdify``, cse),
@@ -447,17 +491,7 @@ class ScipyODE(_OdeHybrid):
     def __init__(self, cm, rtol, atol, method, newton=3):
         super().__init__(cm)
         self.rtol, self.atol, self.method = rtol, np.asarray(atol)[:self.ns], method
-        dae, ns = cm.dae, self.ns
-        w_expr, cons = explicit_form(cm)
-        za = list(dae.y[ns:])
-        g = sp.Matrix(cons)
-        step = sp.Matrix(za) - g.jacobian(za).LUsolve(g)
-        args = [t_sym, list(dae.y[:ns]), za, list(cm.param_syms) + list(cm.disc_syms)]
-        mods = [{"PosPow": lambda x, e: x ** e if x > 0 else 0.0}, "math"]
-        self.step = sp.lambdify(args, list(step), modules=mods, cse=True)
-        self.w = sp.lambdify(args, w_expr, modules=mods, cse=True)
-        self.g = sp.lambdify(args + [list(dae.yp[:ns])],
-                             [self.exprs[i] for i in self.active], modules=mods, cse=True)
+        self.step, self.w, self.g = python_form(cm, [self.exprs[i] for i in self.active])
         self.newton = newton
         self._key, self._gval = None, None
 
@@ -500,14 +534,54 @@ class ScipyODE(_OdeHybrid):
         return np.array(list(za) + list(self.w(t, x, za, pd)), float)
 
 
+class JaxForm:
+    """The explicit form in jax.numpy: ``zw(t, x, pd, zg)`` -> (algebraic
+    unknowns by ``newton`` Newton steps from ``zg``, x'), and a root
+    function's diffrax condition (the Newton steps only where the root needs
+    the algebraic unknowns or x')."""
+
+    def __init__(self, cm, newton):
+        import jax.numpy as jnp
+        self.cm, self.ns, self.newton, self.lib = cm, cm.dae.n_states, newton, _jax_lib()
+        w_expr, cons = explicit_form(cm)
+        self.g, self.w = self.fn(cons), self.fn(w_expr)
+        self.w0 = jnp.zeros(self.ns)
+
+    def fn(self, exprs):
+        import jax.numpy as jnp
+
+        def f(t, x, za, w, pd):
+            env = _sym_env(self.cm, jnp.concatenate([x, za]), w, pd, t)
+            memo = {}
+            return jnp.stack([jnp.asarray(convert(e, env, memo, self.lib), float)
+                              for e in exprs])
+        return f
+
+    def zw(self, t, x, pd, zg):
+        import jax
+        import jax.numpy as jnp
+        za, w0 = zg, self.w0
+        for _ in range(self.newton):
+            jac = jax.jacfwd(self.g, argnums=2)(t, x, za, w0, pd)
+            za = za - jnp.linalg.solve(jac, self.g(t, x, za, w0, pd))
+        return za, self.w(t, x, za, w0, pd)
+
+    def rhs(self, t, x, args):
+        return self.zw(t, x, *args)[1]
+
+    def cond(self, expr):
+        dae, root = self.cm.dae, self.fn([expr])
+        if expr.free_symbols & (set(dae.y[self.ns:]) | set(dae.yp[:self.ns])):
+            return lambda t, y, args, **kw: root(t, y, *self.zw(t, y, *args), args[0])[0]
+        return lambda t, y, args, **kw: root(t, y, args[1], self.w0, args[0])[0]
+
+
 class DiffraxODE(_OdeHybrid):
-    """diffrax (JAX, CPU, float64) on x' = w(t, x, z(x)): the same sympy
-    equations converted to jax.numpy, z(x) by ``newton`` Newton steps (a
-    fixed count, so the function is traceable) from the algebraic unknowns at
-    the segment's start, one ``jax.jit``-compiled ``diffeqsolve`` per
-    segment with a PID step-size controller and a ``diffrax.Event`` of the
-    acting root functions (with their directions, optimistix Newton on the
-    dense output for the root time). Parameters and discrete values are
+    """diffrax (JAX, CPU, float64) on x' = w(t, x, z(x)) (:class:`JaxForm`):
+    one ``jax.jit``-compiled ``diffeqsolve`` per segment with a PID step-size
+    controller and a ``diffrax.Event`` of the acting root functions (with
+    their directions, optimistix Newton on the dense output for the root
+    time). Parameters, discrete values and the Newton steps' start are
     arguments, so the one compiled function serves every mode."""
 
     def __init__(self, cm, rtol, atol, solver="Tsit5", newton=3):
@@ -517,40 +591,13 @@ class DiffraxODE(_OdeHybrid):
         import jax.numpy as jnp
         import optimistix as optx
         super().__init__(cm)
-        lib = _jax_lib()
-        w_expr, cons = explicit_form(cm)
-        ns = self.ns
-
-        def sym(exprs):
-            def fn(t, x, za, w, pd):
-                env = _sym_env(cm, jnp.concatenate([x, za]), w, pd, t)
-                memo = {}
-                return jnp.stack([jnp.asarray(convert(e, env, memo, lib), float) for e in exprs])
-            return fn
-        g_c, w_f = sym(cons), sym(w_expr)
-        nw = jnp.zeros(ns)
-
-        def zw(t, x, pd, zg):
-            za = zg
-            for _ in range(newton):
-                r = g_c(t, x, za, nw, pd)
-                za = za - jnp.linalg.solve(jax.jacfwd(g_c, argnums=2)(t, x, za, nw, pd), r)
-            return za, w_f(t, x, za, nw, pd)
-
-        def rhs(t, x, args):
-            return zw(t, x, *args)[1]
-
-        def cond(k):
-            expr = self.exprs[self.active[k]]
-            root = sym([expr])
-            if expr.free_symbols & (set(cm.dae.y[ns:]) | set(cm.dae.yp[:ns])):
-                return lambda t, y, args, **kw: root(t, y, *zw(t, y, *args), args[0])[0]
-            return lambda t, y, args, **kw: root(t, y, args[1], nw, args[0])[0]
-        dirs = [None if self.dirs[i] == 0 else self.dirs[i] > 0 for i in self.active]
-        event = dfx.Event([cond(k) for k in range(len(self.active))],
-                          root_finder=optx.Newton(rtol=1e-12, atol=1e-15), direction=dirs)
-        ctrl = dfx.PIDController(rtol=rtol, atol=jnp.asarray(np.asarray(atol)[:ns]))
-        term, solv = dfx.ODETerm(rhs), getattr(dfx, solver)()
+        form = JaxForm(cm, newton)
+        event = dfx.Event([form.cond(self.exprs[i]) for i in self.active],
+                          root_finder=optx.Newton(rtol=1e-12, atol=1e-15),
+                          direction=[None if self.dirs[i] == 0 else self.dirs[i] > 0
+                                     for i in self.active])
+        ctrl = dfx.PIDController(rtol=rtol, atol=jnp.asarray(np.asarray(atol)[:self.ns]))
+        term, solv = dfx.ODETerm(form.rhs), getattr(dfx, solver)()
 
         @jax.jit
         def segment(x, pd, zg, t, t_end):
@@ -558,7 +605,7 @@ class DiffraxODE(_OdeHybrid):
                                   stepsize_controller=ctrl, event=event, max_steps=100000)
             return sol.ts[-1], sol.ys[-1], jnp.stack(sol.event_mask)
         self.segment_jit = segment
-        self.zw_jit = jax.jit(lambda x, pd, zg, t: jnp.concatenate(zw(t, x, pd, zg)))
+        self.zw_jit = jax.jit(lambda x, pd, zg, t: jnp.concatenate(form.zw(t, x, pd, zg)))
 
     def _segment(self, x, pd, zg, t, t_end):
         te, xe, mask = self.segment_jit(x, pd, zg, t, t_end)
@@ -567,6 +614,8 @@ class DiffraxODE(_OdeHybrid):
 
     def _zw(self, x, pd, zg, t):
         return np.asarray(self.zw_jit(x, pd, zg, t))
+
+
 def _thrt(events):
     onset = next(t for t, n in events if n.endswith("onset"))
     return next(t for t, n in events if n == "release") - onset
@@ -689,7 +738,8 @@ def print_table(runs, times, args, load0):
     print(f"\nbest of {args.repeat}, interleaved, {'CPU' if args.cpu else 'wall'} time (load "
           f"{load0:.1f} before, {os.getloadavg()[0]:.1f} after); THRT difference against "
           "acausal sundae (benchmark options)")
-    print(f"{'engine':58s} {'ms/sim':>8s} {'x IDAS':>7s} {'THRT [ms]':>12s} {'dTHRT [s]':>10s}")
+    per = "x IDAS" if idas else "x best"      # per CasADi IDAS, else per the fastest row
+    print(f"{'engine':58s} {'ms/sim':>8s} {per:>7s} {'THRT [ms]':>12s} {'dTHRT [s]':>10s}")
     for (lab, _, thrt), tm in zip(runs, times):
         print(f"{lab:58s} {tm * 1e3:8.2f} {tm / anchor:7.2f} {thrt * 1e3:12.7f} "
               f"{thrt - ref:10.1e}")
