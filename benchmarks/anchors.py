@@ -434,8 +434,8 @@ class _OdeHybrid:
     segment runs to the first root (with its direction) of the root
     functions that change the trajectory, in the current mode's discrete
     values; acausal's event action then gives the next mode. A subclass
-    gives ``_segment(x, pd, zg, t, t_end)`` -> (t, x, index into
-    ``self.active`` or None) and ``_zw(x, pd, zg, t)`` -> (algebraic unknowns, x')."""
+    gives ``_segment(x, pd, zg, t, t_end)`` -> (t, x, z = (algebraic unknowns,
+    x') at t, index into ``self.active`` or None)."""
 
     def __init__(self, cm):
         self.cm, self.ns = cm, cm.dae.n_states
@@ -447,11 +447,10 @@ class _OdeHybrid:
         x, zg, d, events = np.array(y[:ns]), np.array(y[ns:]), list(d), []
         while t < t_end:
             pd = np.concatenate([p, d])
-            t, x, k = self._segment(x, pd, zg, t, t_end)
+            t, x, z, k = self._segment(x, pd, zg, t, t_end)
             if k is None:
                 break
             i = self.active[k]
-            z = self._zw(x, pd, zg, t)
             zg = z[:len(zg)]
             events.append((t, cm.events[i].name if i < len(cm.events) else "assert"))
             if _ended(cm, i):
@@ -513,9 +512,10 @@ class ScipyODE(_OdeHybrid):
                         atol=self.atol, events=events)
         hit = [k for k, te in enumerate(sol.t_events) if len(te)]
         if not hit:
-            return sol.t[-1], sol.y[:, -1], None
+            return sol.t[-1], sol.y[:, -1], None, None
         k = hit[0]
-        return sol.t_events[k][0], sol.y_events[k][0], k
+        te, xe = sol.t_events[k][0], sol.y_events[k][0]
+        return te, xe, self._zw(xe, pd, zg, te), k
 
     def _event(self, k, pd, zg):
         def g(t, x):
@@ -529,8 +529,8 @@ class ScipyODE(_OdeHybrid):
         return g
 
     def _zw(self, x, pd, zg, t):
-        x, pd = x.tolist(), pd.tolist()
-        za = self._za(t, x, pd, zg.tolist())
+        x = x.tolist()
+        za = self._za(t, x, pd, zg)
         return np.array(list(za) + list(self.w(t, x, za, pd)), float)
 
 
@@ -603,17 +603,15 @@ class DiffraxODE(_OdeHybrid):
         def segment(x, pd, zg, t, t_end):
             sol = dfx.diffeqsolve(term, solv, t, t_end, None, x, args=(pd, zg),
                                   stepsize_controller=ctrl, event=event, max_steps=100000)
-            return sol.ts[-1], sol.ys[-1], jnp.stack(sol.event_mask)
+            te, xe = sol.ts[-1], sol.ys[-1]
+            return te, xe, jnp.concatenate(form.zw(te, xe, pd, zg)), jnp.stack(sol.event_mask)
         self.segment_jit = segment
-        self.zw_jit = jax.jit(lambda x, pd, zg, t: jnp.concatenate(form.zw(t, x, pd, zg)))
 
     def _segment(self, x, pd, zg, t, t_end):
-        te, xe, mask = self.segment_jit(x, pd, zg, t, t_end)
+        te, xe, z, mask = self.segment_jit(x, pd, zg, t, t_end)
         mask = np.asarray(mask)
-        return float(te), np.asarray(xe), (int(np.argmax(mask)) if mask.any() else None)
-
-    def _zw(self, x, pd, zg, t):
-        return np.asarray(self.zw_jit(x, pd, zg, t))
+        return (float(te), np.asarray(xe), np.asarray(z),
+                int(np.argmax(mask)) if mask.any() else None)
 
 
 def _thrt(events):
@@ -694,20 +692,12 @@ def _casadi_pair(case, label, eng, chunk):
                   eng.replay(case.p, case.d, 0.0, case.y, case.yp, events), row[2])]
 
 
-def scipy_rows(case, methods):
+def ode_rows(case, engine, methods, label):
+    """One row per method of an ODE engine (:class:`ScipyODE`, :class:`DiffraxODE`)."""
     rows = []
     for method in methods:
-        eng = ScipyODE(case.cm, case.rtol, case.atol, method)
-        rows.append(case.row(f"scipy {method}, plain-Python right-hand side",
-                             lambda *a, e=eng: e.simulate(*a, case.t_end)))
-    return rows
-
-
-def diffrax_rows(case, solvers):
-    rows = []
-    for solver in solvers:
-        eng = DiffraxODE(case.cm, case.rtol, case.atol, solver)
-        rows.append(case.row(f"diffrax {solver} (JAX, CPU, jit), event root",
+        eng = engine(case.cm, case.rtol, case.atol, method)
+        rows.append(case.row(label.format(method),
                              lambda *a, e=eng: e.simulate(*a, case.t_end)))
     return rows
 
@@ -720,12 +710,14 @@ def outside_rows(case, args):
               "(pip install 'acausal[bench]')")
     else:
         rows += casadi_rows(case, [False] if args.no_jit else [False, True], args.cvodes)
-    rows += scipy_rows(case, args.scipy.split(","))
+    rows += ode_rows(case, ScipyODE, args.scipy.split(","),
+                     "scipy {}, plain-Python right-hand side")
     gone = _missing("jax", "diffrax", "optimistix")
     if gone:
         print(f"skipped: diffrax: {gone} is not installed (pip install 'acausal[bench]')")
     else:
-        rows += diffrax_rows(case, args.diffrax.split(","))
+        rows += ode_rows(case, DiffraxODE, args.diffrax.split(","),
+                         "diffrax {} (JAX, CPU, jit), event root")
     return rows
 
 
