@@ -563,7 +563,7 @@ class JaxForm:
         za, w0 = zg, self.w0
         for _ in range(self.newton):
             jac = jax.jacfwd(self.g, argnums=2)(t, x, za, w0, pd)
-            za = za - jnp.linalg.solve(jac, self.g(t, x, za, w0, pd))
+            za = za - _small_solve(jac, self.g(t, x, za, w0, pd))
         return za, self.w(t, x, za, w0, pd)
 
     def rhs(self, t, x, args):
@@ -574,6 +574,17 @@ class JaxForm:
         if expr.free_symbols & (set(dae.y[self.ns:]) | set(dae.yp[:self.ns])):
             return lambda t, y, args, **kw: root(t, y, *self.zw(t, y, *args), args[0])[0]
         return lambda t, y, args, **kw: root(t, y, args[1], self.w0, args[0])[0]
+
+
+def _small_solve(A, b):
+    """A^-1 b in jax.numpy; 2x2 by Cramer's rule: XLA's LAPACK call on the
+    CPU took two thirds of the diffrax run (1.5 against 0.56 ms) when the
+    closure's 2x2 Newton steps used ``jnp.linalg.solve``."""
+    import jax.numpy as jnp
+    if A.shape != (2, 2):
+        return jnp.linalg.solve(A, b)
+    det = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
+    return jnp.stack([A[1, 1] * b[0] - A[0, 1] * b[1], A[0, 0] * b[1] - A[1, 0] * b[0]]) / det
 
 
 class DiffraxODE(_OdeHybrid):
