@@ -37,9 +37,10 @@ of that engine would write for this hybrid system:
   ``jax.jit``-compiled ``diffeqsolve`` per mode segment with a
   ``diffrax.Event`` of the root functions (directions, optimistix Newton
   for the root time); Tsit5 by default (``--diffrax``): Dopri5 took about
-  the same time, Dopri8 6x and Kvaerno5 (implicit) 30x as long. Timed warm;
-  its compile time (13-45 s on 2 loaded cores) is the "first run" line
-  printed before the table.
+  as long, Dopri8 7x as long, Kvaerno5 (implicit) 30x (measured when the
+  Newton steps still used ``jnp.linalg.solve``). Timed warm; its compile
+  time (13-45 s on 2 loaded cores) is the "first run" line printed before
+  the table.
 
 The ODE engines reach the same THRT to a few 1e-10 s (the same rtol and
 per-state absolute tolerances; CVODES takes one absolute tolerance, so its
