@@ -46,12 +46,17 @@ The ODE engines reach the same THRT to a few 1e-10 s (the same rtol and
 per-state absolute tolerances; CVODES takes one absolute tolerance, so its
 states are scaled by theirs, which gives the same error weights).
 
-    python benchmarks/anchors.py [--repeat N] [--no-jit] [--cpu]
+    python benchmarks/anchors.py [--repeat N] [--no-jit] [--cpu] [--blocks]
         [--scipy LSODA,DOP853] [--diffrax Tsit5] [--cvodes adams|bdf]
 
 ``--cpu`` times CPU seconds of this process instead of wall time (the engines
-are single-threaded, except that XLA may use a second thread for JAX):
-steadier on a shared machine. The load average is printed with the table.
+are single-threaded; JAX's CPU time equalled its wall time here): steadier
+on a shared machine. The load average is printed with the table. The runs
+are interleaved (a, b, c, a, b, c, ...) so that a change of load hits every
+engine alike, but then each run starts with caches the others have used:
+``--blocks`` adds a column with each engine's runs back to back, what a loop
+of simulations on one engine sees (acausal's compiled backend and diffrax
+took about half their interleaved time that way).
 """
 import argparse
 import os
@@ -733,7 +738,9 @@ def outside_rows(case, args):
     return rows
 
 
-def print_table(runs, times, args, load0):
+def print_table(runs, times, args, load0, blocks=None):
+    """The table; ``blocks``: each engine's best time with its runs back to
+    back, when measured."""
     names = [lab for lab, _, _ in runs]
     idas = [tm for lab, tm in zip(names, times) if lab.startswith("CasADi IDAS")
             and "given" not in lab]
@@ -743,10 +750,14 @@ def print_table(runs, times, args, load0):
           f"{load0:.1f} before, {os.getloadavg()[0]:.1f} after); THRT difference against "
           "acausal sundae (benchmark options)")
     per = "x IDAS" if idas else "x best"      # per CasADi IDAS, else per the fastest row
-    print(f"{'engine':58s} {'ms/sim':>8s} {per:>7s} {'THRT [ms]':>12s} {'dTHRT [s]':>10s}")
-    for (lab, _, thrt), tm in zip(runs, times):
+    print(f"{'engine':58s} {'ms/sim':>8s} {per:>7s} {'THRT [ms]':>12s} {'dTHRT [s]':>10s}"
+          + (f" {'blocks':>7s}" if blocks else ""))
+    for k, ((lab, _, thrt), tm) in enumerate(zip(runs, times)):
         print(f"{lab:58s} {tm * 1e3:8.2f} {tm / anchor:7.2f} {thrt * 1e3:12.7f} "
-              f"{thrt - ref:10.1e}")
+              f"{thrt - ref:10.1e}" + (f" {blocks[k] * 1e3:7.2f}" if blocks else ""))
+    if blocks:
+        print("blocks: ms/sim with each engine's runs back to back (measured after the "
+              "interleaved runs)")
     fastest = min(tm for lab, tm in zip(names, times) if lab.startswith("acausal"))
     if idas:
         bound = min(tm for lab, tm in zip(names, times) if "given" in lab and "IDAS" in lab)
@@ -766,6 +777,8 @@ def main(argv=None):
     ap.add_argument("--cpu", action="store_true", help="CPU time instead of wall time")
     ap.add_argument("--scipy", default="LSODA,DOP853", help="solve_ivp methods, comma-separated")
     ap.add_argument("--diffrax", default="Tsit5", help="diffrax solvers, comma-separated")
+    ap.add_argument("--blocks", action="store_true",
+                    help="also time each engine's runs back to back (warm caches)")
     ap.add_argument("--cvodes", default="adams", choices=["adams", "bdf"],
                     help="CVODES's multistep method (Adams with functional iteration, "
                          "or BDF with Newton)")
@@ -778,9 +791,11 @@ def main(argv=None):
     bench.update(output_step=0, atol=ATOL)
     runs = acausal_rows(mf, cm, bench) + outside_rows(Case(cm, bench), args)
     load0 = os.getloadavg()[0]
-    times = best_interleaved([fn for _, fn, _ in runs], args.repeat,
-                             time.process_time if args.cpu else time.perf_counter)
-    print_table(runs, times, args, load0)
+    clock = time.process_time if args.cpu else time.perf_counter
+    times = best_interleaved([fn for _, fn, _ in runs], args.repeat, clock)
+    blocks = [best_interleaved([fn], args.repeat, clock)[0] for _, fn, _ in runs] \
+        if args.blocks else None
+    print_table(runs, times, args, load0, blocks)
 
 
 if __name__ == "__main__":
