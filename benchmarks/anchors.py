@@ -390,7 +390,7 @@ class CasadiCVODES(_CasadiHybrid):
     CasADi 3.8) fire on falling crossings only and need the event actions as
     CasADi functions (casadi#4393), so the events are located as for IDAS."""
 
-    def __init__(self, cm, rtol, atol, jit, grid=40, newton=3, method="bdf"):
+    def __init__(self, cm, rtol, atol, jit, grid=40, newton=3, method="adams"):
         import casadi as ca
         super().__init__(cm, grid)
         w_expr, cons = explicit_form(cm)
