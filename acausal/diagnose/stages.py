@@ -276,12 +276,14 @@ def _budget(cal):
 def member_refit_tasks(problem: Problem, cal, dec) -> list:
     """When the best row is a pair: each of its members alone, started from
     the pair's fit (its own parameters and the free parameters at the
-    pair's values; one refinement from the best scored start). A pair earns
+    pair's values; one refinement on the whole record from the best scored
+    start: :meth:`.problem.Problem.from_fit`). A pair earns
     its second cause only against the best each member can do alone, and a
     single fit can miss its minimum where the pair found it (breaker,
     position_dependent_force seed 6000: the coil slope alone ended at S
     3066, above the nominal 2803, while the pair with Hunt-Crossley had
-    it at 21281 and S 693; the slope alone reaches 695 from there)."""
+    it at 21281 and S 693; the slope alone reaches 695 from there on the
+    whole record, where a first window of 30 % led it back to its bound)."""
     best = dec.rows[0] if dec.rows else None
     if best is None or "+" not in best.candidate.hypothesis:
         return []
@@ -294,7 +296,7 @@ def member_refit_tasks(problem: Problem, cal, dec) -> list:
             continue
         cand = dataclasses.replace(single.candidate, params=tuple(
             p.moved(v[n]) for p, n in zip(single.candidate.params, names)))
-        task = fit_tasks(problem.one_start(), cal, [cand])[0]
+        task = fit_tasks(problem.from_fit(), cal, [cand])[0]
         out.append(dataclasses.replace(task, free=tuple(p.moved(v[p.name]) for p in task.free)))
     return out
 

@@ -102,7 +102,8 @@ def test_a_best_pair_has_its_members_refitted_alone_from_its_point():
         (p,) = t.candidate.params
         assert (p.name, p.start, p.prior) == ("hyp_h.k", k, 0.0)   # the pair's value
         assert [q.start for q in t.free] == [61.0] and t.free[0].prior == 50.0
-        assert t.problem.settings.refine == 1 and t.problem.settings.lhs == 0
+        st = t.problem.settings
+        assert st.refine == 1 and st.lhs == 0 and st.windows == (1.0,)
     # a single on top: nothing to refit
     assert member_refit_tasks(problem, _cal(), _Dec(rows[1:] + rows[:1])) == []
 
