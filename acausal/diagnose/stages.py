@@ -405,7 +405,8 @@ def decide(ds, cal: Calibration, fits, alpha=st.ALPHA) -> Decision:
     f0 = cal.fit
     n = f0.n
     good = _lowest_per_key([r for r in fits if r.ok])
-    failed = tuple(r for r in fits if not r.ok)
+    fitted = {r.candidate.key for r in good}
+    failed = tuple(r for r in fits if not r.ok and r.candidate.key not in fitted)
     c_hat = st.overdispersion([(f0.cost, n, f0.k)] + [(r.fit.cost, n, r.fit.k) for r in good])
     rows = [Row(r.candidate, r.fit, r.starts, r.loo, st.aicc(r.fit.cost, n, r.fit.k, c_hat),
                 st.lr_test(f0.cost, r.fit.cost, r.fit.k - f0.k), heldout_rms(r.loo))
