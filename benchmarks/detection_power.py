@@ -14,11 +14,14 @@ model against the data (every hypothesis x location of the library).
         --effects 1,3,10 --seeds 3 --nulls 10 --workers 2 --out docs/detection_power.md
 
 Columns: right = right cause at the right location named or in the named
-class; named = named exactly; weak = a discrepancy found but no cause named
-(evidence weak); missed = no discrepancy found; capped = cases whose
-location cannot reach the requested effect within the library's bounds on
-the parameter (the achieved effect is below 0.9 times the requested one;
-e.g. a cubic term on a spring that barely deflects): they are counted in
+class (or a member of its family there to which the truth's law reduces,
+e.g. Stribeck friction drawn with no static excess is Coulomb friction:
+:func:`acausal.diagnose.synth.same_law_members`); named = named exactly;
+weak = a discrepancy found but no cause named (evidence weak); missed = no
+discrepancy found; capped = cases whose location cannot reach the requested
+effect within the library's bounds on the parameter (the achieved effect is
+below 0.9 times the requested one; e.g. a cubic term on a spring that
+barely deflects): they are counted in
 their cell, with the achieved effect shown. The table is printed as Markdown
 and, with ``--out``, written to a file, with every case's outcome beside it
 as JSON (``--out`` with ``.json``).
@@ -53,7 +56,7 @@ SETUPS = {
 def run_case(model, hyp, effect, seed, library, quick):
     """One blind diagnosis; returns a dict of outcomes (runs in a worker)."""
     from acausal.diagnose.run import candidates, diagnose
-    from acausal.diagnose.synth import synthesize
+    from acausal.diagnose.synth import same_law_members, synthesize
 
     setup = SETUPS[model]
     rng = np.random.default_rng(seed)
@@ -72,15 +75,18 @@ def run_case(model, hyp, effect, seed, library, quick):
                        out_dir=os.path.join(tmp, "out"), scheduler="serial",
                        progress=False, exact_cv=False, plots=False, library=library,
                        max_nfev=30 if quick else 60)
+        read = {k: v for k, v in kw.items() if k != "units"}
+        same = same_law_members(setup["path"], truth, library=library, **read) if hyp else []
     members = [(out["cause"], out["location"])] + [(e["cause"], e["location"])
                                                   for e in out["equivalent_causes"]]
-    right = hyp is not None and (hyp, loc) in members
+    right = hyp is not None and any(m in members for m in [(hyp, loc)] + same)
     return dict(hyp=hyp, effect=effect, seed=seed, location=loc,
                 achieved=truth.effect, discrepancy=out["discrepancy"],
                 named=hyp is not None and out["cause"] == hyp and out["location"] == loc,
                 right=bool(right and out["discrepancy"]),
                 weak=out["discrepancy"] and out["cause"] is None,
-                cause=out["cause"], wall_s=time.perf_counter() - t0,
+                cause=out["cause"], cause_location=out["location"],
+                same_law=[f"{h} at {l}" for h, l in same], wall_s=time.perf_counter() - t0,
                 cpu_s=time.process_time() - c0)
 
 

@@ -108,8 +108,9 @@ def fit_members(problem, cal, dec, ex, progress=True, collect=None) -> tuple:
              for t, (_, head) in zip(tasks, pairs)]
     rest = other_members(problem, dec, index, done | {c.key for c, _ in pairs})
     # a screened member starts where the step predicts: one refinement suffices
-    tasks += fit_tasks(problem.one_start(), cal, screened(problem, cal, dec, rest, ex,
-                                                          run_tasks))
+    steps = screened(problem, cal, dec, rest, ex, run_tasks)
+    tasks += [dataclasses.replace(t, seed_free=free) for t, (_, free) in zip(
+        fit_tasks(problem.one_start(), cal, [c for c, _ in steps]), steps)]
     if not tasks:
         return ()
     return tuple(run_tasks(ex, fit_candidate, tasks, "fitting family members", progress,

@@ -157,3 +157,11 @@ class Problem:
         already lies in the right basin."""
         return dataclasses.replace(self, settings=dataclasses.replace(
             self.settings, lhs=0, refine=1))
+
+    def from_fit(self) -> "Problem":
+        """:meth:`one_start` on the whole record only (no growing windows):
+        for a start that is already a fit to the whole record (a pair's
+        member refitted alone from the pair's point), which a first window
+        could only lead away."""
+        return dataclasses.replace(self, settings=dataclasses.replace(
+            self.settings, lhs=0, refine=1, windows=(1.0,)))

@@ -29,6 +29,7 @@ from .problem import FitSettings
 from .result import Diagnosis, details, summary
 from .resume import FitStore
 from .stages import DiagnosisError
+from .tasks import fit_candidate
 
 __all__ = ["diagnose", "run_stages", "DiagnosisError"]
 
@@ -62,10 +63,8 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
             fits += members
             dec = stages.decide(ds, cal, fits, alpha)
         if pairs and stages.pairs_needed(dec):
-            got, clock["pair_screen_n_sim"] = _timed(clock, "pairs_s", stages.search_pairs,
-                                                     problem, cal, dec, ex, progress, collect)
-            fits += got
-            dec = stages.decide(ds, cal, fits, alpha)
+            fits, dec = _timed(clock, "pairs_s", _pairs, problem, ds, cal, dec, fits, ex,
+                               (progress, collect, alpha), clock)
         cv = stages.cross_validate(problem, ds, cal, dec, ex, exact_cv, progress)
         rk = stages.rank(ds, cal, dec, cv)
         if families:
@@ -90,6 +89,23 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
                   total_s=time.perf_counter() - t0, **clock)
     return Diagnosis(problem, ds, cal, len(cands), dec, cv, rk, extended, shown,
                      nxt, timing, where, ivs, index)
+
+
+def _pairs(problem, ds, cal, dec, fits, ex, opts, clock):
+    """(fits, decision) after the pair search (:func:`.stages.search_pairs`)
+    and, when a pair comes out best, its members refitted alone from the
+    pair's point (:func:`.stages.member_refit_tasks`)."""
+    progress, collect, alpha = opts
+    got, clock["pair_screen_n_sim"] = stages.search_pairs(problem, cal, dec, ex, progress,
+                                                          collect)
+    fits += got
+    dec = stages.decide(ds, cal, fits, alpha)
+    again = stages.member_refit_tasks(problem, cal, dec)
+    if not again:
+        return fits, dec
+    fits += tuple(stages.run_tasks(ex, fit_candidate, again, "refitting the pair's members",
+                                   progress, collect))
+    return fits, stages.decide(ds, cal, fits, alpha)
 
 
 def _timed(clock, key, fn, *args):

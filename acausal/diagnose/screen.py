@@ -85,10 +85,22 @@ def _stepped(cand, d_own):
         q.moved(q.start + float(x) * (abs(q.scale) or 1.0)) for q, x in zip(cand.params, d_own)))
 
 
+def _free_step(problem, f0, d_free):
+    """The free parameters' values after the predicted step (the nominal
+    fit's Jacobian is in parameter units), clipped to their bounds: the
+    step's own part alone is not the point it predicts (a bilinear open
+    spring on the breaker: 548 predicted, 11859 with the free parameters
+    left at their calibrated values)."""
+    step = dict(zip(f0.names, np.asarray(d_free, float).tolist()))
+    return tuple(float(min(max(f0.values[p.name] + step.get(p.name, 0.0), p.low), p.high))
+                 for p in problem.free)
+
+
 def screened(problem, cal, dec, cands, ex, run_tasks) -> list:
-    """The candidates of ``cands`` whose predicted AICc comes within reach of
-    the best row's, most promising first, each with the predicted step as a
-    second start (module doc)."""
+    """[(candidate, free values)] of the candidates of ``cands`` whose
+    predicted AICc comes within reach of the best row's, most promising
+    first, each with the predicted step as a second start: its own
+    parameters' (in the candidate) and the free parameters' (module doc)."""
     if not cands or not dec.rows:
         return []
     f0 = cal.fit
@@ -104,6 +116,6 @@ def screened(problem, cal, dec, cands, ex, run_tasks) -> list:
         S, d = predicted_step(o[0], o[1], f0.jacobian)
         a = st.aicc(S, f0.n, f0.k + len(c.params), dec.c_hat) if np.isfinite(S) else np.inf
         if a < reach:
-            scored.append((a, _stepped(c, d[f0.k:])))
+            scored.append((a, _stepped(c, d[f0.k:]), _free_step(problem, f0, d[:f0.k])))
     scored.sort(key=lambda t: t[0])
-    return [c for _, c in scored[:MAX_FITS]]
+    return [(c, free) for _, c, free in scored[:MAX_FITS]]

@@ -142,6 +142,54 @@ def synthesize(model_path, folder, *, conditions, hypothesis=None, location=None
     return Truth(hypothesis, location, ext_values, truth_free, achieved, seed, names)
 
 
+SAME_LAW = 1e-4   # floors (RMS): a law this close to the truth's data is the truth's law
+                  # (identical laws differ by the solver's error, ~4e-6 on the breaker)
+
+
+def same_law_members(model_path, truth: Truth, *, conditions, measures=(), traces=(),
+                     sample_rate=None, noise=None, resolution=None, library=None,
+                     tol=SAME_LAW) -> list:
+    """The members of the truth's family at its location (``[(hypothesis,
+    location)]``) whose law, given the truth's parameter values (matched by
+    name after the sub-model prefix; the member's others at their initial
+    values), changes the truth's noise-free data by less than ``tol``
+    floors (identical up to the solver's error): the truth's law reduces to
+    them (Stribeck friction drawn with its static excess dtau = 0 is Coulomb
+    friction), so naming one of them names the truth. Only members of one family are compared: their laws are
+    nested, whereas a different cause that merely mimics the truth on these
+    experiments (a constant load for a friction that never reverses) is not
+    the same cause."""
+    if truth.hypothesis is None:
+        return []
+    lib = load_library(library)
+    family = next((ms for ms in lib.FAMILIES.values() if truth.hypothesis in ms), ())
+    others = [m for m in family if m != truth.hypothesis and m in lib.HYPOTHESES]
+    if not others:
+        return []
+    conds = _conditions(conditions)
+    measures, traces = list(measures), list(traces)
+    floors = _floors(measures + traces, noise, resolution)
+    ref = _simulate(lib.build_extended(model_path, truth.hypothesis, truth.location),
+                    {**truth.free, **truth.values}, conds)
+    short = {k.partition(".")[2]: v for k, v in truth.values.items()}
+    graph = lib.graph_of(model_path)
+    out = []
+    for m in others:
+        h = lib.HYPOTHESES[m]
+        if truth.location not in h.candidates(graph):
+            continue
+        vals = {s.name: short.get(s.name.partition(".")[2], float(s.initial))
+                for s in h.params(graph, truth.location)}
+        try:
+            runs = _simulate(lib.build_extended(model_path, m, truth.location),
+                             {**truth.free, **vals}, conds)
+        except AcausalError:
+            continue
+        if _effect(runs, ref, measures, traces, floors, sample_rate) < tol:
+            out.append((m, truth.location))
+    return out
+
+
 def _truth_free(mf, cm, free, jitter, rng):
     """The free parameters of the truth: given, or the model's values each
     times exp(jitter N(0, 1)), kept in their bounds."""

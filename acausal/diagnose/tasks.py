@@ -30,6 +30,7 @@ from scipy.stats import qmc
 
 from ..calibrate import model_dataset
 from ..data import Dataset, Experiment, Trace
+from ..errors import AcausalError
 from ..executor import worker_cache
 from ..modelfile import compile_file
 from .fitting import Fit, Objective, failed_fit, finish, linear_loo, refine_or_keep, \
@@ -44,13 +45,17 @@ from .problem import LOO_TOL, Candidate, Problem
 class FitTask:
     """Fit ``candidate`` within ``problem``; ``free`` are the free
     parameters with the calibrated values as starts (the prior kept in
-    ``Param.prior``); ``absorb`` = (names, Jacobian) of the nominal fit."""
+    ``Param.prior``); ``absorb`` = (names, Jacobian) of the nominal fit;
+    ``seed_free``: values of the free parameters (in ``free``'s order) that
+    go with the candidate's seeded starts, one more start (a screened
+    member's Gauss-Newton step moves both)."""
 
     problem: Problem
     candidate: Candidate
     free: tuple
     absorb: tuple | None = None
     budget_s: float | None = None
+    seed_free: tuple | None = None   # free values that go with a seeded start (a step's)
 
     @property
     def cost(self) -> float:
@@ -182,6 +187,8 @@ def start_points(task: FitTask):
     seeded = [p.start for p in ext]
     if seeded != neutral:                 # a seed (a pair from its single fits)
         pts.append((np.array(cal + seeded), False))
+        if task.seed_free is not None:    # ... with the free values it was predicted with
+            pts.append((np.array(list(task.seed_free) + seeded), False))
     differs = any(abs(a - b) > 1e-9 * max(abs(b), 1e-300) for a, b in zip(cal, prior))
     if differs and ext:
         pts.append((np.array(prior + neutral), True))
@@ -422,8 +429,10 @@ class Refiner:
     def path(self, x, earlier=()):
         """The per-window fits from ``x`` (the last on the whole record), or
         those of an ``earlier`` path it meets. ``n_sim`` of the last fit
-        counts this path's own simulations on every window."""
-        out, n_sim = [], 0
+        counts this path's own simulations on every window. A path that
+        ends above its own start on the whole record is replaced by a
+        refinement of the start on the whole record (:meth:`direct`)."""
+        out, n_sim, x0 = [], 0, x
         for i, w in enumerate(self.windows):
             fit, met, used = self.window_fit(w, x, [p[i] for p in earlier])
             n_sim += used
@@ -432,8 +441,45 @@ class Refiner:
                 break
             out.append(fit)
             x = np.array([fit.values[n] for n in self.names])
+        else:
+            out[-1], used = self.direct(x0, out[-1])
+            n_sim += used
         out[-1] = dataclasses.replace(out[-1], n_sim=n_sim)
         return out
+
+    def direct(self, x0, end):
+        """(fit, simulations): ``end`` (the last window's fit of the path
+        from ``x0``), or, when it ends above ``x0``'s own cost on the whole
+        record (beyond the converged-start tolerance), the refinement of
+        ``x0`` on the whole record if that ends lower. The growing windows
+        keep an oscillating trace from wrapping its phase, but a window can
+        also lead away: on a breaker case a stroke-dependent coil force ran
+        to its lower bound on the first 30 % of the record, and the whole
+        record's refinement stayed there, 263 above the nominal model the
+        candidate nests (its start), while a refinement of the start on the
+        whole record reached the truth."""
+        if len(self.windows) < 2 or not np.isfinite(end.cost):
+            return end, 0
+        obj = Objective(self.pair, self.ds, self.names, budget_s=self.budget_s,
+                        penalty=self.penalty, backend=self.settings.integrator)
+        try:
+            r = obj(np.clip(np.asarray(x0, float), self.lo, self.hi))
+        except AcausalError:
+            return end, obj.n_sim
+        total = end.cost + self._penalty([end.values[n] for n in self.names])
+        if total <= float(r @ r) + max(0.5, 1e-3 * total):
+            return end, obj.n_sim
+        fit, _, used = self.window_fit(1.0, x0)
+        better = fit.cost + self._penalty([fit.values[n] for n in self.names]) < total
+        return (fit if better else end), obj.n_sim + used
+
+    def _penalty(self, x):
+        """The penalty rows' share of the cost at ``x`` (0 without a penalty)."""
+        if self.penalty is None:
+            return 0.0
+        P, sc = self.penalty
+        p = P @ (np.asarray(x, float)[-P.shape[1]:] / sc)
+        return float(p @ p)
 
     def all(self, starts):
         """The final fit of each start's path, in order."""

@@ -89,3 +89,24 @@ def test_bad_requests(tmp_path):
     with pytest.raises(UsageError, match="values, magnitude or effect"):
         synthesize(LATCH, tmp_path, conditions=COND, measures=["trip_time"],
                    hypothesis="constant_load", location="latch", library=STUB)
+
+
+def test_a_truth_whose_law_reduces_to_another_member_names_it():
+    """Stribeck friction drawn with no static excess is Coulomb friction (and
+    Coulomb + viscous with b = 0): naming either names the truth; with a
+    static excess it is neither (benchmarks/detection_power.py's judgement)."""
+    from acausal.diagnose.synth import Truth, same_law_members
+    slider = os.path.join(HERE, "slider_model.py")
+    read = dict(conditions={"s0": [0.1, -0.05], "v0": [0.0, 0.3]}, traces=["mass.s"],
+                sample_rate=500.0, noise={"mass.s": 1e-4})
+    free = {"spring.c": 90.0}
+    plain = Truth("stribeck_friction", "mass", {"hyp_sf.F": 2.0, "hyp_sf.dF": 0.0,
+                                                "hyp_sf.v_s": 0.05}, free)
+    assert sorted(same_law_members(slider, plain, **read)) == [
+        ("coulomb_friction", "mass"), ("coulomb_viscous_friction", "mass")]
+    excess = Truth("stribeck_friction", "mass", {"hyp_sf.F": 2.0, "hyp_sf.dF": 1.0,
+                                                 "hyp_sf.v_s": 0.05}, free)
+    assert same_law_members(slider, excess, **read) == []
+    assert same_law_members(slider, Truth("constant_load", "mass", {"hyp_cl.F": 1.0},
+                                          free), **read) == []
+    assert same_law_members(slider, Truth(None, None), **read) == []
