@@ -3,7 +3,7 @@ cause, an extended model and the measured gain.
 
 :func:`diagnose` chains the stages of :mod:`.stages` (calibrate ->
 candidates -> fit -> family members -> decide -> pairs -> cross-validate ->
-rank -> locate -> intervals -> extend -> next experiment -> views),
+rank -> tied sites -> locate -> intervals -> extend -> next experiment -> views),
 keeps what they return in a :class:`~.result.Diagnosis`, renders the
 report from it (:mod:`.report`, a pure view) and returns the JSON summary
 (:func:`.result.summary`).
@@ -23,6 +23,7 @@ from . import stages
 from . import stats as st
 from .families import family_index, fit_members, prefer_simplest
 from .intervals import intervals
+from .kinematics import Kinematics, equivalents, kinematics, prefer_site
 from .locate import Location, locate
 from .nextexp import next_experiment
 from .problem import FitSettings
@@ -70,12 +71,16 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
         rk = stages.rank(ds, cal, dec, cv)
         if families:
             rk = prefer_simplest(rk, family_index(problem.library))
+        kin = _timed(clock, "kinematics_s", kinematics, problem, cal) if rk.after is not None \
+            else Kinematics(message="no cause to place")
+        rk = prefer_site(rk, kin)
         where = locate(problem, cal, dec, rk, ex, progress, collect) if generic else Location(
             skipped="not run (generic=False)")
         ivs = _timed(clock, "profile_s", intervals, problem, cal, rk, ex,
                      progress) if profile else None
     Path(out_dir).mkdir(parents=True, exist_ok=True)
     extended = stages.extend(problem, rk, out_dir)
+    tied = equivalents(problem, kin, rk)
     index = family_index(problem.library)
     nxt = _timed(clock, "design_s", next_experiment, problem, ds, dec, rk,
                  index) if design else None
@@ -89,7 +94,7 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
     timing = dict(fit_s=t_fit, cv_s=t_cv, n_candidates=len(cands), n_sim=n_sim,
                   total_s=time.perf_counter() - t0, **clock)
     return Diagnosis(problem, ds, cal, len(cands), dec, cv, rk, extended, shown,
-                     nxt, timing, where, ivs, index)
+                     nxt, timing, where, ivs, index, kin, tied)
 
 
 def _timed(clock, key, fn, *args):
