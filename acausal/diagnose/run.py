@@ -69,11 +69,7 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
             dec = stages.decide(ds, cal, fits, alpha)
         cv = stages.cross_validate(problem, ds, cal, dec, ex, exact_cv, progress)
         rk = stages.rank(ds, cal, dec, cv)
-        if families:
-            rk = prefer_simplest(rk, family_index(problem.library))
-        kin = _timed(clock, "kinematics_s", kinematics, problem, cal) if rk.after is not None \
-            else Kinematics(message="no cause to place")
-        rk = prefer_site(rk, kin)
+        rk, kin = _shown(problem, cal, rk, families, clock)
         where = locate(problem, cal, dec, rk, ex, progress, collect) if generic else Location(
             skipped="not run (generic=False)")
         ivs = _timed(clock, "profile_s", intervals, problem, cal, rk, ex,
@@ -95,6 +91,19 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
                   total_s=time.perf_counter() - t0, **clock)
     return Diagnosis(problem, ds, cal, len(cands), dec, cv, rk, extended, shown,
                      nxt, timing, where, ivs, index, kin, tied)
+
+
+def _shown(problem, cal, rk, families, clock):
+    """(ranking, Kinematics): the row shown moved to the simplest member of
+    its family the data support (:func:`.families.prefer_simplest`), then to
+    a kinematically tied site whose coordinate is measured when the data
+    cannot tell the two apart (:func:`.kinematics.prefer_site`)."""
+    if families:
+        rk = prefer_simplest(rk, family_index(problem.library))
+    if rk.after is None:
+        return rk, Kinematics(message="no cause to place")
+    kin = _timed(clock, "kinematics_s", kinematics, problem, cal)
+    return prefer_site(rk, kin), kin
 
 
 def _timed(clock, key, fn, *args):
