@@ -161,13 +161,13 @@ def kinematics(problem, cal, tol=KIN_TOL) -> Kinematics:
         return Kinematics(message="no sites" if not coords else "a nominal run failed")
     signals = sorted({s for e in ds.experiments if e.trace is not None for s in e.trace.signals})
     series = {}
-    for name, var in [(p, v) for p, v in coords.items()] + [(s, s) for s in signals]:
+    for name, var in list(coords.items()) + [(s, s) for s in signals]:
         try:
             series[name] = rates([(res.t, res[var]) for res in sims.values()])
         except KeyError:
             continue
     sites = [p for p in coords if p in series]
-    ties = tuple(t for t in ties_of({p: series[p] for p in sites}, tol))
+    ties = ties_of({p: series[p] for p in sites}, tol)
     measured = tuple((p, s) for p in sites for s in signals if s in series and p != s
                      and _same(tie(series[p], series[s], tol), tol))
     return Kinematics(ties, measured)

@@ -36,8 +36,8 @@ def _dataset(folder):
     exps = []
     for name, x0 in (("a", 0.01), ("b", 0.016)):
         res = cm.simulate(params={"x0": x0}, **mf.experiment.run_options())
-        exps.append(Experiment(name, {"x0": x0}, {},
-                               Trace(np.asarray(res.t), {"slider.s": np.asarray(res["slider.s"])})))
+        trace = Trace(np.asarray(res.t), {"slider.s": np.asarray(res["slider.s"])})
+        exps.append(Experiment(name, {"x0": x0}, {}, trace))
     write_dataset(folder, Dataset(str(folder), exps,
                                   {"slider.s": Instrument("slider.s", 0.0, 1e-6)}))
     return folder
