@@ -53,6 +53,11 @@ from .tasks import dataset_of, model_of
 # varies over the stroke), armature and hook far apart (the armature moves
 # alone before the contact).
 KIN_TOL = 0.05
+# A traced signal is a site's coordinate when their rates agree to this
+# (ratio +1, spread): a sensor on the site's flange or the same variable. Not
+# a looser "about +-1": on the planar breaker the cam pin turns at -1.0017
+# times the hook (spread 4e-5) and its angle is not the measured hook angle.
+SAME_TOL = 1e-3
 
 
 @dataclass(frozen=True)
@@ -69,8 +74,8 @@ class Tie:
 @dataclass(frozen=True)
 class Kinematics:
     """The tied sites of a model over the data (``ties``), and ``measured``:
-    (site, signal) pairs whose coordinate a traced signal records (tied at
-    ratio +-1). ``message``: why nothing was found, when so."""
+    (site, signal) pairs whose coordinate a traced signal records (the same
+    rate, :data:`SAME_TOL`). ``message``: why nothing was found, when so."""
 
     ties: tuple = ()
     measured: tuple = ()
@@ -169,13 +174,13 @@ def kinematics(problem, cal, tol=KIN_TOL) -> Kinematics:
     sites = [p for p in coords if p in series]
     ties = ties_of({p: series[p] for p in sites}, tol)
     measured = tuple((p, s) for p in sites for s in signals if s in series and p != s
-                     and _same(tie(series[p], series[s], tol), tol))
+                     and _same(tie(series[p], series[s], SAME_TOL)))
     return Kinematics(ties, measured)
 
 
-def _same(got, tol) -> bool:
-    """A tie at ratio +-1: the signal is the site's coordinate."""
-    return got is not None and abs(abs(got[0]) - 1.0) <= tol
+def _same(got) -> bool:
+    """A tie at ratio +1: the signal is the site's coordinate."""
+    return got is not None and abs(got[0] - 1.0) <= SAME_TOL
 
 
 # -- converting a cause's parameters --------------------------------------------------
