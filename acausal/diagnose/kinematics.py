@@ -251,13 +251,17 @@ def _class_of(rk, i) -> list:
     return next((c for c in rk.classes if i in c), [i])
 
 
+def _members(candidate) -> list:
+    return sorted((h, loc) for h, loc, _ in candidate.members())
+
+
 def _alternative(rk, row, i, site):
     """Index of the ranked row that is ``row`` with its member ``i`` at
-    ``site`` instead (None: not fitted)."""
-    locs = row.candidate.location.split("+")
-    locs[i] = site
-    key = (row.candidate.hypothesis, "+".join(locs))
-    return next((j for j, r in enumerate(rk.rows) if r.candidate.key == key), None)
+    ``site`` instead, a pair's members in either order (None: not fitted)."""
+    want = [(h, site if k == i else loc) for k, (h, loc, _) in
+            enumerate(row.candidate.members())]
+    return next((j for j, r in enumerate(rk.rows) if _members(r.candidate) == sorted(want)),
+                None)
 
 
 def prefer_site(rk, kin: Kinematics):
@@ -305,7 +309,7 @@ def equivalents(problem, kin: Kinematics, rk) -> tuple:
 def _at(rk, row, i, hyp, graph, other, ratio, spread) -> EquivalentSite:
     """Member ``i`` of ``row`` at the tied site ``other`` (rate ratio
     ``ratio`` against its own site)."""
-    _, loc, names = row.candidate.members()[i]
+    h, loc, names = row.candidate.members()[i]
     prefix = names[0].partition(".")[0]
     dom = domain_name(graph.components[loc])
     odd = getattr(hyp, "odd", True)
@@ -317,7 +321,8 @@ def _at(rk, row, i, hyp, graph, other, ratio, spread) -> EquivalentSite:
     if j is None:
         return EquivalentSite(other, ratio, spread, tuple(values))
     alt = rk.rows[j]
-    fitted = tuple((nm, alt.fit.values[nm]) for nm in alt.candidate.members()[i][2])
+    there = next(nm for hh, at, nm in alt.candidate.members() if (hh, at) == (h, other))
+    fitted = tuple((nm, alt.fit.values[nm]) for nm in there)
     return EquivalentSite(other, ratio, spread, tuple(values), fitted, alt.aicc - row.aicc,
                           j in _class_of(rk, rk.after))
 

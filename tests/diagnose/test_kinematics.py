@@ -156,3 +156,21 @@ def test_sites_the_data_tell_apart_or_untied_sites_keep_the_ranking():
     assert prefer_site(_ranking([[0, 1], [2]]), none).after == 0
     assert equivalents(problem, none, _ranking([[0, 1], [2]])) == ()
     assert isinstance(eq.sites[0], EquivalentSite) and HYPOTHESES["constant_load"].odd is False
+
+
+def test_a_pair_member_is_found_at_the_tied_site_in_either_order():
+    """Drag on the tip + friction on the slider named; the pair with the
+    friction on the wheel was fitted with its members the other way round:
+    it is the friction's fit at the tied site."""
+    problem = Problem(LEVER, "", "acausal.diagnose.hypotheses", FREE)
+    named = _row("quadratic_damping+coulomb_friction", "tip+slider",
+                 {"k.c": 500.0, "hyp_qd.c": 1.0, "hyp_cf.F": 0.08}, 10.0)
+    alt = _row("coulomb_friction+quadratic_damping", "wheel+tip",
+               {"k.c": 500.0, "hyp_cf.tau": 0.0041, "hyp_qd.c": 1.0}, 10.5)
+    rk = Ranking((named, alt), [[0, 1]], 0, 0, None, [], (), 5.0)
+    (eq,) = equivalents(problem, TIED, rk)
+    assert (eq.cause, eq.location) == ("coulomb_friction", "slider")
+    (site,) = eq.sites
+    assert site.location == "wheel" and dict(site.fitted) == {"hyp_cf.tau": 0.0041}
+    assert dict(site.values)["hyp_cf.tau"] == pytest.approx(0.08 * 0.05)
+    assert prefer_site(rk, TIED).after == 1
