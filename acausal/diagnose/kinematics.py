@@ -223,8 +223,10 @@ class EquivalentSite:
     cause's site's), the cause's parameters converted through it
     (``values``: (name, value) pairs, named as at that site), the same
     hypothesis's own fit there (``fitted``, empty when it was not fitted),
-    its AICc against the cause's (``daicc``) and whether the data tell it
-    apart from the cause (``in_class``: False when they do)."""
+    its AICc against the cause's (``daicc``), whether the data tell it
+    apart from the cause (``in_class``: False when they do) and whether the
+    converted values lie in the hypothesis's declared range at that site
+    (``in_range``: a fit there cannot reach them otherwise)."""
 
     location: str
     ratio: float
@@ -233,6 +235,7 @@ class EquivalentSite:
     fitted: tuple = ()
     daicc: float | None = None
     in_class: bool = False
+    in_range: bool = True
 
 
 @dataclass(frozen=True)
@@ -313,18 +316,19 @@ def _at(rk, row, i, hyp, graph, other, ratio, spread) -> EquivalentSite:
     prefix = names[0].partition(".")[0]
     dom = domain_name(graph.components[loc])
     odd = getattr(hyp, "odd", True)
-    values = []
+    values, in_range = [], True
     for here, there, name in zip(hyp.params(graph, loc), hyp.params(graph, other), names):
         v = convert(row.fit.values[name], here.unit, dom, ratio, odd)
         values.append((f"{prefix}.{there.name.partition('.')[2]}", v))
+        in_range = in_range and v is not None and there.low <= v <= there.high
     j = _alternative(rk, row, i, other)
     if j is None:
-        return EquivalentSite(other, ratio, spread, tuple(values))
+        return EquivalentSite(other, ratio, spread, tuple(values), in_range=in_range)
     alt = rk.rows[j]
     there = next(nm for hh, at, nm in alt.candidate.members() if (hh, at) == (h, other))
     fitted = tuple((nm, alt.fit.values[nm]) for nm in there)
     return EquivalentSite(other, ratio, spread, tuple(values), fitted, alt.aicc - row.aicc,
-                          j in _class_of(rk, rk.after))
+                          j in _class_of(rk, rk.after), in_range)
 
 
 def _reason(kin: Kinematics, loc, sites) -> str:
@@ -336,6 +340,8 @@ def _reason(kin: Kinematics, loc, sites) -> str:
         return (f"`{loc}` is shown: the same cause at the tied site(s) "
                 + ", ".join(f"`{s.location}`" + (" was not fitted" if s.daicc is None else
                                                  f" ranks {s.daicc:+.3g} AICc units apart")
+                            + ("" if s.in_range else " (its converted parameters lie "
+                               "outside the range declared there, which a fit cannot leave)")
                             for s in sites) + ".")
     txt = (f"The data cannot tell `{loc}` from " + ", ".join(f"`{x}`" for x in same)
            + ": the sites move together at a fixed ratio and the fits there are one class.")

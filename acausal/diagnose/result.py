@@ -101,13 +101,15 @@ def _causes(d, row):
 def equivalent_sites(tied) -> list:
     """The sites kinematically tied to a cause's (``kinematics.SiteEquivalence``
     or None): each with its rate ratio (its rate per the cause's site's),
-    the ratio's spread, the cause's parameters converted through the ratio,
-    and the same hypothesis's own fit there (null when not fitted) with its
+    the ratio's spread, the cause's parameters converted through the ratio
+    (``in_range``: inside the range the hypothesis declares there), and the
+    same hypothesis's own fit there (null when not fitted) with its
     AICc against the cause's and whether the data tell the two apart."""
     if tied is None:
         return []
     return [dict(location=s.location, ratio=num(s.ratio), spread=num(s.spread),
                  parameters={k: None if v is None else num(v) for k, v in s.values},
+                 in_range=bool(s.in_range),
                  fitted=None if not s.fitted else dict(
                      parameters={k: num(v) for k, v in s.fitted}, daicc=num(s.daicc),
                      same_class=bool(s.in_class)))

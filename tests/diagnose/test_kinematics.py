@@ -135,7 +135,7 @@ def test_the_measured_site_is_shown_and_every_tied_site_reported():
     assert site.location == "slider" and site.ratio == pytest.approx(ARM)
     assert dict(site.values)["hyp_cf.F"] == pytest.approx(0.0041 / 0.05)
     assert dict(site.fitted) == {"hyp_cf.F": 0.08}
-    assert site.daicc == pytest.approx(-0.3) and site.in_class
+    assert site.daicc == pytest.approx(-0.3) and site.in_class and site.in_range
     assert "cannot tell `wheel` from `slider`" in eq.reason
     assert "measured signal `wheel.phi`" in eq.reason
     got = equivalent_sites(eq)
@@ -152,6 +152,11 @@ def test_sites_the_data_tell_apart_or_untied_sites_keep_the_ranking():
     assert rk.after == 0
     (eq,) = equivalents(problem, TIED, rk)
     assert not eq.sites[0].in_class and "ranks +0.3 AICc units apart" in eq.reason
+    # a friction on the slider too large for the wheel's declared range is said to be so
+    big = Ranking((_row("coulomb_friction", "slider", {"k.c": 500.0, "hyp_cf.F": 1e6}, 10.0),),
+                  [[0]], 0, 0, None, [], (), 5.0)
+    (eq,) = equivalents(problem, TIED, big)
+    assert not eq.sites[0].in_range and "outside the range declared there" in eq.reason
     none = Kinematics()
     assert prefer_site(_ranking([[0, 1], [2]]), none).after == 0
     assert equivalents(problem, none, _ranking([[0, 1], [2]])) == ()
