@@ -45,6 +45,7 @@ from .domain import DOMAINS, domain_name
 from .library import load_library
 from .problem import NOMINAL
 from .tasks import dataset_of, model_of
+from .views import simulate_all
 
 # Rate series whose best constant ratio leaves more than this fraction (RMS,
 # relative) are not tied. 5 %: the converted parameter is then right to
@@ -152,23 +153,23 @@ def coordinates(graph) -> dict:
 
 def kinematics(problem, cal, tol=KIN_TOL) -> Kinematics:
     """The stage: simulate the calibrated nominal model on every experiment
-    (one run each, main process) and tie the sites' rates (module doc)."""
-    from .views import simulate_all
+    (one run each, main process) and tie the sites' rates (module doc); an
+    experiment whose run fails is left out."""
     lib = load_library(problem.library)
     try:
         coords = coordinates(lib.graph_of(problem.model_path))
     except Exception as exc:  # noqa: BLE001 - a stand-in library without sites
         return Kinematics(message=f"no sites: {type(exc).__name__}: {exc}")
     ds = dataset_of(problem)
-    sims = simulate_all(model_of(problem, NOMINAL), ds, cal.fit.values,
-                        problem.settings.integrator)
-    if not coords or any(r is None for r in sims.values()):
-        return Kinematics(message="no sites" if not coords else "a nominal run failed")
+    runs = [r for r in simulate_all(model_of(problem, NOMINAL), ds, cal.fit.values,
+                                    problem.settings.integrator).values() if r is not None]
+    if not coords or not runs:
+        return Kinematics(message="no sites" if not coords else "every nominal run failed")
     signals = sorted({s for e in ds.experiments if e.trace is not None for s in e.trace.signals})
     series = {}
     for name, var in list(coords.items()) + [(s, s) for s in signals]:
         try:
-            series[name] = rates([(res.t, res[var]) for res in sims.values()])
+            series[name] = rates([(res.t, res[var]) for res in runs])
         except KeyError:
             continue
     sites = [p for p in coords if p in series]
