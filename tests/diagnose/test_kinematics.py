@@ -179,3 +179,38 @@ def test_a_pair_member_is_found_at_the_tied_site_in_either_order():
     assert site.location == "wheel" and dict(site.fitted) == {"hyp_cf.tau": 0.0041}
     assert dict(site.values)["hyp_cf.tau"] == pytest.approx(0.08 * 0.05)
     assert prefer_site(rk, TIED).after == 1
+
+
+def test_a_diagnosis_reports_the_tied_site(tmp_path):
+    """The whole chain on the lever (data from the model with Coulomb friction
+    at the wheel, the slider's travel traced): the friction is named with the
+    other of wheel and slider as its tied site in the JSON and the report;
+    when the data cannot tell them apart, the slider (its travel is the
+    measured signal) is the site shown."""
+    from acausal.diagnose.problem import FitSettings
+    from acausal.diagnose.run import diagnose
+    mf, cm = build_extended(LEVER, "coulomb_friction", "wheel")
+    rng = np.random.default_rng(5)
+    exps = []
+    for name, x0 in (("a", 0.01), ("b", 0.016), ("c", 0.02)):
+        res = cm.simulate(params={"x0": x0, "hyp_cf.tau": 0.002}, **mf.experiment.run_options())
+        s = np.asarray(res["slider.s"]) + 1e-6 * rng.standard_normal(len(res.t))
+        exps.append(Experiment(name, {"x0": x0}, {}, Trace(np.asarray(res.t), {"slider.s": s})))
+    write_dataset(tmp_path / "data", Dataset(str(tmp_path / "data"), exps,
+                                             {"slider.s": Instrument("slider.s", 0.0, 1e-6)}))
+    out = diagnose(LEVER, tmp_path / "data", out_dir=tmp_path / "out", workers=1,
+                   progress=False, hypotheses=["coulomb_friction"], generic=False, pairs=False,
+                   families=False, profile=False, design=False, plots=False,
+                   settings=FitSettings(lhs=1, refine=1))
+    assert out["cause"] == "coulomb_friction" and out["location"] in ("wheel", "slider")
+    (cause,) = out["causes"]
+    (tied,) = cause["equivalent_sites"]
+    assert {tied["location"], out["location"]} == {"wheel", "slider"}
+    assert tied["ratio"] == pytest.approx(ARM if out["location"] == "wheel" else 1 / ARM,
+                                          rel=1e-4)
+    tau = out["parameters"]["hyp_cf.tau"]["value"] if out["location"] == "wheel" else \
+        tied["parameters"]["hyp_cf.tau"]
+    assert tau == pytest.approx(0.002, rel=0.05)
+    if tied["fitted"] is not None and tied["fitted"]["same_class"]:
+        assert out["location"] == "slider" and "measured signal `slider.s`" in cause["site_reason"]
+    assert "Kinematically equivalent sites" in (tmp_path / "out" / "report.md").read_text()
