@@ -149,7 +149,8 @@ def simpler_tasks(problem: Problem, cal, fits, c_hat, budget, done=()) -> list:
     AICc) with each of its family members replaced by every member of the
     same family with fewer parameters that can act at its site, seeded from
     the best pair's fit (module doc); pairs whose key is in ``done`` are
-    left out."""
+    left out, and so is one hypothesis twice at one site (its two
+    magnitudes would add: not identifiable)."""
     pairs = [r for r in fits if r.ok and "+" in r.candidate.hypothesis]
     if not pairs:
         return []
@@ -168,7 +169,7 @@ def simpler_tasks(problem: Problem, cal, fits, c_hat, budget, done=()) -> list:
     out = []
     for a, b in itertools.product(*options):
         cand = pair_of(a, b)
-        if cand.key != best.candidate.key and cand.key not in done:
+        if a.key != b.key and cand.key != best.candidate.key and cand.key not in done:
             out.append(FitTask(problem.one_start(), cand, free, absorb, budget))
     return out
 

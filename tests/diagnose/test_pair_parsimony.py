@@ -113,3 +113,14 @@ def test_the_simpler_mate_replaces_an_extra_parameter_at_neutral():
     assert prefer_simplest(_ranking(rows, worse), index).after == 0
     same = [e, 0.999 * e, e]      # as good: the simpler pair is named
     assert prefer_simplest(_ranking(rows, same), index).after == 1
+
+
+def test_no_simpler_mate_repeats_one_hypothesis_at_one_site():
+    """Power drag + quadratic drag at one site (the breaker's
+    out-of-library case): replacing the power law by quadratic drag would
+    put quadratic drag twice at one site, whose two coefficients only add;
+    that pair is not fitted."""
+    best = _pair_fit("power_drag+quadratic_damping", "m2+m2",
+                     {"k1.c": 2000.0, "d1.d": 1.0, "hyp_pd.c": 0.1, "hyp_pd.n": 1.5,
+                      "hyp_qd.c": 0.4}, cost=100.0)
+    assert simpler_tasks(_problem(), CAL, [best], 1.0, 60.0) == []
