@@ -20,37 +20,14 @@ class) and member a row is.
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
 
-from .library import load_library
+from .library import FamilyIndex, family_index, load_library  # noqa: F401 (re-exported)
 from .problem import Candidate, Param
 from .screen import screened
 from .stages import fit_tasks, run_tasks
 from .tasks import fit_candidate
 
 TOP = 4               # members are fitted at the sites of the TOP best single candidates
-
-
-@dataclass(frozen=True)
-class FamilyIndex:
-    """hypothesis id -> (family, member position); ``members``: family ->
-    member ids (the head first)."""
-
-    of: dict
-    members: dict
-
-    def family(self, hid):
-        """The cause class of a hypothesis (its own id when it has no family)."""
-        return self.of.get(hid, (hid, 0))[0]
-
-    def is_head(self, hid):
-        return self.of.get(hid, (hid, 0))[1] == 0
-
-
-def family_index(library) -> FamilyIndex:
-    fams = getattr(load_library(library), "FAMILIES", None) or {}
-    return FamilyIndex({m: (f, i) for f, ms in fams.items() for i, m in enumerate(ms)},
-                       {f: tuple(ms) for f, ms in fams.items()})
 
 
 def heads(dec, index: FamilyIndex, top=TOP) -> list:
@@ -64,10 +41,7 @@ def heads(dec, index: FamilyIndex, top=TOP) -> list:
 
 def _seeded(spec, head_values, head_prefix):
     short = spec.name.partition(".")[2]
-    seed = head_values.get(f"{head_prefix}.{short}")
-    p = Param(spec.name, float(spec.initial), float(spec.low), float(spec.high),
-              float(spec.scale) or 1.0, float(spec.initial))
-    return p if seed is None else p.moved(seed)
+    return Param.from_spec(spec, head_values.get(f"{head_prefix}.{short}"))
 
 
 def member_candidates(problem, dec, index: FamilyIndex, done=()) -> list:
@@ -158,15 +132,18 @@ def prefer_simplest(rk, index: FamilyIndex):
     parameters and model selection using Akaike's Information Criterion",
     J. Wildlife Management 74 (2010) 1175-1178; Burnham and Anderson 2002,
     sec. 2.6). Coulomb friction is then named rather than Coulomb + viscous
-    with a viscous term the data cannot see. A pair is compared with the pairs
-    at the same sites whose members are of the same families. Rows and
-    classes are unchanged."""
+    with a viscous term the data cannot see. The simpler member must also
+    predict the held-out data no worse (:meth:`.stages.Ranking.heldout_no_worse`).
+    A pair is compared with the pairs at the same sites whose members are of
+    the same families (the best pair's simpler mates are fitted for this:
+    :func:`.pairsearch.simpler_tasks`). Rows and classes are unchanged."""
     if rk.after is None:
         return rk
     best = rk.rows[rk.after]
     sites = _family_sites(best.candidate, index)
     mates = [i for i, r in enumerate(rk.rows) if _family_sites(r.candidate, index) == sites
-             and r.aicc <= best.aicc + PARSIMONY and r.starts.tested]
+             and r.aicc <= best.aicc + PARSIMONY and r.starts.tested
+             and rk.heldout_no_worse(i, rk.after)]
     pick = min(mates, key=lambda i: (rk.rows[i].k, rk.rows[i].aicc), default=rk.after)
     if pick == rk.after:
         return rk

@@ -108,6 +108,9 @@ class Hypothesis:
     prefix = "hyp"
     distinguishing_experiment = ""
     fixed = {}          # name -> default of parameters added but not fitted
+    odd = True          # the law is odd in the site's motion (friction, drag): the same
+    #                     cause at a site moving the other way has the same sign
+    #                     (acausal.diagnose.kinematics.convert); False: a constant load
     relative_cost = 1.0  # a simulation's cost against the nominal model's (task ordering)
 
     # -- interface ------------------------------------------------------------------
@@ -284,6 +287,7 @@ class ConstantLoad(Hypothesis):
     title = "An unmodelled constant load (preload) on a body"
     prefix = "hyp_cl"
     site_kinds = ("body",)
+    odd = False         # keeps its direction: at a site moving the other way it changes sign
     law = "f = F on the body along +s (+phi) against the frame, either sign"
     explanation = ("A constant force or torque the model leaves out (weight, a spring "
                    "preload that is off, a magnet, a pressure) shifts the balance of "

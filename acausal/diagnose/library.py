@@ -7,6 +7,7 @@ by its import path so that worker processes can import it too."""
 from __future__ import annotations
 
 import importlib
+from dataclasses import dataclass
 from types import SimpleNamespace
 
 from ..errors import DiagnosisError
@@ -41,3 +42,29 @@ def _graph_of(graph_cls, path):
         return from_file(path)
     from ..modelfile import compile_file
     return graph_cls(compile_file(path)[0].model)
+
+
+@dataclass(frozen=True)
+class FamilyIndex:
+    """hypothesis id -> (family, member position); ``members``: family ->
+    member ids (the head first). Families: :mod:`.families`."""
+
+    of: dict
+    members: dict
+
+    def family(self, hid):
+        """The cause class of a hypothesis (its own id when it has no family)."""
+        return self.of.get(hid, (hid, 0))[0]
+
+    def is_head(self, hid):
+        return self.of.get(hid, (hid, 0))[1] == 0
+
+    def mates(self, hid):
+        """The other members of ``hid``'s family (none without a family)."""
+        return tuple(m for m in self.members.get(self.family(hid), ()) if m != hid)
+
+
+def family_index(library) -> FamilyIndex:
+    fams = getattr(load_library(library), "FAMILIES", None) or {}
+    return FamilyIndex({m: (f, i) for f, ms in fams.items() for i, m in enumerate(ms)},
+                       {f: tuple(ms) for f, ms in fams.items()})

@@ -23,16 +23,31 @@ evaluations (a few Gauss-Newton steps with forward differences). The
 below the best single's S) get a full pair fit (:func:`.tasks.fit_candidate`)
 seeded from the screened point: the free parameters there, the calibrated
 ones kept as priors.
+
+Simpler mates (:func:`simpler_tasks`): when the best fitted pair holds a
+family member with more parameters than another member of its family (Coulomb
++ viscous friction where Coulomb friction would do), the pair with the
+simpler member in its place is fitted briefly (one refinement), seeded from
+the best pair's fit: the shared parameters (by name within the sub-model,
+``F``) and the free parameters at its values. The ranking then compares the
+two (:func:`.families.prefer_simplest`): an extra parameter the data do not
+support (AICc, held-out error) does not take the name. Without this the
+simpler pair was never fitted (it is neither among the best singles' pairs
+nor a screened partner) and the richer one was named with its extra
+parameter near neutral (the two-mass pair case: b = 9e-6).
 """
 from __future__ import annotations
 
 import dataclasses
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
 
+from . import stats as st
 from .fitting import Objective, finish, refine_or_keep, score_starts
-from .problem import Candidate, Problem
+from .library import family_index, load_library
+from .problem import Candidate, Param, Problem, pair_of
 from .tasks import FitTask, _bounds, dataset_of, lhs_values, model_of
 
 SCREEN_LHS = 2        # Latin-hypercube starts of the partner besides its neutral value
@@ -127,3 +142,46 @@ def keep(best, screened, n=SCREEN_KEEP) -> list:
     ok = [r for r in screened if r.error is None and np.isfinite(r.cost)
           and r.cost < best.fit.cost]
     return sorted(ok, key=lambda r: r.cost)[:n]
+
+
+def simpler_tasks(problem: Problem, cal, fits, c_hat, budget, done=()) -> list:
+    """:class:`FitTask` (one refinement each) of the best fitted pair (by
+    AICc) with each of its family members replaced by every member of the
+    same family with fewer parameters that can act at its site, seeded from
+    the best pair's fit (module doc); pairs whose key is in ``done`` are
+    left out, and so is one hypothesis twice at one site (its two
+    magnitudes would add: not identifiable)."""
+    pairs = [r for r in fits if r.ok and "+" in r.candidate.hypothesis]
+    if not pairs:
+        return []
+    n = cal.fit.n
+    best = min(pairs, key=lambda r: st.aicc(r.fit.cost, n, r.fit.k, c_hat))
+    lib, index = load_library(problem.library), family_index(problem.library)
+    graph = lib.graph_of(problem.model_path)
+    v = best.fit.values
+    options = []
+    for h, loc, names in best.candidate.members():
+        seeds = {nm.partition(".")[2]: v[nm] for nm in names}
+        options.append([_member(lib, graph, m, loc, seeds) for m in (h,) + index.mates(h)
+                        if m == h or _fewer(lib, graph, m, loc, len(names))])
+    free = tuple(q.moved(v[q.name]) for q in problem.free)
+    absorb = (list(cal.fit.names), cal.fit.jacobian)
+    out = []
+    for a, b in itertools.product(*options):
+        cand = pair_of(a, b)
+        if a.key != b.key and cand.key != best.candidate.key and cand.key not in done:
+            out.append(FitTask(problem.one_start(), cand, free, absorb, budget))
+    return out
+
+
+def _fewer(lib, graph, mid, loc, k) -> bool:
+    """Whether member ``mid`` acts at ``loc`` with fewer than ``k`` parameters."""
+    h = lib.HYPOTHESES.get(mid)
+    return h is not None and loc in h.candidates(graph) and len(h.params(graph, loc)) < k
+
+
+def _member(lib, graph, mid, loc, seeds) -> Candidate:
+    """Member ``mid`` at ``loc``, each parameter seeded from ``seeds`` (its
+    name within the sub-model -> value) where it has one."""
+    return Candidate(mid, loc, tuple(Param.from_spec(s, seeds.get(s.name.partition(".")[2]))
+                                     for s in lib.HYPOTHESES[mid].params(graph, loc)))

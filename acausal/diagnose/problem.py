@@ -53,6 +53,14 @@ class Param:
         return Param(self.name, float(min(max(start, self.low), self.high)), self.low,
                      self.high, self.scale, self.prior)
 
+    @classmethod
+    def from_spec(cls, spec, seed=None) -> "Param":
+        """An extension's parameter from a hypothesis's ``ParamSpec``: neutral
+        prior, started at ``seed`` (clipped into its bounds) when one is given."""
+        p = cls(spec.name, float(spec.initial), float(spec.low), float(spec.high),
+                float(spec.scale) or 1.0, float(spec.initial))
+        return p if seed is None else p.moved(seed)
+
 
 def free_param(name, default, low, high) -> Param:
     """A model file's free parameter (its default clipped into its bounds)."""
@@ -109,6 +117,18 @@ def second_name(name: str) -> str:
 def second_prefix(prefix: str) -> str:
     """The renamed sub-model of a pair's second member (see :func:`second_name`)."""
     return prefix + "2"
+
+
+def pair_of(first: Candidate, second: Candidate) -> Candidate:
+    """The pair of two single candidates, each parameter at its start; the
+    second's parameters renamed (:func:`second_name`) when its sub-model
+    clashes with the first's (one hypothesis, or two members of one family
+    sharing a sub-model name, at two sites)."""
+    taken = {p.name.split(".")[0] for p in first.params}
+    renamed = tuple(dataclasses.replace(p, name=second_name(p.name))
+                    if p.name.split(".")[0] in taken else p for p in second.params)
+    return Candidate(f"{first.hypothesis}+{second.hypothesis}",
+                     f"{first.location}+{second.location}", first.params + renamed)
 
 
 @dataclass(frozen=True)

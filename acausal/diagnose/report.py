@@ -319,14 +319,32 @@ def verdict(d, s) -> str:
         txt = f"**Discrepancy, but the evidence is weak: no cause is named.** {reasons}."
         if best is not None:
             txt += f" The best candidate would be {best.candidate.label} ({held})."
-        return txt + _class_sentence(s["cause_class"])
+        return txt + _tied_sentence(d) + _class_sentence(s["cause_class"])
     txt = (f"**Discrepancy; cause: {s['cause']} at `{s['location']}`.** {held[0].upper()}"
            f"{held[1:]} (train {fmt(g['before']['train'], 3)} -> "
            f"{fmt(g['after']['train'], 3)}).")
     if s["equivalent_causes"]:
         txt += " The data cannot tell it from: " + ", ".join(
             f"{e['cause']} at `{e['location']}`" for e in s["equivalent_causes"]) + "."
-    return txt + _class_sentence(s["cause_class"])
+    return txt + _tied_sentence(d) + _class_sentence(s["cause_class"])
+
+
+def _tied_sentence(d) -> str:
+    """The sites kinematically tied to the shown cause's, the cause's
+    parameters at each, and why its own site is the one shown
+    (:mod:`.kinematics`)."""
+    parts = []
+    for t in d.tied:
+        for x in t.sites:
+            vals = ", ".join(f"`{k}` = {fmt(v)}" for k, v in x.values if v is not None)
+            own = "" if not x.fitted else (
+                " (fitted there: " + ", ".join(f"{fmt(v)}" for _, v in x.fitted)
+                + f", dAICc {x.daicc:+.3g})")
+            parts.append(f"`{x.location}` moves {fmt(x.ratio, 3)} times as fast as "
+                         f"`{t.location}` (a constant ratio within {x.spread:.1%} over every "
+                         f"experiment): {t.cause} there is {vals or 'not convertible'}{own}.")
+        parts.append(t.reason)
+    return (" **Kinematically equivalent sites.** " + " ".join(parts)) if parts else ""
 
 
 def _class_sentence(cc):

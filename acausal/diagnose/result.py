@@ -29,6 +29,8 @@ class Diagnosis:
     location: object = None       # locate.Location (None: not run)
     intervals: object = None      # intervals.Intervals (None: not run)
     families: object = None       # families.FamilyIndex (None: no families)
+    kinematics: object = None     # kinematics.Kinematics (None: not run)
+    tied: tuple = ()              # kinematics.SiteEquivalence of the shown row's members
 
 
 def num(x):
@@ -83,11 +85,35 @@ def family_of(d: Diagnosis, hid):
 
 def _causes(d, row):
     """One entry per cause of a named single or pair: its family (cause
-    class), member (the law) and own parameters."""
+    class), member (the law), own parameters, and the kinematically
+    equivalent sites (:func:`equivalent_sites`) with why this site is shown."""
     every = parameters(row)
-    return [dict(cause=h, location=loc, family=family_of(d, h), member=h,
-                 parameters={k: every[k] for k in names})
-            for h, loc, names in row.candidate.members()]
+    out = []
+    for h, loc, names in row.candidate.members():
+        tied = next((t for t in d.tied if (t.cause, t.location) == (h, loc)), None)
+        out.append(dict(cause=h, location=loc, family=family_of(d, h), member=h,
+                        parameters={k: every[k] for k in names},
+                        equivalent_sites=equivalent_sites(tied),
+                        site_reason=None if tied is None else tied.reason))
+    return out
+
+
+def equivalent_sites(tied) -> list:
+    """The sites kinematically tied to a cause's (``kinematics.SiteEquivalence``
+    or None): each with its rate ratio (its rate per the cause's site's),
+    the ratio's spread, the cause's parameters converted through the ratio
+    (``in_range``: inside the range the hypothesis declares there), and the
+    same hypothesis's own fit there (null when not fitted) with its
+    AICc against the cause's and whether the data tell the two apart."""
+    if tied is None:
+        return []
+    return [dict(location=s.location, ratio=num(s.ratio), spread=num(s.spread),
+                 parameters={k: None if v is None else num(v) for k, v in s.values},
+                 in_range=bool(s.in_range),
+                 fitted=None if not s.fitted else dict(
+                     parameters={k: num(v) for k, v in s.fitted}, daicc=num(s.daicc),
+                     same_class=bool(s.in_class)))
+            for s in tied.sites]
 
 
 def cause_class(d: Diagnosis):

@@ -3,7 +3,7 @@ cause, an extended model and the measured gain.
 
 :func:`diagnose` chains the stages of :mod:`.stages` (calibrate ->
 candidates -> fit -> family members -> decide -> pairs -> cross-validate ->
-rank -> locate -> intervals -> extend -> next experiment -> views),
+rank -> tied sites -> locate -> intervals -> extend -> next experiment -> views),
 keeps what they return in a :class:`~.result.Diagnosis`, renders the
 report from it (:mod:`.report`, a pure view) and returns the JSON summary
 (:func:`.result.summary`).
@@ -23,6 +23,7 @@ from . import stages
 from . import stats as st
 from .families import family_index, fit_members, prefer_simplest
 from .intervals import intervals
+from .kinematics import Kinematics, equivalents, kinematics, prefer_site
 from .locate import Location, locate
 from .nextexp import next_experiment
 from .problem import FitSettings
@@ -67,14 +68,14 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
                                (progress, collect, alpha), clock)
         cv = stages.cross_validate(problem, ds, cal, dec, ex, exact_cv, progress)
         rk = stages.rank(ds, cal, dec, cv)
-        if families:
-            rk = prefer_simplest(rk, family_index(problem.library))
+        rk, kin = _shown(problem, cal, rk, families, clock)
         where = locate(problem, cal, dec, rk, ex, progress, collect) if generic else Location(
             skipped="not run (generic=False)")
         ivs = _timed(clock, "profile_s", intervals, problem, cal, rk, ex,
                      progress) if profile else None
     Path(out_dir).mkdir(parents=True, exist_ok=True)
     extended = stages.extend(problem, rk, out_dir)
+    tied = equivalents(problem, kin, rk)
     index = family_index(problem.library)
     nxt = _timed(clock, "design_s", next_experiment, problem, ds, dec, rk,
                  index) if design else None
@@ -88,7 +89,20 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
     timing = dict(fit_s=t_fit, cv_s=t_cv, n_candidates=len(cands), n_sim=n_sim,
                   total_s=time.perf_counter() - t0, **clock)
     return Diagnosis(problem, ds, cal, len(cands), dec, cv, rk, extended, shown,
-                     nxt, timing, where, ivs, index)
+                     nxt, timing, where, ivs, index, kin, tied)
+
+
+def _shown(problem, cal, rk, families, clock):
+    """(ranking, Kinematics): the row shown moved to the simplest member of
+    its family the data support (:func:`.families.prefer_simplest`), then to
+    a kinematically tied site whose coordinate is measured when the data
+    cannot tell the two apart (:func:`.kinematics.prefer_site`)."""
+    if families:
+        rk = prefer_simplest(rk, family_index(problem.library))
+    if rk.after is None:
+        return rk, Kinematics(message="no cause to place")
+    kin = _timed(clock, "kinematics_s", kinematics, problem, cal)
+    return prefer_site(rk, kin), kin
 
 
 def _pairs(problem, ds, cal, dec, fits, ex, opts, clock):

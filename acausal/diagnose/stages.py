@@ -28,7 +28,7 @@ from . import pairsearch as ps
 from . import stats as st
 from .fitting import heldout_rms
 from .library import load_library
-from .problem import NOMINAL, Candidate, FitSettings, Param, Problem, free_param, second_name
+from .problem import NOMINAL, Candidate, FitSettings, Param, Problem, free_param, pair_of
 from .tasks import CandidateFit, FitTask, LooTask, calibrate_nominal, fit_candidate, \
     refit_without
 
@@ -93,9 +93,7 @@ def candidates(problem: Problem, hypotheses=None, locations=None) -> tuple:
             if locations is not None and not any(
                     loc == w or loc.startswith(w + ".") for w in locations):
                 continue
-            params = tuple(Param(s.name, float(s.initial), float(s.low), float(s.high),
-                                 float(s.scale) or 1.0, float(s.initial))
-                           for s in hyp.params(graph, loc))
+            params = tuple(Param.from_spec(s) for s in hyp.params(graph, loc))
             out.append(Candidate(hid, loc, params))
     return tuple(out)
 
@@ -254,18 +252,24 @@ def search_pairs(problem: Problem, cal, dec, ex, progress=True, collect=None):
     """Stage 3b: (fits of the pairs, simulations spent screening): the
     pairs among the best singles (:func:`pair_candidates`) fitted, and the
     best single's pairs with every other candidate at another site
-    screened, the best few fitted in full (:mod:`.pairsearch`)."""
+    screened, the best few fitted in full; then the best pair with a simpler
+    member of a family in place of a richer one, fitted briefly from it
+    (:mod:`.pairsearch`)."""
     top = pair_candidates(problem, dec)
     if not top and load_library(problem.library).build_pair is None:
         return (), 0
     tasks = fit_tasks(problem, cal, top)
+    budget = _budget(cal)
     others = partners(dec, {c.key for c in top})
     screened = run_tasks(ex, ps.screen_pair, ps.screen_tasks(problem, _singles(dec)[0], others),
                          "screening pairs", progress, collect) if others else []
     best = _singles(dec)[0] if others else None
-    tasks += ps.full_tasks(problem, cal, ps.keep(best, screened) if best else [],
-                           tasks[0].budget_s if tasks else _budget(cal))
+    tasks += ps.full_tasks(problem, cal, ps.keep(best, screened) if best else [], budget)
     fits = run_tasks(ex, fit_candidate, tasks, "fitting pairs", progress, collect)
+    simpler = ps.simpler_tasks(problem, cal, fits, dec.c_hat, budget,
+                               {t.candidate.key for t in tasks})
+    fits += run_tasks(ex, fit_candidate, simpler, "fitting simpler mates", progress,
+                      collect) if simpler else []
     return tuple(fits), sum(r.n_sim for r in screened)
 
 
@@ -305,20 +309,12 @@ def _pair(a, b, neutral=False) -> Candidate:
     """The pair of rows ``a`` and ``b``, seeded from their fits (``b`` at
     its neutral values when ``neutral``)."""
     ca, cb = a.candidate, b.candidate
-    first = {p.name.split(".")[0] for p in ca.params}
-    params = tuple(p.moved(a.fit.values[p.name]) for p in ca.params) + tuple(
-        _renamed(p, first).moved(p.prior if neutral else b.fit.values[p.name])
-        for p in cb.params)
-    return Candidate(f"{ca.hypothesis}+{cb.hypothesis}", f"{ca.location}+{cb.location}",
-                     params)
-
-
-def _renamed(p: Param, first) -> Param:
-    """A second member's parameter, renamed when its sub-model clashes with
-    the first's (one hypothesis at two sites: :func:`.problem.second_name`)."""
-    if p.name.split(".")[0] not in first:
-        return p
-    return Param(second_name(p.name), p.start, p.low, p.high, p.scale, p.prior)
+    return pair_of(
+        Candidate(ca.hypothesis, ca.location,
+                  tuple(p.moved(a.fit.values[p.name]) for p in ca.params)),
+        Candidate(cb.hypothesis, cb.location,
+                  tuple(p.moved(p.prior if neutral else b.fit.values[p.name])
+                        for p in cb.params)))
 
 
 # -- stage 4: decide ------------------------------------------------------------------------
@@ -486,6 +482,7 @@ class Ranking:
     weak: list
     untested: tuple               # Row whose extension was never tested
     heldout0: float
+    heldout: tuple = ()           # each row's held-out residual vector (None: one missing)
 
     def row(self, i):
         return None if i is None else self.rows[i]
@@ -493,6 +490,15 @@ class Ranking:
     @property
     def named(self):
         return self.row(self.cause)
+
+    def heldout_no_worse(self, i, j) -> bool:
+        """Is row ``i``'s held-out error no worse than row ``j``'s
+        (:func:`.stats.heldout_no_worse`: paired on their residual vectors
+        where both are known)?"""
+        vec = self.heldout or (None,) * len(self.rows)
+        a, b = self.rows[i], self.rows[j]
+        return st.heldout_no_worse(dict(heldout=vec[i], heldout_rmse=a.heldout_rmse),
+                                   dict(heldout=vec[j], heldout_rmse=b.heldout_rmse))
 
     @property
     def best(self):
@@ -588,9 +594,9 @@ def rank(ds, cal: Calibration, dec: Decision, cv: CrossValidation) -> Ranking:
                                      heldout_exact=r.candidate.key in cv.exact)
                  for r in dec.rows)
     held0 = cv.heldout(NOMINAL.key, cal.nominal.loo)
-    classes = st.equivalence_classes(
-        [dict(aicc=r.aicc, heldout_rmse=r.heldout_rmse,
-              heldout=_heldout_vector(cv, r, ds)) for r in rows]) if rows else []
+    vectors = tuple(_heldout_vector(cv, r, ds) for r in rows)
+    classes = st.equivalence_classes([dict(aicc=r.aicc, heldout_rmse=r.heldout_rmse, heldout=h)
+                                      for r, h in zip(rows, vectors)]) if rows else []
     runner = classes[1][0] if len(classes) > 1 else None
     acted = _acted_in(rows[0] if rows else None)
     untested = tuple(r for r in rows if not r.starts.tested and r.candidate.key not in acted)
@@ -606,7 +612,7 @@ def rank(ds, cal: Calibration, dec: Decision, cv: CrossValidation) -> Ranking:
         weak += _untested_reasons(untested, b) + _pair_reasons(b, rows) + _bound_reasons(b)
     cause = best if (dec.discrepancy and rows and not weak) else None
     after = best if dec.discrepancy else None
-    return Ranking(rows, classes, cause, after, runner, weak, untested, held0)
+    return Ranking(rows, classes, cause, after, runner, weak, untested, held0, vectors)
 
 
 def _heldout_vector(cv, row, ds):

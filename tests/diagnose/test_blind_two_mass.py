@@ -71,13 +71,17 @@ def test_two_mass_two_causes_at_two_sites(tmp_path):
     """Quadratic drag on m1 and dry friction on m2 (197 floors): both named
     at their nodes. Measured 2026-11-23: coulomb_viscous_friction at m2 (F
     0.019998, b 9e-6) + quadratic_damping at m1 (c 0.50006), held-out
-    67.5 -> 1.000, 355 s at load 5-7."""
+    67.5 -> 1.000, 355 s at load 5-7. Since the best pair's simpler mates are
+    fitted (pairsearch.simpler_tasks; 2026-11-26): coulomb_friction at m2 (F
+    0.0200000) + quadratic_damping at m1 (c 0.50016), S 17999.19 as the
+    Coulomb + viscous pair's (b 1.8e-6 there), so 2 AICc units ahead of it;
+    the simpler pair's fit took 102 simulations of 11193; held-out 67.5 ->
+    1.000, 210 s at load 8. The simplest friction law is now required."""
     out, det, floors = _run(tmp_path, {"m1_drag": 0.5, "m2_coulomb": 0.02}, name="two-mass pair")
     assert 50 <= floors <= 500
     got = blind.named(out)
     assert ("quadratic_damping", "m1") in got
-    assert got & {(h, "m2") for h in ("coulomb_friction", "coulomb_viscous_friction",
-                                       "stribeck_friction")}
+    assert ("coulomb_friction", "m2") in got
     vals = blind.values(out)
     assert vals["hyp_qd.c"] == pytest.approx(0.5, rel=0.10)
     assert next(v for k, v in vals.items() if k.endswith(".F")) == pytest.approx(0.02, rel=0.10)

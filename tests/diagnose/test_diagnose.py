@@ -81,7 +81,8 @@ def test_blind_case_names_the_hidden_cause(blind):
     assert out["extended_model"] and os.path.exists(out["extended_model"])
     assert out["causes"] == [{"cause": "coulomb_friction", "location": "latch",
                               "family": "friction", "member": "coulomb_friction",
-                              "parameters": {name: out["parameters"][name]}}]
+                              "parameters": {name: out["parameters"][name]},
+                              "equivalent_sites": [], "site_reason": None}]
     assert out["unexplained"]["value"] is False
     # one member in the class (or several cause classes and no condition declared):
     # the next experiment says so instead of a null
