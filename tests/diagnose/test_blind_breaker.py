@@ -76,7 +76,9 @@ def test_breaker_two_causes_at_two_sites(tmp_path):
     2026-11-23): the same pair, held-out 35.66 -> 0.966, 248 s at load 1.5-2;
     2026-11-26: the same, 309 s wall, 152 s CPU at load 7.8-8.8 (this run's
     fresh model cache: every hypothesis model compiled; the diagnosis's
-    timing: total 307 s, 22668 simulations, pairs 109 s)."""
+    timing: total 307 s, 22668 simulations, pairs 109 s); after the
+    model-build cuts (776dac1, 14d0b3b) 150 s alone (104 s CPU, load 5.5)
+    and 111 s in the whole file's run (load 5-6)."""
     out, det, floors = _run(tmp_path, {"hook_coulomb": 1.0, "coil_slope": 2e4},
                             name="breaker pair")
     assert len(out["causes"]) == 2
@@ -100,7 +102,9 @@ def test_breaker_out_of_library(tmp_path):
     main_shaft.body next (1.220, 71 AICc units behind), armature.mass far
     behind (9.74); the best library answer, power drag + quadratic drag at
     the hook, left held-out 19.06 -> 1.92 (nothing named); 357 s wall,
-    204 s CPU at load 2.4-9.6."""
+    204 s CPU at load 2.4-9.6 alone with a fresh model cache; 206 s in the
+    whole file's run after 14d0b3b (pairs 80 s, the located term about
+    83 s, 25368 simulations)."""
     out, det, floors = _run(tmp_path, "hook_threshold", 8.0)
     assert 50 <= floors <= 500
     assert out["causes"] == [] and out["cause"] is None
@@ -122,7 +126,8 @@ def test_breaker_hunt_crossley_contact(tmp_path):
     (de 0.0639, 95 % [0.0638, 0.0640]) with Hunt-Crossley 0.0011 AICc units
     behind in its class, the model's own law (contact_damping_law) 3rd at
     held-out 1.94; held-out 10.862 -> 0.957; 184 s wall, 98 s CPU at load
-    8.9-9.4."""
+    8.9-9.4 alone with a fresh model cache (34 s in the whole file's run,
+    its models built by the cases before it)."""
     out, det, floors = _run(tmp_path, "hunt_crossley", 0.74)
     assert blind.named(out) and all(loc == "contact" for _, loc in blind.named(out))
     assert {c.get("family") for c in out["causes"]} == {"contact_damping"}
