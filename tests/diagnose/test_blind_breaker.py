@@ -103,8 +103,8 @@ def test_breaker_out_of_library(tmp_path):
     behind (9.74); the best library answer, power drag + quadratic drag at
     the hook, left held-out 19.06 -> 1.92 (nothing named); 357 s wall,
     204 s CPU at load 2.4-9.6 alone with a fresh model cache; 206 s in the
-    whole file's run after 14d0b3b (pairs 80 s, the located term about
-    83 s, 25368 simulations)."""
+    whole file's run after 14d0b3b (pairs 80 s, about 83 s after the
+    fits, mostly the located term; 25368 simulations)."""
     out, det, floors = _run(tmp_path, "hook_threshold", 8.0)
     assert 50 <= floors <= 500
     assert out["causes"] == [] and out["cause"] is None
