@@ -8,6 +8,7 @@ its unknown with a constant coefficient is solved explicitly and substituted
 one. What remains: residuals ``F(t, y, y', p, d) = 0`` over ``y`` = states +
 algebraic unknowns of implicit blocks.
 """
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -261,7 +262,7 @@ def _simplified_pivot(M, k, params, values, max_ops=30, max_tries=6):
             tries += 1
             if tries > max_tries:
                 return best
-            s = sp.trigsimp(a)
+            s = _trigsimp(a)
             if s == 0 or not s.free_symbols <= params:
                 continue
             M[i, j] = s
@@ -290,6 +291,16 @@ def _moves(a, params, values, rtol=1e-8):
         if np.isfinite(v) and abs(v - v0) > rtol * max(1.0, abs(v0)):
             return True
     return False
+
+
+@functools.lru_cache(maxsize=256)
+def _trigsimp(a):
+    """``sp.trigsimp(a)``, remembered in this process: the models of a
+    diagnosis (one per hypothesis, site and pair) share the mechanism's
+    blocks, so the same entries come back with every model (a four-bar's
+    inertia entries: 0.2-0.5 s a call, most of the Python of compiling the
+    breaker)."""
+    return sp.trigsimp(a)
 
 
 def _blt(eqs, unknowns):

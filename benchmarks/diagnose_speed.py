@@ -6,7 +6,9 @@ SLOW_CASES[0]): hidden Coulomb friction at ``hook.body``, 8 noise floors,
 hook-angle and armature traces at six impact velocities, seed 100. The data
 are synthesized once into ``--data`` (kept between runs); the diagnosis
 then runs with everything the command line runs by default (families,
-pairs, located term, profiles, next experiment; no plots).
+pairs, located term, profiles, next experiment; no plots). ``--case pair``
+is instead the slow tier's blind pair case (issue #11's timing case: two
+causes, data from the independent tests/diagnose/breaker_scipy.py).
 
 Printed: the verdict, held-out errors, wall and CPU time (this process and
 its finished workers), the diagnosis's own stage times, the load average
@@ -16,6 +18,7 @@ a cProfile of the whole run (``--profile FILE``).
 
     PYTHONPATH=. python benchmarks/diagnose_speed.py            # 2 workers
     PYTHONPATH=. python benchmarks/diagnose_speed.py --serial --profile prof.txt
+    PYTHONPATH=. python benchmarks/diagnose_speed.py --case pair --serial
 """
 from __future__ import annotations
 
@@ -42,17 +45,24 @@ CASES = {  # name -> (hypothesis, location, effect [floors], seed): the slow tie
     "flexible": ("flexible_link", "hook.body:hook.arm3", 5.0, 105),
     "null": (None, None, 0.0, 500),
 }
+# the slow tier's blind pair case (tests/diagnose/test_blind_breaker.py): dry
+# friction at the hook (1 N*m) and a coil force rising with the stroke (20 kN/m),
+# 47 floors, data from the independent scipy simulator (breaker_scipy.py), seed 7
+BLIND = {"pair": ({"hook_coulomb": 1.0, "coil_slope": 2e4}, 7,
+                  "coulomb_friction+position_dependent_force", "hook.body+armature.coil")}
 
 
 def data_folder(case, root):
     """The case's dataset (synthesized on first use); returns (folder, truth)."""
     from acausal.diagnose.synth import synthesize
-    hyp, loc, effect, seed = CASES[case]
     folder = os.path.join(root, f"breaker_{case}")
     marker = os.path.join(folder, "truth.json")
     if os.path.exists(marker):
         with open(marker) as f:
             return folder, json.load(f)
+    if case in BLIND:
+        return blind_folder(case, folder, marker)
+    hyp, loc, effect, seed = CASES[case]
     truth = synthesize(BREAKER, folder, hypothesis=hyp, location=loc,
                        effect=None if hyp is None else (effect, effect), free_jitter=0.1,
                        seed=seed, **SETUP)
@@ -61,11 +71,23 @@ def data_folder(case, root):
     return folder, truth.to_dict()
 
 
+def blind_folder(case, folder, marker):
+    """A blind case's dataset, written by tests/diagnose/breaker_scipy.py."""
+    sys.path.insert(0, os.path.join(ROOT, "tests", "diagnose"))
+    import breaker_scipy
+    effect, seed, hyp, loc = BLIND[case]
+    breaker_scipy.write(folder, effect, seed=seed)
+    truth = dict(hypothesis=hyp, location=loc)
+    with open(marker, "w") as f:
+        json.dump(truth, f)
+    return folder, truth
+
+
 class StageCounter:
     """Simulations and wall time per diagnosis stage (serial runs only:
     every task then runs in this process)."""
 
-    STAGES = {"stages": ("calibrate", "fit", "cross_validate"),
+    STAGES = {"stages": ("calibrate", "fit", "search_pairs", "cross_validate"),
               "run": ("fit_members", "locate", "intervals", "next_experiment")}
 
     def __init__(self):
@@ -117,7 +139,7 @@ def cpu_s():
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--case", choices=sorted(CASES), default="coulomb")
+    ap.add_argument("--case", choices=sorted(CASES) + sorted(BLIND), default="coulomb")
     ap.add_argument("--data", default=os.path.join(tempfile.gettempdir(), "acausal_dspeed"))
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--serial", action="store_true", help="run every task in this process "

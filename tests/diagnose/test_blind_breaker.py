@@ -73,7 +73,12 @@ def test_breaker_two_causes_at_two_sites(tmp_path):
     35.7 -> 0.966; the pairs with a constant load at the hook and at the
     main shaft next (23 and 44 AICc units behind); screening 2304
     simulations of 24510. On the independent scipy data (breaker_scipy.py,
-    2026-11-23): the same pair, held-out 35.66 -> 0.966, 248 s at load 1.5-2.
+    2026-11-23): the same pair, held-out 35.66 -> 0.966, 248 s at load 1.5-2;
+    2026-11-26: the same, 309 s wall, 152 s CPU at load 7.8-8.8 (this run's
+    fresh model cache: every hypothesis model compiled; the diagnosis's
+    timing: total 307 s, 22668 simulations, pairs 109 s); after the
+    model-build cuts (776dac1, 14d0b3b) 150 s alone (104 s CPU, load 5.5)
+    and 111 s in the whole file's run (load 5-6).
     With the tied sites (2026-11-26, 366 s at load 7-8): the same pair (tau
     0.9861, k 19998), the hook's friction reported at the main shaft too,
     rate ratio -1.5702e-3 (constant within 1.4 % over the six experiments),
@@ -104,7 +109,15 @@ def test_breaker_out_of_library(tmp_path):
     Measured 2026-11-23 at 5 N*m (40 floors): first named as power_drag at the hook with its
     coefficient at the bound of its range (held-out 1.59); with the bound
     rule (stages._bound_reasons) not explained, located at hook.body first
-    (held-out 1.21), main_shaft.body 26 AICc units behind."""
+    (held-out 1.21), main_shaft.body 26 AICc units behind. On the
+    independent scipy data (breaker_scipy.py, 2026-11-26, 8 N*m, 68
+    floors): not explained, located at hook.body first (held-out 0.962),
+    main_shaft.body next (1.220, 71 AICc units behind), armature.mass far
+    behind (9.74); the best library answer, power drag + quadratic drag at
+    the hook, left held-out 19.06 -> 1.92 (nothing named); 357 s wall,
+    204 s CPU at load 2.4-9.6 alone with a fresh model cache; 206 s in the
+    whole file's run after 14d0b3b (pairs 80 s, about 83 s after the
+    fits, mostly the located term; 25368 simulations)."""
     out, det, floors = _run(tmp_path, "hook_threshold", 8.0)
     assert 50 <= floors <= 500
     assert out["causes"] == [] and out["cause"] is None
@@ -121,7 +134,13 @@ def test_breaker_hunt_crossley_contact(tmp_path):
     (e + de) the Hunt-Crossley and Flores members are the same law (chi is
     a function of e): measured 2026-11-23, Flores named (de 0.0639) with
     Hunt-Crossley (de -2.3e-4, the truth) 0.0006 AICc units behind in its
-    class, held-out 10.86 -> 0.957."""
+    class, held-out 10.86 -> 0.957. On the independent scipy data
+    (breaker_scipy.py, 2026-11-26, 15.8 floors): the same, Flores named
+    (de 0.0639, 95 % [0.0638, 0.0640]) with Hunt-Crossley 0.0011 AICc units
+    behind in its class, the model's own law (contact_damping_law) 3rd at
+    held-out 1.94; held-out 10.862 -> 0.957; 184 s wall, 98 s CPU at load
+    8.9-9.4 alone with a fresh model cache (34 s in the whole file's run,
+    its models built by the cases before it)."""
     out, det, floors = _run(tmp_path, "hunt_crossley", 0.74)
     assert blind.named(out) and all(loc == "contact" for _, loc in blind.named(out))
     assert {c.get("family") for c in out["causes"]} == {"contact_damping"}
