@@ -388,6 +388,22 @@ class Generated:
     sparsity: Sparsity
 
 
+def _make_prologue(npar, nd):
+    """The first lines of the generated ``make(p, d)``: the parameters and
+    discrete values unpacked, the step-attempt counter, and ``other(k)``,
+    the IEEE variant's callback k (:data:`_IEEE_ERRORS`), made at its first
+    use."""
+    return (["def make(p, d):"]
+            + _unpack("p", npar, "p", "    ", conv="_consts")
+            + _unpack("d", nd, "d", "    ", conv="_consts")
+            + ["    count = [0, None]  # step attempts: distinct times the residual sees",
+               "    ieee = []",
+               "    def other(k):  # the IEEE variant's callback k (made at its first use)",
+               "        if not ieee:",
+               "            ieee.append(_make_ieee(p, d))",
+               "        return ieee[0][k]"])
+
+
 def generate(dae, params, discretes, roots, observed, fixed_rows=()):
     """Generate and compile the callbacks (see :class:`Generated`).
 
@@ -414,15 +430,7 @@ def generate(dae, params, discretes, roots, observed, fixed_rows=()):
                            fixed_rows, ysyms, ypsyms, dae.n_states)
     npar, nd = len(params), len(discretes)
     unpack = _unpack("y", n, "y", _B, conv="_floats") + _unpack("yp", n, "yp", _B, conv="_floats")
-    L = ["def make(p, d):"]
-    L += _unpack("p", npar, "p", "    ", conv="_consts")
-    L += _unpack("d", nd, "d", "    ", conv="_consts")
-    L += ["    count = [0, None]  # step attempts: distinct times the residual sees",
-          "    ieee = []",
-          "    def other(k):  # the IEEE variant's callback k (made at its first use)",
-          "        if not ieee:",
-          "            ieee.append(_make_ieee(p, d))",
-          "        return ieee[0][k]"]
+    L = _make_prologue(npar, nd)
     L += _guarded("    def res(t, y, yp, r):",
                   ["        if t != count[1]:", "            count[0] += 1",
                    "            count[1] = t"],
