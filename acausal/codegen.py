@@ -113,9 +113,9 @@ def _fast_namespace():
 
 def _ieee_namespace():
     ns = _namespace()
-    for k in list(ns):
+    for k in dir(math):
         f = getattr(np, _NUMPY_NAMES.get(k, k), None)
-        if k in dir(math) and isinstance(f, np.ufunc):
+        if isinstance(f, np.ufunc):
             ns[k] = f
     ns.update(_floats=lambda a: np.asarray(a, dtype=float), _ieee_errors=(),
               _consts=lambda a: np.asarray(a, dtype=float), _quiet=None)
@@ -456,11 +456,9 @@ def generate(dae, params, discretes, roots, observed, fixed_rows=()):
         f"{_B}return o"], "other(4)(t, y, yp)", ret=True)
     L += ["    return res, jac, roots, jacs, observe, count, jac_csc"]
     L += _guarded("def fixjac(t, y, yp, p, d, F):", [], [
-        f"    {line}" for line in _unpack("p", npar, "p", "        ", conv="_consts")
-        + _unpack("d", nd, "d", "        ", conv="_consts")
-        + _unpack("y", n, "y", "        ", conv="_consts")
-        + _unpack("yp", n, "yp", "        ", conv="_consts")
-        + _body([e for _, _, e in fixed], [f"F[{a}, {k}]" for a, k, _ in fixed], "        ")],
+        line for v, m in (("p", npar), ("d", nd), ("y", n), ("yp", n))
+        for line in _unpack(v, m, v, _B, conv="_consts")]
+        + _body([e for _, _, e in fixed], [f"F[{a}, {k}]" for a, k, _ in fixed], _B),
         "_fixjac_ieee(t, y, yp, p, d, F)")
     src = "\n".join(L) + "\n"
     make, fixjac = load(src)
@@ -473,10 +471,16 @@ def load(src):
     _counter[0] += 1
     fname = f"<acausal-generated-{_counter[0]}>"
     linecache.cache[fname] = (len(src), None, src.splitlines(True), fname)
-    code = compile(src, fname, "exec")
-    ieee = _ieee_namespace()
-    exec(code, ieee)
-    ns = _fast_namespace()
+    ns, ieee = exec_twins(compile(src, fname, "exec"))
     ns.update(_make_ieee=ieee["make"], _fixjac_ieee=ieee["fixjac"])
-    exec(code, ns)
     return ns["make"], ns["fixjac"]
+
+
+def exec_twins(code):
+    """(fast namespace, IEEE namespace) after running compiled generated
+    ``code`` in each (:data:`_IEEE_ERRORS`): the same functions on Python
+    floats and on numpy float64."""
+    ns, ieee = _fast_namespace(), _ieee_namespace()
+    exec(code, ns)
+    exec(code, ieee)
+    return ns, ieee

@@ -57,8 +57,8 @@ import sympy as sp
 
 from .backends import choose_linear_solver
 from .causalize import DAE
-from .codegen import (_IEEE_ERRORS, Names, Sparsity, _body, _ieee_namespace, _namespace,
-                      _unpack, generate, load)
+from .codegen import (_IEEE_ERRORS, Names, Sparsity, _body, _unpack, exec_twins, generate,
+                      load)
 from .errors import ModelError, UsageError
 from .events import EventState
 from .fastdiff import diff
@@ -372,10 +372,7 @@ def _root_gradients(cm, roots, P, dyn):
     L += _unpack("p", len(cm.param_syms), "p", "    ", False)
     L += _unpack("d", len(cm.disc_syms), "d", "    ", False)
     L += _body(exprs, targets, "    ", symbols=names.code) + ["    pass"]
-    code = compile("\n".join(L) + "\n", "<acausal-root-gradients>", "exec")
-    ns, ieee = _namespace(), _ieee_namespace()
-    exec(code, ns)
-    exec(code, ieee)
+    ns, ieee = exec_twins(compile("\n".join(L) + "\n", "<acausal-root-gradients>", "exec"))
     fill, fill_ieee = ns["rootgrad"], ieee["rootgrad"]
 
     def rootgrad(t, y, yp, p, d):

@@ -475,6 +475,12 @@ def _penalty_rows(f: Fit, penalty):
     return J, P @ (x / sc)
 
 
+def penalty_cost(f: Fit, penalty) -> float:
+    """The penalty rows' share of the cost at the fit (0 without a penalty)."""
+    rp = _penalty_rows(f, penalty)[1]
+    return float(rp @ rp)
+
+
 def effective_k(f: Fit, penalty=None) -> float:
     """The number of parameters a (penalised) fit spends: the trace of its
     hat matrix, tr[J (J'J + Jp'Jp)^+ J'] (the effective degrees of freedom of

@@ -33,8 +33,8 @@ from ..data import Dataset, Experiment, Trace
 from ..errors import AcausalError
 from ..executor import worker_cache
 from ..modelfile import compile_file
-from .fitting import Fit, Objective, failed_fit, finish, linear_loo, refine_or_keep, \
-    score_starts, subset, weighted_residuals
+from .fitting import Fit, Objective, failed_fit, finish, linear_loo, penalty_cost, \
+    refine_or_keep, score_starts, subset, weighted_residuals
 from .generic import GENERIC
 from .generic import build as build_generic
 from .library import load_library
@@ -466,20 +466,12 @@ class Refiner:
             r = obj(np.clip(np.asarray(x0, float), self.lo, self.hi))
         except AcausalError:
             return end, obj.n_sim
-        total = end.cost + self._penalty([end.values[n] for n in self.names])
+        total = end.cost + penalty_cost(end, self.penalty)
         if total <= float(r @ r) + max(0.5, 1e-3 * total):
             return end, obj.n_sim
         fit, _, used = self.window_fit(1.0, x0)
-        better = fit.cost + self._penalty([fit.values[n] for n in self.names]) < total
+        better = fit.cost + penalty_cost(fit, self.penalty) < total
         return (fit if better else end), obj.n_sim + used
-
-    def _penalty(self, x):
-        """The penalty rows' share of the cost at ``x`` (0 without a penalty)."""
-        if self.penalty is None:
-            return 0.0
-        P, sc = self.penalty
-        p = P @ (np.asarray(x, float)[-P.shape[1]:] / sc)
-        return float(p @ p)
 
     def all(self, starts):
         """The final fit of each start's path, in order."""
