@@ -20,6 +20,7 @@ class) and member a row is.
 from __future__ import annotations
 
 import dataclasses
+from dataclasses import dataclass
 
 from .library import FamilyIndex, family_index, load_library  # noqa: F401 (re-exported)
 from .problem import Candidate, Param
@@ -65,14 +66,23 @@ def member_candidates(problem, dec, index: FamilyIndex, done=()) -> list:
     return out
 
 
-def fit_members(problem, cal, dec, ex, progress=True, collect=None) -> tuple:
+@dataclass(frozen=True)
+class Members:
+    """The family stage's outcome: the members' fits and the screened
+    members left unfitted (:class:`.screen.Unfitted`)."""
+
+    fits: tuple = ()
+    unfitted: tuple = ()
+
+
+def fit_members(problem, cal, dec, ex, progress=True, collect=None) -> Members:
     """Stage: the other members of each competitive family, fitted at the
     head's site with the free parameters starting from the head's fit, and
     the members elsewhere that a one-step score screen finds promising
     (:mod:`.screen`; only when a discrepancy is found: on data the model
     explains there is no cause class to refine)."""
     if not dec.discrepancy:
-        return ()
+        return Members()
     index = family_index(problem.library)
     done = {r.candidate.key for r in dec.rows} | {r.candidate.key for r in dec.failed}
     pairs = member_candidates(problem, dec, index, done)
@@ -82,13 +92,12 @@ def fit_members(problem, cal, dec, ex, progress=True, collect=None) -> tuple:
              for t, (_, head) in zip(tasks, pairs)]
     rest = other_members(problem, dec, index, done | {c.key for c, _ in pairs})
     # a screened member starts where the step predicts: one refinement suffices
-    steps = screened(problem, cal, dec, rest, ex, run_tasks)
+    screen = screened(problem, cal, dec, rest, ex, run_tasks)
     tasks += [dataclasses.replace(t, seed_free=free) for t, (_, free) in zip(
-        fit_tasks(problem.one_start(), cal, [c for c, _ in steps]), steps)]
-    if not tasks:
-        return ()
-    return tuple(run_tasks(ex, fit_candidate, tasks, "fitting family members", progress,
-                           collect))
+        fit_tasks(problem.one_start(), cal, [c for c, _ in screen.picks]), screen.picks)]
+    fits = tuple(run_tasks(ex, fit_candidate, tasks, "fitting family members", progress,
+                           collect)) if tasks else ()
+    return Members(fits, screen.unfitted)
 
 
 def other_members(problem, dec, index: FamilyIndex, done) -> list:

@@ -21,7 +21,7 @@ from pathlib import Path
 from ..executor import open_executor
 from . import stages
 from . import stats as st
-from .families import family_index, fit_members, prefer_simplest
+from .families import Members, family_index, fit_members, prefer_simplest
 from .intervals import intervals
 from .kinematics import Kinematics, equivalents, kinematics, prefer_site
 from .locate import Location, locate
@@ -59,15 +59,15 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
         t_fit = time.perf_counter() - t0
         dec = stages.decide(ds, cal, fits, alpha)
         members = _timed(clock, "families_s", fit_members, problem, cal, dec, ex, progress,
-                         collect) if families else ()
-        if members:
-            fits += members
+                         collect) if families else Members()
+        if members.fits:
+            fits += members.fits
             dec = stages.decide(ds, cal, fits, alpha)
         if pairs and stages.pairs_needed(dec):
             fits, dec = _timed(clock, "pairs_s", _pairs, problem, ds, cal, dec, fits, ex,
                                (progress, collect, alpha), clock)
         cv = stages.cross_validate(problem, ds, cal, dec, ex, exact_cv, progress)
-        rk = stages.rank(ds, cal, dec, cv)
+        rk = stages.rank(ds, cal, dec, cv, members.unfitted)
         rk, kin = _shown(problem, cal, rk, families, clock)
         where = locate(problem, cal, dec, rk, ex, progress, collect) if generic else Location(
             skipped="not run (generic=False)")

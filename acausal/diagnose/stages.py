@@ -587,9 +587,16 @@ def _bound_reasons(best):
     return out
 
 
-def rank(ds, cal: Calibration, dec: Decision, cv: CrossValidation) -> Ranking:
+def _unfitted_reasons(unfitted):
+    return [f"{u.label} was screened as a plausible rival (one-step predicted AICc "
+            f"{u.predicted_aicc:.1f}) but not fitted (over the screen's fit budget), so it "
+            f"cannot be ruled out" for u in unfitted][:3]
+
+
+def rank(ds, cal: Calibration, dec: Decision, cv: CrossValidation, unfitted=()) -> Ranking:
     """Stage 6: exact held-out errors in, classes, weak-evidence rules; a
-    cause is never named while a rival candidate is untested."""
+    cause is never named while a rival candidate is untested, or screened
+    as plausible and left unfitted (``unfitted``: :class:`.screen.Unfitted`)."""
     rows = tuple(dataclasses.replace(r, heldout_rmse=cv.heldout(r.candidate.key, r.loo),
                                      heldout_exact=r.candidate.key in cv.exact)
                  for r in dec.rows)
@@ -609,7 +616,8 @@ def rank(ds, cal: Calibration, dec: Decision, cv: CrossValidation) -> Ranking:
             d_runner=None if runner is None else rows[runner].aicc - b.aicc,
             heldout_nominal=held0, heldout_best=b.heldout_rmse, ci_rel=_ci_rel(b),
             c_hat=dec.c_hat, coarse=_coarse(ds, cal.fit))
-        weak += _untested_reasons(untested, b) + _pair_reasons(b, rows) + _bound_reasons(b)
+        weak += _untested_reasons(untested, b) + _unfitted_reasons(unfitted)
+        weak += _pair_reasons(b, rows) + _bound_reasons(b)
     cause = best if (dec.discrepancy and rows and not weak) else None
     after = best if dec.discrepancy else None
     return Ranking(rows, classes, cause, after, runner, weak, untested, held0, vectors)

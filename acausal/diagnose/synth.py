@@ -18,7 +18,11 @@ Magnitude: give the extension's parameter ``values`` outright, or a range
 solved for so that the RMS change the extension makes to the data (before
 any recalibration), divided by the instrument floor, equals a value drawn
 log-uniformly in that range. ``effect`` makes "big enough to matter against
-the noise" the same statement for every hypothesis and mechanism.
+the noise" the same statement for every hypothesis and mechanism. Without
+``values``, the other parameters are drawn too, away from the values at
+which a family member reduces to its head (:func:`_drawn_shape`): a
+Stribeck truth has a static excess, a power-law drag an exponent other
+than 2.
 """
 from __future__ import annotations
 
@@ -219,18 +223,96 @@ def _hidden(model_path, nominal, hypothesis, location, values, magnitude, effect
     if values and first.name in values:
         return pair, ext, location
     if magnitude is not None:
+        shape, linked = _drawn_shape(specs, sign, rng)
         lo, hi = sorted(abs(float(x)) for x in magnitude)
-        ext[first.name] = sign * math.exp(rng.uniform(math.log(lo), math.log(hi)))
+        ext.update({**shape, **_sized(
+            first, sign * math.exp(rng.uniform(math.log(lo), math.log(hi))), linked)})
     elif effect is not None:
         lo, hi = sorted(float(x) for x in effect)
         target = math.exp(rng.uniform(math.log(lo), math.log(hi)))
         ref = _simulate(nominal, truth_free, conds)
-        ext[first.name] = _solve_effect(pair, truth_free, ext, first, sign, target, conds,
-                                        ref, read["measures"], read["traces"],
-                                        read["floors"], read["rate"])
+        ext.update(_reachable(pair, truth_free, ext, specs, sign, target, conds, ref, read,
+                              rng))
     else:
         raise UsageError("give values, magnitude or effect for the hidden extension")
     return pair, ext, location
+
+
+SHAPE_DRAWS = 4   # shapes drawn at most until one can reach the requested effect
+
+
+def _reachable(pair, truth_free, ext, specs, sign, target, conds, ref, read, rng):
+    """{name: value} of the extension's parameters at the requested effect:
+    a shape drawn (:func:`_drawn_shape`) and the first parameter solved for.
+    A shape that cannot reach the effect within the first parameter's bounds
+    (a knee beyond the motion) is drawn again, up to ``SHAPE_DRAWS`` times;
+    the last one is kept (the achieved effect then says it fell short)."""
+    first = specs[0]
+    limit = float(first.high) if sign > 0 else -float(first.low)
+    for _ in range(SHAPE_DRAWS):
+        shape, linked = _drawn_shape(specs, sign, rng)
+        v = _solve_effect(pair, truth_free, {**ext, **shape}, (first, linked), sign, target,
+                          conds, ref, read["measures"], read["traces"], read["floors"],
+                          read["rate"])
+        if abs(v) < limit or len(specs) == 1:
+            break
+    return {**shape, **_sized(first, v, linked)}
+
+
+SHAPE_MOVE = (0.2, 0.5)   # of the way from a shape parameter's neutral value to a bound
+RATIO = (0.3, 3.0)        # a magnitude parameter's size against the first's, in scales
+
+
+def _drawn_shape(specs, sign, rng):
+    """({name: value} of the shape parameters, {name: ratio to the first} of
+    the magnitude parameters) of an extension's parameters after the first.
+
+    A magnitude parameter (neutral value 0: Stribeck's static excess dtau,
+    the viscous coefficient b of Coulomb + viscous friction) is drawn as a
+    ratio to the first parameter, so that the effect solved for scales them
+    together and the law keeps its shape (log-uniform in ``RATIO`` times the
+    ratio of their scales, on the side of 0 its bounds open; the first
+    parameter's sign is divided out). A shape
+    parameter (a non-zero neutral value: the drag exponent n = 2, the
+    Stribeck speed v_s, a knee d) is moved from its neutral value towards a
+    bound drawn at random by a share drawn in ``SHAPE_MOVE`` of the way (in
+    logarithms for a positive range). Either way the truth is the member's
+    own law, not its family head's (which it reduces to at the neutral
+    values)."""
+    shape, linked = {}, {}
+    s0 = abs(specs[0].scale) or 1.0
+    for sp_ in specs[1:]:
+        lo, hi, x0 = float(sp_.low), float(sp_.high), float(sp_.initial)
+        if x0 == 0.0:
+            side = _open_side(lo, hi, rng)
+            r = math.exp(rng.uniform(*np.log(RATIO))) * (abs(sp_.scale) or 1.0) / s0
+            linked[sp_.name] = (side * sign * r, lo, hi)
+            continue
+        bound = hi if (rng.uniform() < 0.5 or x0 <= lo) and x0 < hi else lo
+        share = rng.uniform(*SHAPE_MOVE)
+        if lo > 0 and x0 > 0:
+            v = math.exp(math.log(x0) + share * (math.log(bound) - math.log(x0)))
+        else:
+            v = x0 + share * (bound - x0)
+        shape[sp_.name] = float(min(max(v, lo), hi))
+    return shape, linked
+
+
+def _open_side(lo, hi, rng):
+    """+1 or -1: the side of 0 a magnitude parameter's bounds leave room on
+    (drawn when both do)."""
+    if hi > 0 and lo < 0:
+        return 1.0 if rng.uniform() < 0.5 else -1.0
+    return 1.0 if hi > 0 else -1.0
+
+
+def _sized(first, v, linked):
+    """{name: value} of the first parameter at ``v`` and of the magnitude
+    parameters at their ratios to it (clipped to their bounds)."""
+    out = {first.name: float(v)}
+    for name, (r, lo, hi) in linked.items():
+        out[name] = float(min(max(r * v, lo), hi))
+    return out
 
 
 def _experiment(name, c, res, meas, read, noise, resolution, rng):
@@ -254,9 +336,12 @@ def _read(x, signal, noise, resolution, rng):
     return float(y) if y.ndim == 0 else y
 
 
-def _solve_effect(pair, free, values, spec, sign, target, conds, ref, measures, traces,
+def _solve_effect(pair, free, values, sized, sign, target, conds, ref, measures, traces,
                   floors, rate):
-    """First-parameter value whose effect equals ``target`` (bisection in log)."""
+    """First-parameter value whose effect equals ``target`` (bisection in
+    log); ``sized`` = (the first parameter's spec, the magnitude parameters
+    linked to it: :func:`_sized`)."""
+    spec, linked = sized
     lo_b, hi_b = float(spec.low), float(spec.high)
     limit = hi_b if sign > 0 else -lo_b
     if not limit > 0:
@@ -268,7 +353,7 @@ def _solve_effect(pair, free, values, spec, sign, target, conds, ref, measures, 
         # measure or the simulation fails) is stronger than any target
         v = sign * math.exp(logm)
         try:
-            runs = _simulate(pair, {**free, **values, spec.name: v}, conds)
+            runs = _simulate(pair, {**free, **values, **_sized(spec, v, linked)}, conds)
         except AcausalError:
             return TOO_STRONG
         return _effect(runs, ref, measures, traces, floors, rate) - target

@@ -34,3 +34,34 @@ def test_mismatched_or_broken_columns_give_nan():
     bad = np.ones((10, 1))
     bad[3] = np.nan
     assert np.isnan(predicted_cost(r0, bad, np.ones((10, 1))))
+
+
+def test_a_bounded_step_is_the_bounded_least_squares_solution():
+    # one own column, the best unbounded step negative (a friction torque
+    # that would have to drive): bounded at 0, the step cannot gain
+    rng = np.random.default_rng(2)
+    J_own = rng.normal(size=(50, 1))
+    r0 = 3.0 * J_own[:, 0] + 0.01 * rng.normal(size=50)     # wants d = -3
+    free = np.zeros((50, 0))
+    S_unb = predicted_cost(r0, J_own, free)
+    S_b, d = predicted_step(r0, J_own, free, (np.array([0.0]), np.array([np.inf])))
+    assert S_unb < 0.01 * (r0 @ r0)
+    assert d[0] == pytest.approx(0.0, abs=1e-12)
+    assert S_b == pytest.approx(r0 @ r0, rel=1e-12)
+
+
+def test_a_bounded_step_with_columns_of_very_different_sizes():
+    # a free column in parameter units of a stiffness (~1e-8 per unit) and
+    # an own column per unit of scale: the closed form of the box-constrained
+    # problem whose bound on the own step is active
+    rng = np.random.default_rng(3)
+    a, b = 1e-8 * rng.normal(size=40), rng.normal(size=40)
+    r0 = -(2e7 * a + 5.0 * b)
+    S, d = predicted_step(r0, b[:, None], a[:, None],
+                          (np.array([-1e9, 0.0]), np.array([1e9, 2.0])))
+    # own step clipped at 2; the free step is then the 1-D least squares fit
+    x = -(r0 + 2.0 * b) @ a / (a @ a)
+    r = r0 + x * a + 2.0 * b
+    assert d[1] == pytest.approx(2.0, rel=1e-9)
+    assert d[0] == pytest.approx(x, rel=1e-6)
+    assert S == pytest.approx(r @ r, rel=1e-6)

@@ -110,3 +110,28 @@ def test_a_truth_whose_law_reduces_to_another_member_names_it():
     assert same_law_members(slider, Truth("constant_load", "mass", {"hyp_cl.F": 1.0},
                                           free), **read) == []
     assert same_law_members(slider, Truth(None, None), **read) == []
+
+
+@pytest.mark.parametrize("hyp, seed", [("stribeck_friction", 3), ("coulomb_viscous_friction", 4),
+                                       ("power_drag", 5)])
+def test_a_family_member_truth_is_its_own_law_at_the_requested_effect(tmp_path, hyp, seed):
+    """A member's truth has its own parameters away from the values at
+    which it reduces to its family's head (Stribeck's static excess > 0,
+    the viscous term b > 0, the drag exponent n != 2), the magnitude ones in
+    proportion to the first, and the effect solved for with all of them."""
+    from acausal.diagnose.synth import same_law_members
+    slider = os.path.join(HERE, "slider_model.py")
+    read = dict(conditions={"s0": [0.1, -0.05], "v0": [0.0, 0.3]}, traces=["mass.s"],
+                sample_rate=500.0, noise={"mass.s": 1e-4})
+    t = synthesize(slider, tmp_path, hypothesis=hyp, location="mass", effect=(6.0, 6.0),
+                   seed=seed, **read)
+    assert t.effect == pytest.approx(6.0, rel=0.03)
+    v = {k.partition(".")[2]: x for k, x in t.values.items()}
+    if hyp == "stribeck_friction":
+        assert v["F"] > 0 and v["dF"] > 0
+    elif hyp == "coulomb_viscous_friction":
+        assert v["F"] > 0 and v["b"] > 0
+    else:
+        assert v["c"] > 0 and abs(v["n"] - 2.0) > 0.2
+    # the truth's law does not reduce to another member of its family
+    assert same_law_members(slider, t, **read) == []
