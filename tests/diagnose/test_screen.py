@@ -65,3 +65,52 @@ def test_a_bounded_step_with_columns_of_very_different_sizes():
     assert d[1] == pytest.approx(2.0, rel=1e-9)
     assert d[0] == pytest.approx(x, rel=1e-6)
     assert S == pytest.approx(r @ r, rel=1e-6)
+
+
+COSTS = (5, 10, 15, 20, 25, 30, 40, 50, 70, 90)
+
+
+def test_members_within_reach_beyond_the_budget_are_returned_unfitted():
+    """Ten one-parameter members whose bounded steps reach S = 5 ... 90
+    from S0 = 100 (columns along the residual, each step at its upper
+    bound; unbounded, every one would reach 0); the best candidate has
+    S = 30 and the nominal 100. Reach: the best + 0.5 x its gain (one free
+    parameter, c = 1): members up to S = 64 are within it (eight); the best six are
+    fitted, the rest within reach come back unfitted, none beyond it."""
+    from types import SimpleNamespace as NS
+
+    from acausal.diagnose import screen, stats as st
+    from acausal.diagnose.problem import Candidate, Param, Problem
+
+    n, r0 = 200, np.full(200, np.sqrt(100.0 / 200))
+    rng = np.random.default_rng(4)
+    ortho = rng.normal(size=n)
+    ortho -= (ortho @ r0) / (r0 @ r0) * r0
+    free = (Param("k.c", 1.0, 0.0, 10.0, 1.0, 1.0),)
+    problem = Problem("m.py", "", "lib", free)
+    J_free = ortho[:, None] / np.linalg.norm(ortho)       # the free parameter cannot help
+    f0 = NS(values={"k.c": 1.0}, names=["k.c"], jacobian=J_free, n=n, k=1)
+    cands, cols = [], {}
+    for i, S in enumerate(COSTS):
+        c = Candidate("h", f"site{i}", (Param(f"hyp{i}.x", 0.0, 0.0, 1.0, 1.0, 0.0),))
+        # a column along -r0 whose unit step (the bound) leaves S: |r0| (1 - a) = sqrt(S)
+        a = 1.0 - np.sqrt(S / 100.0)
+        cands.append(c)
+        cols[c.key] = (r0, (-a * r0)[:, None])
+    a_best = st.aicc(30.0, n, 2, 1.0)
+    a0 = st.aicc(100.0, n, 1, 1.0)
+    dec = NS(rows=[NS(aicc=a_best)], a0=a0, c_hat=1.0)
+
+    def run_tasks(ex, fn, tasks, label, progress):
+        return [cols[t.candidate.key] for t in tasks]
+
+    got = screen.screened(problem, NS(fit=f0), dec, cands, None, run_tasks)
+    reach = a_best + max(screen.MARGIN, screen.SHARE * (a0 - a_best))
+    within = [c.location for c, S in zip(cands, COSTS)
+              if st.aicc(float(S), n, 2, 1.0) < reach]
+    assert [c.location for c, _ in got.picks] == within[:screen.MAX_FITS]
+    assert [u.label for u in got.unfitted] == [f"h at {loc}" for loc in
+                                               within[screen.MAX_FITS:]]
+    assert len(within) > screen.MAX_FITS and len(within) < len(cands)
+    for u in got.unfitted:
+        assert u.predicted_aicc < reach
