@@ -221,7 +221,8 @@ def weak_evidence(*, n: int, k: int, d_null: float, d_runner: float | None,
     parameters of the best model k, its dAICc below no extension (d_null) and
     below the best candidate outside its class (d_runner), held-out RMS of the
     nominal and of the best (noise-floor units), the relative 95 % half-width
-    of its main parameter, the over-dispersion, and the nominal misfit's RMS in
+    of its main parameter (relative to its distance from the neutral value), the
+    over-dispersion, and the nominal misfit's RMS in
     resolution steps (coarse; None if the data have no resolution)."""
     out = []
     if n < MIN_PER_PARAM * k:
@@ -243,7 +244,8 @@ def weak_evidence(*, n: int, k: int, d_null: float, d_runner: float | None,
                    f"{HELDOUT_GAIN:g}x)")
     if ci_rel is not None and not (ci_rel < CI_REL):
         out.append(f"the cause's parameter is poorly determined: 95 % half-width "
-                   f"{ci_rel:.0%} of its value (needs below {CI_REL:.0%})")
+                   f"{ci_rel:.0%} of its distance from the neutral value (needs below "
+                   f"{CI_REL:.0%})")
     if c_hat > OVERDISPERSION:
         out.append(f"the best extension still leaves {math.sqrt(c_hat):.2g}x the noise "
                    f"floor (RMS), so part of the discrepancy is not explained")

@@ -36,6 +36,7 @@ import numpy as np
 import pytest
 
 from acausal.backends import compiled_available
+from acausal.errors import AcausalError
 from acausal.modelfile import compile_file, evaluate_measures
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -120,28 +121,48 @@ def _no_worse(err, tol, what):
     assert err["sundae"] <= 2 * err["compiled"] + tol, (what, err, tol)
 
 
-# The toggle's knee, latched 1.4 deg from its dead centre, makes its
-# re-initialisation matrix 100 times worse conditioned than the planar
-# breaker's (column-scaled condition number 5e7 against 5.7e5; 2.3e5 for
-# the 1-D breaker): IDA's corrector cannot converge below rtol 1e-10 there
-# (it fails at t = 8 us at rtol 1e-10 and at 0.27 ms at 1e-11, on either
-# backend), so its reference is the tightest run it allows: 3e-2 of the
-# file's tolerances (rtol 3e-10), still 30 times the accuracy of the runs.
-TIGHTEN = {"breaker_24kv_toggle": 3e-2}
+# The reference: the reference backend at the tightest of LADDER's
+# fractions of the file's tolerances that IDA completes, 1e-3 first. Where a
+# model's conditioning bounds the accuracy IDA can reach, a tighter run
+# fails outright: the toggle's knee, latched 1.4 deg from its dead centre,
+# makes its re-initialisation matrix 100 times worse conditioned than the
+# planar breaker's (column-scaled condition number 5e7 against 5.7e5; 2.3e5
+# for the 1-D breaker), and IDA's corrector fails at t = 8 us at rtol 1e-10
+# and at 0.27 ms at 1e-11, on either backend. Whether a run at that limit
+# completes is decided by the last bits of the arithmetic: moving the
+# toggle's fraction 3e-2 by 1e-6 relative, 6 of 14 reference runs failed
+# (docs/planar.md, session 9). The coarsest rung, 3e-2 (rtol 3e-10 for the
+# toggle), is still 30 times the accuracy of the runs it judges.
+LADDER = (1e-3, 2e-3, 5e-3, 1e-2, 2e-2, 3e-2)
+
+
+def _reference(cm, params, opts, rtol, atol):
+    """The tightest completed run of :data:`LADDER` (module doc above)."""
+    err = None
+    for f in LADDER:
+        try:
+            ref = cm.simulate(params=params, backend="sundae",
+                              **dict(opts, rtol=rtol * f, atol=atol * f))
+        except AcausalError as e:
+            err = e
+            continue
+        if ref.status == "ok":
+            return ref
+        err = ref.status
+    raise AssertionError(f"no reference run completed down to {LADDER[-1]:g} of the "
+                         f"file's tolerances: {err}")
 
 
 def _check_equally_accurate(path, params=None):
     """Both backends against the reference backend at 1e-3 of the file's
-    tolerances (:data:`TIGHTEN` where the model's conditioning does not
-    allow that): event times, measures and traces (on the dense grid) no
-    less accurate on one backend than on the other (see the module doc)."""
+    tolerances, or the tightest fraction the model's conditioning allows
+    (:data:`LADDER`): event times, measures and traces (on the dense grid)
+    no less accurate on one backend than on the other (see the module doc)."""
     mf, cm = _compiled(path)
     opts = _trace_options(mf)
     rtol, atol = opts.get("rtol", 1e-6), float(np.max(opts.get("atol", 1e-8)))
-    f = TIGHTEN.get(os.path.basename(path)[:-3], 1e-3)
-    tight = dict(opts, rtol=rtol * f, atol=atol * f)
     tol = GLOBAL * rtol
-    ref = cm.simulate(params=params, backend="sundae", **tight)
+    ref = _reference(cm, params, opts, rtol, atol)
     runs = dict(zip(("sundae", "compiled"), _both(cm, params, opts)))
     assert [n for _, n in ref.events] == [n for _, n in runs["sundae"].events]
     span = ref.t[-1] - ref.t[0]

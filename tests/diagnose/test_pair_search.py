@@ -6,6 +6,7 @@ screening's starts move only the partner; a member of the best pair that
 was not tested alone but acted in the pair is not its rival. Pure data, no
 simulation (the blind pair cases in test_blind_*.py run the search)."""
 import numpy as np
+import pytest
 
 from acausal.diagnose.fitting import Fit
 from acausal.diagnose.pairsearch import (
@@ -84,3 +85,22 @@ def test_a_member_of_the_best_pair_untested_alone_is_not_its_rival():
     stayed = _row("h+g", "a+b", {"k.c": 1.0, "hyp_h.k": 2.0, "hyp_g.c": 0.0})
     assert _acted_in(stayed) == {("h", "a")}
     assert _acted_in(_row("h", "a", {"hyp_h.k": 2.0})) == set()
+
+
+def test_a_cause_is_sized_against_its_neutral_value():
+    """The 'poorly determined' rule's ratio: the 95 % half-width of the
+    cause's parameter over its distance from its neutral value (the prior).
+    A law switch whose restitution stays the model's is a well determined
+    effect, though its fitted shift is near 0 (the breaker's Hunt-Crossley
+    blind case); with a neutral value of 0 it is the relative half-width."""
+    from acausal.diagnose.stages import _ci_rel
+
+    def row(prior, value, half):
+        cand = Candidate("h", "a", (Param("hyp_h.de", prior, -0.5, 0.26, 0.05, prior),))
+        fit = Fit(["k.c", "hyp_h.de"], {"k.c": 1.0, "hyp_h.de": value}, 1.0, np.zeros(3),
+                  np.zeros((3, 2)), [], [], ci95={"hyp_h.de": (value - half, value + half)})
+        return Row(cand, fit, Starts(), {}, 0.0, 1.0, 1.0)
+
+    assert _ci_rel(row(0.0338, -0.000232, 0.00018)) == pytest.approx(0.00018 / 0.034032)
+    assert _ci_rel(row(0.0, -0.000232, 0.00018)) == pytest.approx(0.00018 / 0.000232)
+    assert _ci_rel(row(0.0338, 0.0338, 0.001)) == float("inf")
