@@ -205,9 +205,10 @@ def _safe_coefficient(c, params):
 def _solve_linear_block(exprs, us, params, values=None, max_size=12, max_varying=2):
     """Solve a block of equations linear in its unknowns, with constant
     (parameter) coefficients, symbolically; None when it is not such a block.
-    A larger block (more than ``max_varying`` unknowns) whose coefficients
-    depend on variables is first eliminated on constant pivots, if it can be
-    (:func:`_constant_pivot_solve`)."""
+    A block whose coefficients depend on variables is solved by
+    :func:`_constant_pivot_solve` if it can be, else on pivots chosen at the
+    start values; the solution of a block of at most ``max_varying``
+    unknowns is simplified (``cancel``)."""
     if len(us) > max_size:
         return None
     try:
@@ -218,16 +219,14 @@ def _solve_linear_block(exprs, us, params, values=None, max_size=12, max_varying
         return None
     if any(set(us) & bi.free_symbols for bi in b):
         return None
-    simplify = True
+    simplify = len(us) <= max_varying   # cancel on trigonometric entries costs seconds
     if not all(a.free_symbols <= params for a in A):
-        if len(us) > max_varying:
-            # coefficients that move with the variables (a planar body's
-            # r x f): pivots fixed at the start values could vanish later in
-            # the motion, so first try to eliminate on constant pivots only
-            x = _constant_pivot_solve(A, b, params, values)
-            if x is not None:
-                return x
-            simplify = False    # cancel on trigonometric entries costs seconds
+        # coefficients that move with the variables (a planar body's r x f):
+        # pivots fixed at the start values could vanish later in the motion,
+        # so first eliminate on constant pivots, the rest by the determinant
+        x = _constant_pivot_solve(A, b, params, values)
+        if x is not None:
+            return [sp.cancel(xi) if simplify and xi.count_ops() < 200 else xi for xi in x]
         # pivots chosen numerically at the start values (partial pivoting),
         # then imposed on the symbolic LU by reordering the rows: sympy would
         # otherwise take the first structurally non-zero pivot, which can be
@@ -246,12 +245,43 @@ def _solve_linear_block(exprs, us, params, values=None, max_size=12, max_varying
     return [sp.cancel(xi) if simplify and xi.count_ops() < 200 else xi for xi in x]
 
 
-def _constant_pivot_solve(A, b, params, values):
-    """Gaussian elimination of ``A x = b`` whose every pivot is made of
-    numbers and parameters only (full pivoting, largest at the start values,
-    among such entries), so that no pivot can vanish as the variables move;
-    None when the elimination runs out of such pivots. No ``cancel`` (it
-    costs seconds on trigonometric entries and gains nothing at run time)."""
+def _constant_pivot_solve(A, b, params, values, max_adjugate=3):
+    """``A x = b`` solved so that it divides only by what cannot vanish as
+    the variables move, or by the determinant: Gaussian elimination on
+    pivots made of numbers and parameters only (full pivoting, largest at
+    the start values, among such entries), then, for the at most
+    ``max_adjugate`` unknowns left when such pivots run out, Cramer's rule
+    (:func:`_adjugate_solve`). None when more are left. No ``cancel`` (it
+    costs seconds on trigonometric entries and gains nothing at run time).
+
+    The rest of a four-bar's velocity block is 2 x 2 in the rocker's and the
+    coupler's rates; its LU pivot chosen at the start values was
+    ``r1*cos(shaft.phi)``, zero whenever the rocker passes the vertical
+    although the block is regular there (its determinant is the transmission
+    angle's sine): the generated code then divided by nearly zero and IDA's
+    corrector failed (docs/planar.md). The determinant vanishes only where
+    the block is singular."""
+    n = A.rows
+    M, rhs, cols, k0 = _eliminate_on_constant_pivots(A, b, params, values)
+    x = [None] * n
+    if k0 < n:
+        if n - k0 > max_adjugate:
+            return None
+        tail = _adjugate_solve(M[k0:, k0:], rhs[k0:, :], values)
+        if tail is None:
+            return None
+        for i, v in enumerate(tail):
+            x[cols[k0 + i]] = v
+    for k in reversed(range(k0)):
+        acc = rhs[k] - sp.Add(*[M[k, j] * x[cols[j]] for j in range(k + 1, n)])
+        x[cols[k]] = acc / M[k, k]
+    return x
+
+
+def _eliminate_on_constant_pivots(A, b, params, values):
+    """(M, rhs, cols, k): ``A x = b`` after ``k`` steps of Gaussian
+    elimination on constant pivots (rows and columns swapped, ``cols[j]``
+    the unknown of column ``j``); ``k < n`` when such pivots ran out."""
     n = A.rows
     M, rhs, cols = A.as_mutable(), b.as_mutable(), list(range(n))
     for k in range(n):
@@ -267,7 +297,7 @@ def _constant_pivot_solve(A, b, params, values):
         if best is None:
             best = _simplified_pivot(M, k, params, values)
         if best is None:
-            return None
+            return M, rhs, cols, k
         _, i, j = best
         M.row_swap(k, i)
         rhs.row_swap(k, i)
@@ -280,11 +310,21 @@ def _constant_pivot_solve(A, b, params, values):
                     M[i, j] = M[i, j] - fct * M[k, j]
                 rhs[i] = rhs[i] - fct * rhs[k]
                 M[i, k] = 0
-    x = [None] * n
-    for k in reversed(range(n)):
-        acc = rhs[k] - sp.Add(*[M[k, j] * x[cols[j]] for j in range(k + 1, n)])
-        x[cols[k]] = acc / M[k, k]
-    return x
+    return M, rhs, cols, n
+
+
+def _adjugate_solve(S, r, values):
+    """``S x = r`` by Cramer's rule, ``x = adj(S) r / det(S)`` (both
+    division-free, Berkowitz), so that the only division is by the
+    determinant; None when the determinant is zero or not a finite non-zero
+    number at the start values."""
+    det = S.det(method="berkowitz")
+    v = _numeric(det, values)
+    if det == 0 or not np.isfinite(v) or v == 0:
+        return None
+    adj = S.adjugate(method="berkowitz")
+    return [sp.Add(*[adj[i, j] * r[j, 0] for j in range(S.rows)]) / det
+            for i in range(S.rows)]
 
 
 def _simplified_pivot(M, k, params, values, max_ops=30, max_tries=6):
