@@ -250,8 +250,9 @@ def _constant_pivot_solve(A, b, params, values, max_adjugate=3):
     the variables move, or by the determinant: Gaussian elimination on
     pivots made of numbers and parameters only (full pivoting, largest at
     the start values, among such entries), then, for the at most
-    ``max_adjugate`` unknowns left when such pivots run out, Cramer's rule
-    (:func:`_adjugate_solve`). None when more are left. No ``cancel`` (it
+    ``max_adjugate`` unknowns left when such pivots run out, after pivots
+    that are numbers, Cramer's rule (:func:`_adjugate_solve`). None
+    otherwise. No ``cancel`` (it
     costs seconds on trigonometric entries and gains nothing at run time).
 
     The rest of a four-bar's velocity block is 2 x 2 in the rocker's and the
@@ -265,7 +266,10 @@ def _constant_pivot_solve(A, b, params, values, max_adjugate=3):
     M, rhs, cols, k0 = _eliminate_on_constant_pivots(A, b, params, values)
     x = [None] * n
     if k0 < n:
-        if n - k0 > max_adjugate:
+        # after a pivot that is a parameter (a 1e-30 kg m^2 hook's inertia
+        # in a breaker's dynamics block) the rest would be scaled by it:
+        # then the start values' pivots, as before, instead
+        if n - k0 > max_adjugate or not all(M[k, k].is_number for k in range(k0)):
             return None
         tail = _adjugate_solve(M[k0:, k0:], rhs[k0:, :], values)
         if tail is None:
