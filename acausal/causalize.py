@@ -8,9 +8,9 @@ its unknown with a constant coefficient is solved explicitly and substituted
 one. What remains: residuals ``F(t, y, y', p, d) = 0`` over ``y`` = states +
 algebraic unknowns of implicit blocks.
 
-Last, :func:`semi_explicit` confines each state derivative to its own
-state row where that row gives it explicitly (``y' = f(y)``): the other
-rows then use ``f(y)``, the semi-explicit index-1 form ``y' = f(y, z),
+Last, :func:`semi_explicit` confines each state derivative that its state
+row equates to an algebraic unknown (``y'_k = z_j``) to that row: the other
+rows use ``z_j``. This is the semi-explicit index-1 form ``y' = f(y, z),
 0 = g(y, z)`` of Brenan, Campbell and Petzold (1996, section 3.2), whose
 algebraic rows do not depend on IDA's ``cj``.
 """
@@ -65,23 +65,26 @@ def build_dae(g, dummies, params, values=None):
 
 
 def semi_explicit(dae):
-    """``dae`` with every state derivative that its state row gives
-    explicitly (``c*y'_k + rest``: ``c`` a number, ``rest`` free of
-    derivatives) replaced by ``-rest/c`` in the other rows (a new DAE).
+    """``dae`` with every state derivative that its state row equates to an
+    algebraic unknown (``c*y'_k - c*z_j``, ``c`` a number) replaced by that
+    unknown in the other rows (a new DAE, with the same solutions).
 
     The dummy derivative method leaves the derivative of a state in
-    algebraic rows (a four-bar's acceleration constraints hold
+    algebraic rows: a four-bar's acceleration constraints hold
     ``der(der(hook.phi))``, the derivative of the state ``der(hook.phi)``,
-    where the state row says it equals the algebraic ``der(hook.w)``).
-    IDA's iteration matrix ``dF/dy + cj dF/dy'`` then has ``cj`` in those
-    algebraic rows; IDA reuses the matrix while ``cj`` changes by up to 25 %
-    and scales each Newton correction by ``2/(1 + cj/cj_old)``, right for
-    rows ``y' - f`` and wrong for such algebraic rows: the Newton iteration
-    leaves errors of 5-15 % of the error weights in the accelerations, which
-    enter IDA's local error estimates. On the frictionless generic four-bar
-    (docs/planar.md) that locked IDA's step and order control into a cycle
-    at order 2 (7000 steps) in 5 % of runs, chosen by the last bits of the
-    arithmetic, and the energy drifted 4e-8 instead of 1e-9."""
+    which the state row equates to the algebraic ``der(hook.w)``. IDA's
+    iteration matrix ``dF/dy + cj dF/dy'`` then has ``cj`` in those
+    algebraic rows. IDA reuses the matrix while ``cj`` changes by up to
+    25 %, and it rescales each Newton correction by ``2/(1 + cj/cj_old)``,
+    a correction meant for differential rows. Measured on the frictionless
+    generic four-bar (docs/planar.md): the Newton iteration left errors of
+    a median 6-13 % of the error weights in the accelerations, which enter
+    IDA's local error estimates. In 4-5 % of neighbouring runs (decided by
+    the last bits of the arithmetic) IDA's step and order control then
+    locked into a cycle at order 2: 7000 steps, and an energy drift of 4e-8
+    instead of 1e-9. In this form: none of 81 runs, in 35 % fewer steps.
+    A derivative that its state row gives as an expression is left where it
+    is (substituting expressions was not needed, nor measured)."""
     n, alg = dae.n_states, set(dae.y[dae.n_states:])
     sub = {}
     for k in range(n):
@@ -252,8 +255,8 @@ def _constant_pivot_solve(A, b, params, values, max_adjugate=3):
     the start values, among such entries), then, for the at most
     ``max_adjugate`` unknowns left when such pivots run out, after pivots
     that are numbers, Cramer's rule (:func:`_adjugate_solve`). None
-    otherwise. No ``cancel`` (it
-    costs seconds on trigonometric entries and gains nothing at run time).
+    otherwise. No ``cancel`` (it costs seconds on trigonometric entries and
+    gains nothing at run time).
 
     The rest of a four-bar's velocity block is 2 x 2 in the rocker's and the
     coupler's rates; its LU pivot chosen at the start values was
