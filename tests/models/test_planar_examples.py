@@ -161,8 +161,8 @@ def test_fourbar_planar_generic_geometry_over_turns_and_energy(backend):
 # docs/planar.md (the generated velocity solve divided by r1*cos(shaft.phi);
 # IDA's step control locked at order 2) 5 of these 6 runs failed: drifts of
 # 0.9-1.8e-7 with 16000-35000 steps, and at theta1_0 = 1.0 on sundae IDA
-# stopped at t = 2.0 s with the rocker vertical, reported as a dead centre
-# (the transmission angle's sine was 0.79 there). Now: at most 1.1e-9, in
+# stopped at t = 2.996 s with the rocker vertical, reported as a dead centre
+# (the transmission angle's sine is 0.8 there). Now: at most 1.1e-9, in
 # 6000-15000 steps.
 OTHER = dict(e=0.05, f=0.12, r1=0.09, r2=0.04, r3=0.06)
 
