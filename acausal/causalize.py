@@ -229,7 +229,7 @@ def _solve_linear_block(exprs, us, params, values=None, max_size=12, max_varying
         # so first eliminate on constant pivots, the rest by the determinant
         x = _constant_pivot_solve(A, b, params, values)
         if x is not None:
-            return [sp.cancel(xi) if simplify and xi.count_ops() < 200 else xi for xi in x]
+            return _cancelled(x, simplify)
         # pivots chosen numerically at the start values (partial pivoting),
         # then imposed on the symbolic LU by reordering the rows: sympy would
         # otherwise take the first structurally non-zero pivot, which can be
@@ -245,6 +245,12 @@ def _solve_linear_block(exprs, us, params, values=None, max_size=12, max_varying
         x = A.LUsolve(b)
     except (ValueError, ZeroDivisionError):
         return None
+    return _cancelled(x, simplify)
+
+
+def _cancelled(x, simplify):
+    """The solution ``x`` with each small entry simplified (``cancel``) when
+    ``simplify``."""
     return [sp.cancel(xi) if simplify and xi.count_ops() < 200 else xi for xi in x]
 
 

@@ -175,5 +175,5 @@ def screened(problem, cal, dec, cands, ex, run_tasks) -> Screen:
         if a < reach:
             scored.append((a, _stepped(c, d[f0.k:]), _free_step(problem, f0, d[:f0.k])))
     scored.sort(key=lambda t: t[0])
-    return Screen(tuple((c, free) for _, c, free in scored[:MAX_FITS]),
+    return Screen(tuple((c, at) for _, c, at in scored[:MAX_FITS]),
                   tuple(Unfitted(c.label, a) for a, c, _ in scored[MAX_FITS:]))

@@ -248,7 +248,7 @@ def _reachable(pair, truth_free, ext, specs, sign, target, conds, ref, read, rng
     (a knee beyond the motion) is drawn again, up to ``SHAPE_DRAWS`` times;
     the last one is kept (the achieved effect then says it fell short)."""
     first = specs[0]
-    limit = float(first.high) if sign > 0 else -float(first.low)
+    limit = _limit(first, sign)
     for _ in range(SHAPE_DRAWS):
         shape, linked = _drawn_shape(specs, sign, rng)
         v = _solve_effect(pair, truth_free, {**ext, **shape}, (first, linked), sign, target,
@@ -336,14 +336,18 @@ def _read(x, signal, noise, resolution, rng):
     return float(y) if y.ndim == 0 else y
 
 
+def _limit(spec, sign):
+    """The largest magnitude of a first parameter of ``sign`` within its bounds."""
+    return float(spec.high) if sign > 0 else -float(spec.low)
+
+
 def _solve_effect(pair, free, values, sized, sign, target, conds, ref, measures, traces,
                   floors, rate):
     """First-parameter value whose effect equals ``target`` (bisection in
     log); ``sized`` = (the first parameter's spec, the magnitude parameters
     linked to it: :func:`_sized`)."""
     spec, linked = sized
-    lo_b, hi_b = float(spec.low), float(spec.high)
-    limit = hi_b if sign > 0 else -lo_b
+    limit = _limit(spec, sign)
     if not limit > 0:
         raise UsageError(f"{spec.name}: no room for sign {sign:+g} in "
                          f"[{spec.low}, {spec.high}]")

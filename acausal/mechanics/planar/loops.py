@@ -152,9 +152,10 @@ def singularity_error(model, paths, message, t, result):
     (:func:`follower_sine` of at least :data:`NOT_DEAD_SIN`): then a
     :class:`~acausal.errors.SolverError` that names the loop and says the
     failure is numerical. Measured: a crank-rocker whose hook spins at 24
-    rad/s stopped at atol 1e-12 with its followers' sine at 0.8, where the
-    coupler's acceleration passes through zero among terms of 600 rad/s^2,
-    and had been reported as "most likely a dead centre"."""
+    rad/s stopped at atol 1e-12 with its followers' sine at -0.94 (the
+    transmission angle's sine 0.79), where the coupler's acceleration
+    passes through zero among terms of 600 rad/s^2, and had been reported
+    as "most likely a dead centre"."""
     loop = loop_of(model, paths)
     if loop is None:
         return None
