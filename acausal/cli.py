@@ -252,7 +252,7 @@ def _plot(mf, res, path, partial=False):
               help="largest number of frames (evenly spaced in time)")
 def animate(file, out, t_end, sets, fps, frames):
     """Simulate a planar model file and animate its mechanism."""
-    from .animate import animate as write_animation
+    from .viz.animate import animate as write_animation
     from .modelfile import compile_file
     try:
         mf, cm = compile_file(file)
@@ -313,7 +313,7 @@ def variables(file):
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object")
 def calibrate(file, data, fit, method, experiments, profile, as_json):
     """Fit parameters of a model file to a measured dataset."""
-    from . import calibrate as cal
+    from .studies import calibrate as cal
     from .modelfile import compile_file
     try:
         mf, cm = compile_file(file)
@@ -421,10 +421,10 @@ def sweep(file, params, measures, out, plot, scheduler, workers, no_progress):
     import functools
     import os
 
-    from .checkpoint import source_files
-    from .executor import open_executor, terminate_on_sigterm
+    from .infra.checkpoint import source_files
+    from .infra.executor import open_executor, terminate_on_sigterm
     from .modelfile import compile_file, sweep_task
-    from .sweep import grid, parse_param, plot_sweep, run_sweep
+    from .studies.sweep import grid, parse_param, plot_sweep, run_sweep
     measures = _csv_list(",".join(measures))
     try:
         mf, cm = compile_file(file)
@@ -494,7 +494,7 @@ def diagnose(file, data, json_path, report_dir, scheduler, workers, hypotheses, 
     extend the model and measure the gain."""
     from .diagnose.problem import FitSettings
     from .diagnose.run import diagnose as run_diagnosis
-    from .executor import terminate_on_sigterm
+    from .infra.executor import terminate_on_sigterm
     try:
         if not 0 < alpha < 1:
             raise click.BadParameter(f"--alpha {alpha}: must be between 0 and 1")

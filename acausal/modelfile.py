@@ -22,10 +22,10 @@ import sys
 import traceback
 from dataclasses import dataclass, field
 
-from .compile import compile_model
-from .component import Model
+from .compiler.pipeline import compile_model
+from .lang.component import Model
 from .errors import AcausalError, ModelFileError
-from .experiment import Experiment, Measure
+from .lang.experiment import Experiment, Measure
 
 
 @dataclass

@@ -11,7 +11,9 @@ flange; the torques of everything connected to it add up there).
 """
 from sympy import Basic, SympifyError, sympify
 
-from acausal import Component, Eq, Parameter, ParameterError, RotFlange, Variable, der
+from acausal.lang import Component, Eq, Parameter, RotFlange, Variable, der
+
+from acausal.errors import ParameterError
 
 from .partials import (PartialRotAbsoluteSensor, PartialRotCompliant,
                        PartialRotRelativeSensor, PartialRotRigid, PartialSource)

@@ -10,7 +10,9 @@ flange; the forces of everything connected to it add up there).
 """
 from sympy import Basic, SympifyError, sympify
 
-from acausal import Component, Eq, Flange, Parameter, ParameterError, Variable, der
+from acausal.lang import Component, Eq, Flange, Parameter, Variable, der
+
+from acausal.errors import ParameterError
 
 from .partials import (PartialAbsoluteSensor, PartialCompliant, PartialRelativeSensor,
                        PartialRigid, PartialSource)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy import integrate, optimize
 
-from acausal.design import (Condition, ModelRival, Signal, conditions_of,
+from acausal.studies.design import (Condition, ModelRival, Signal, conditions_of,
                             design_experiment, score)
 from acausal.errors import ModelFileError
 from acausal.modelfile import compile_file
@@ -43,7 +43,7 @@ def test_two_rivals_separation_is_largest_at_the_analytic_optimum():
 
 
 def test_next_experiment_plot_is_written(tmp_path):
-    from acausal.design import plot_next_experiment
+    from acausal.studies.design import plot_next_experiment
     nxt = design_experiment({"line": _line, "parabola": _parabola},
                             [Condition("a", -0.5, 2.0), Condition("b", 0.0, 1.0)],
                             [Signal("y", 0.01)], n_initial=12, n_refine=1, times=T)

@@ -43,7 +43,7 @@ def _model():
 def test_guarded_terms_outside_their_domain(backend):
     cm = compile_model(_model(), cache=False)
     if backend == "compiled":
-        from acausal.backends import compiled
+        from acausal.runtime.backends import compiled
         try:
             compiled._compiler()
         except compiled.Unavailable:

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from acausal.profile import profile_likelihood, threshold
+from acausal.studies.profile import profile_likelihood, threshold
 
 Q95 = stats.chi2.ppf(0.95, 1)
 
@@ -121,7 +121,7 @@ def test_unidentifiable_parameter_gives_open_profile():
 
 
 def test_linear_check_accepts_linear_and_rejects_asymmetric():
-    from acausal.profile import linear_check
+    from acausal.studies.profile import linear_check
     from scipy import optimize
     X, y, sigma = _quadratic_data()
     beta = np.linalg.lstsq(X, y, rcond=None)[0]
@@ -143,7 +143,7 @@ def test_breaker_K_over_all_voltages_has_an_open_profile():
     each K) is closed below, near 2.9e8, and open up to the bound 1e10.
     About 1100 simulations (1.5 min of CPU)."""
     import os
-    from acausal import calibrate as cal
+    from acausal.studies import calibrate as cal
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     model = os.path.join(root, "models", "breaker_24kv.py")
     ds = cal.model_dataset(model, os.path.join(root, "data", "report_24kv"))
@@ -161,7 +161,7 @@ def test_breaker_K_at_110V_profile_is_closed_and_shifted():
     """Two readings for two parameters (dof 0: threshold 3.84): the profile of
     K is closed, [4.07e8, 1.02e9] against the Wald [3.91e8, 9.74e8]."""
     import os
-    from acausal import calibrate as cal
+    from acausal.studies import calibrate as cal
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     model = os.path.join(root, "models", "breaker_24kv.py")
     ds, _ = cal.split(cal.model_dataset(model, os.path.join(root, "data", "report_24kv")))
@@ -175,7 +175,7 @@ def test_breaker_K_at_110V_profile_is_closed_and_shifted():
 
 def test_profiles_auto_profiles_only_what_the_linear_check_rejects():
     from scipy import optimize
-    from acausal.profile import jacobian_in_profile_variables, profiles
+    from acausal.studies.profile import jacobian_in_profile_variables, profiles
     t, y = _decay(0.15)
 
     def res(x):

@@ -27,7 +27,7 @@ the profile's normal and Coulomb friction along its tangent. Sign convention:
 """
 from sympy import sqrt, tanh
 
-from acausal import Eq, Parameter, Variable, der
+from acausal.lang import Eq, Parameter, Variable, der
 
 from ..contact import PartialContact
 from .geometry import rotate

@@ -31,7 +31,7 @@ import warnings
 import sympy as sp
 from sympy import Eq, Piecewise, sqrt
 
-from acausal import Event
+from acausal.lang import Event
 
 from .geometry import rotate
 

@@ -10,8 +10,8 @@ systems): loop k is that edge plus the tree path between its ends.
 """
 from dataclasses import dataclass
 
-from acausal.component import Model
-from acausal.connectors import Frame
+from acausal.lang.component import Model
+from acausal.lang.connectors import Frame
 from acausal.errors import AcausalError, InitializationError, SolverError
 
 

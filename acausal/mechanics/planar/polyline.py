@@ -48,7 +48,7 @@ import math
 
 from sympy import Eq, Piecewise, sqrt
 
-from acausal import Discrete, Event, Parameter, Variable
+from acausal.lang import Discrete, Event, Parameter, Variable
 from acausal.errors import ParameterError
 
 from .contact import PartialCircleContact
