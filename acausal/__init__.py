@@ -11,7 +11,7 @@ design, sweep); :mod:`.diagnose`; :mod:`.cli`.
 from sympy import Piecewise, cos, exp, sin, sqrt  # noqa: F401  (for model files)
 
 from .lang.component import Component, Model
-from .compiler.pipeline import CompiledModel, compile_model
+from .runtime.model import CompiledModel, compile_model
 from .lang.connectors import Flange, Frame, Port, RotFlange
 from .lang.declare import Assertion, Discrete, Event, Parameter, Start, Variable, guess
 from .lang.experiment import Experiment, Measure, Stop
@@ -45,7 +45,7 @@ _MOVED = {
     "causalize": "compiler.causalize",
     "codegen": "compiler.codegen",
     "codegen_c": "compiler.codegen_c",
-    "compile": "compiler.pipeline",
+    "compile": "runtime.model",
     "simulate": "runtime.hybrid",
     "initialize": "runtime.initialize",
     "events": "runtime.events",

@@ -22,7 +22,7 @@ import sys
 import traceback
 from dataclasses import dataclass, field
 
-from .compiler.pipeline import compile_model
+from .runtime.model import compile_model
 from .lang.component import Model
 from .errors import AcausalError, ModelFileError
 from .lang.experiment import Experiment, Measure

@@ -643,12 +643,12 @@ class Case:
     parameters, discrete values, tolerances."""
 
     def __init__(self, cm, bench):
-        from acausal.runtime.hybrid import _atol_vector
+        from acausal.runtime.hybrid import atol_vector
         self.cm = cm
         self.p = cm.param_vector(PARAMS)
         self.d = cm.discrete_start()
         self.y, self.yp = initial_point(cm, self.p, self.d, cm.callbacks(self.p, self.d), 0.0)
-        self.atol = _atol_vector(cm, ATOL, None)
+        self.atol = atol_vector(cm, ATOL, None)
         self.rtol, self.t_end = bench["rtol"], bench["t_end"]
 
     def row(self, label, run):

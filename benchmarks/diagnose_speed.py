@@ -95,9 +95,9 @@ class StageCounter:
         self.current = "load/other"
 
     def install(self):
-        from acausal.compiler import pipeline as comp
         from acausal.diagnose import run
         from acausal.diagnose.stages import chain as stages
+        from acausal.runtime import model as comp
         inner = comp.CompiledModel.simulate
         me = self
 

@@ -4,13 +4,16 @@ functions and the observed variables, once per model structure.
 The generated functions use plain Python arithmetic on float scalars (``y``
 is unpacked with ``tolist()``), share sub-expressions through ``sympy.cse``
 and fill the solver's arrays in place (``r[i] = ...``). Parameters and
-discrete values are closure constants: ``make(p, d)`` builds the callbacks
-for one parameter vector and one set of discrete values.
+discrete values are closure constants: ``make(p, d)`` builds the
+:class:`Callbacks` for one parameter vector and one set of discrete values.
+:func:`root_gradients` generates the root functions' derivatives that the
+event-time sensitivities need (:mod:`acausal.runtime.sensitivity`).
 """
 import functools
 import linecache
 import math
 from dataclasses import dataclass
+from typing import Callable, NamedTuple, Optional
 
 import numpy as np
 import sympy as sp
@@ -206,7 +209,7 @@ def _cse_print(exprs, indent="        ", prefix="c_", symbols=None):
     large models): every non-atomic sub-expression met twice gets a name,
     defined after the names it uses; work linear in the size of the
     expressions."""
-    repeated = _repeated(exprs)
+    repeated = repeated_subexpressions(exprs)
     names = {e: f"{prefix}{k}" for k, e in enumerate(repeated)}
     # a definition may only use the names defined before it: the printer
     # rebuilds some parts (x**(-1/2) in a product is printed as 1/sqrt(x)),
@@ -223,7 +226,7 @@ def _shareable(e):
     return isinstance(e, sp.Expr) and not e.is_Atom and bool(e.args)
 
 
-def _repeated(exprs):
+def repeated_subexpressions(exprs):
     """Sub-expressions met more than once, each after the ones inside it."""
     seen, repeated = set(), set()
 
@@ -321,7 +324,7 @@ class Sparsity:
                               shape=(self.n, self.n))
 
 
-def _jacobian_entries(res, ysyms, ypsyms, columns=None):
+def jacobian_entries(res, ysyms, ypsyms, columns=None):
     """Non-zero entries (i, j, dF_i/dy_j, dF_i/dy'_j) of the residuals'
     Jacobians, by differentiating each residual only with respect to the
     unknowns it contains (work linear in the number of non-zeros), and,
@@ -360,7 +363,7 @@ def _sparsity(n, entries):
     return Sparsity(n, rows, cols, lband, uband)
 
 
-def _fixed_entries(obs, fixed_rows, ysyms, ypsyms, ns):
+def fixed_entries(obs, fixed_rows, ysyms, ypsyms, ns):
     """Non-zero entries (a, k, expr) of d(observed[fixed_rows[a]])/dz with
     z = (y, y' of the states): the rows initialisation adds for fixed starts."""
     zs = list(ysyms) + list(ypsyms[:ns])
@@ -376,10 +379,38 @@ def _fixed_entries(obs, fixed_rows, ysyms, ypsyms, ns):
     return out
 
 
-@dataclass
+class Callbacks(NamedTuple):
+    """The generated callbacks of one mode (one parameter vector and one set
+    of discrete values), by name; a tuple in this order, so that the storage
+    a linear solver fills is chosen by position
+    (:attr:`acausal.runtime.backends.LinearSolver.jac_index`).
+
+    ``res(t, y, yp, r)`` fills the residual; ``jac(t, y, yp, r, cj, J)`` the
+    iteration matrix ``dF/dy + cj dF/dy'`` into a 2-D (dense or band) array;
+    ``roots(t, y, yp, g)`` the root functions (events, then assertions);
+    ``jacs(t, y, yp, Jy, Jyp)`` ``dF/dy`` and ``dF/dy'`` apart;
+    ``observe(t, y, yp)`` returns every variable's value; ``count`` is
+    ``[step attempts, last time]`` (the distinct times the residual saw);
+    ``jac_csc`` fills the iteration matrix's compressed-sparse-column array.
+    A backend may add its own implementations of the runtime's algorithms
+    on this mode (``reinit``, ``init_newton``, ``init_check``: the compiled
+    backend's C; None where the runtime's Python runs)."""
+    res: Callable
+    jac: Callable
+    roots: Callable
+    jacs: Callable
+    observe: Callable
+    count: list
+    jac_csc: Callable
+    reinit: Optional[Callable] = None
+    init_newton: Optional[Callable] = None
+    init_check: Optional[Callable] = None
+
+
+@dataclass(frozen=True, eq=False)
 class Generated:
     """What :func:`generate` returns: the source, ``make(p, d)`` (the
-    callbacks for one parameter vector and set of discrete values),
+    :class:`Callbacks` for one parameter vector and set of discrete values),
     ``fixjac(t, y, yp, p, d, F)`` (fills the fixed-start rows ``F``) and the
     iteration matrix's :class:`Sparsity`."""
     source: str
@@ -419,13 +450,13 @@ def generate(dae, params, discretes, roots, observed, fixed_rows=()):
     ysyms = [_real(f"y{i}") for i in range(n)]
     ypsyms = [_real(f"yp{i}") if dae.yp[i] is not None else None for i in range(n)]
     cj = sp.Symbol("cj")
-    entries = _jacobian_entries(res, ysyms, ypsyms, dae.jacobian_columns)
+    entries = jacobian_entries(res, ysyms, ypsyms, dae.jacobian_columns)
     sparsity = _sparsity(n, entries)
     jy = [(i, j, dy) for i, j, dy, _ in entries if dy != 0]
     jyp = [(i, j, dyp) for i, j, _, dyp in entries if dyp != 0]
     jcomb = [(i, j, dy + cj * dyp) for i, j, dy, dyp in entries]
     csc_pos = {(i, j): k for k, (i, j) in enumerate(zip(sparsity.rows, sparsity.cols))}
-    fixed = _fixed_entries(dict(zip(fixed_rows, names.rename([obs[k] for k in fixed_rows],
+    fixed = fixed_entries(dict(zip(fixed_rows, names.rename([obs[k] for k in fixed_rows],
                                                              "a fixed start"))),
                            fixed_rows, ysyms, ypsyms, dae.n_states)
     npar, nd = len(params), len(discretes)
@@ -466,14 +497,19 @@ def generate(dae, params, discretes, roots, observed, fixed_rows=()):
 
 
 def load(src):
-    """Compile generated source; returns its (make, fixjac). Used again when
-    a compiled model is read back from the cache."""
+    """Compile generated source; returns its (make, fixjac), ``make(p, d)``
+    giving :class:`Callbacks`. Used again when a compiled model is read back
+    from the cache."""
     _counter[0] += 1
     fname = f"<acausal-generated-{_counter[0]}>"
     linecache.cache[fname] = (len(src), None, src.splitlines(True), fname)
     ns, ieee = exec_twins(compile(src, fname, "exec"))
     ns.update(_make_ieee=ieee["make"], _fixjac_ieee=ieee["fixjac"])
-    return ns["make"], ns["fixjac"]
+    made = ns["make"]
+
+    def make(p, d):
+        return Callbacks(*made(p, d))
+    return make, ns["fixjac"]
 
 
 def exec_twins(code):
@@ -484,3 +520,47 @@ def exec_twins(code):
     exec(code, ns)
     exec(code, ieee)
     return ns, ieee
+
+
+def root_gradients(dae, params, discretes, roots, wrt, dyn):
+    """A function ``(t, y, yp, p, d)`` -> (G_y, G_y', G_t, G_p, G_d), the
+    derivatives of the (resolved) root functions ``roots`` as dense arrays
+    (rows = roots) with respect to the DAE's unknowns and derivatives, time,
+    the parameters ``wrt`` (symbols among ``params``) and the discrete values
+    of indices ``dyn``; generated as the other callbacks, with the same
+    guarded-domain fallback (:data:`_IEEE_ERRORS`)."""
+    n, nr, m = len(dae.y), len(roots), len(wrt)
+    names = Names(dae.y, dae.yp, params, discretes)
+    from ..lang.symbols import time
+    cols = [("Gy", k, s) for k, s in enumerate(dae.y)]
+    cols += [("Gyp", k, s) for k, s in enumerate(dae.yp) if s is not None]
+    exprs, targets = [], []
+    for i, g in enumerate(roots):
+        fs = g.free_symbols
+        for arr, k, s in cols + [("Gp", j, x) for j, x in enumerate(wrt)] + \
+                [("Gd", q, discretes[x]) for q, x in enumerate(dyn)]:
+            if s in fs:
+                exprs.append(diff(g, s))
+                targets.append(f"{arr}[{i}, {k}]")
+        if time in fs:
+            exprs.append(diff(g, time))
+            targets.append(f"Gt[{i}]")
+    L = ["def rootgrad(t, y, yp, p, d, Gy, Gyp, Gt, Gp, Gd):"]
+    L += _unpack("y", n, "y", "    ", False) + _unpack("yp", n, "yp", "    ", False)
+    L += _unpack("p", len(params), "p", "    ", False)
+    L += _unpack("d", len(discretes), "d", "    ", False)
+    L += _body(exprs, targets, "    ", symbols=names.code) + ["    pass"]
+    ns, ieee = exec_twins(compile("\n".join(L) + "\n", "<acausal-root-gradients>", "exec"))
+    fill, fill_ieee = ns["rootgrad"], ieee["rootgrad"]
+
+    def rootgrad(t, y, yp, p, d):
+        G = (np.zeros((nr, n)), np.zeros((nr, n)), np.zeros(nr), np.zeros((nr, m)),
+             np.zeros((nr, len(dyn))))
+        try:
+            fill(t, list(map(float, y)), list(map(float, yp)), list(map(float, p)),
+                 list(map(float, d)), *G)
+        except _IEEE_ERRORS:      # a guarded domain: as the callbacks
+            with np.errstate(all="ignore"):
+                fill_ieee(t, *(np.asarray(a, dtype=float) for a in (y, yp, p, d)), *G)
+        return G
+    return rootgrad

@@ -1,16 +1,17 @@
 """Stage 5b: generate C for the residual, its iteration matrix and the root
-functions, from the same reduced DAE as :mod:`acausal.codegen` (Python).
+functions, from the same reduced DAE as :mod:`acausal.compiler.codegen` (Python).
 
-The compiled backend (:mod:`acausal.backends.compiled`) links it with a
+The compiled backend (:mod:`acausal.runtime.backends.compiled`) links it with a
 small driver around SUNDIALS IDA, so that IDA calls it with no Python in
 between. Parameters and discrete values are one input array ``pd``
 (parameters first), so that one compiled library serves every mode and
 every parameter set. Sub-expressions are shared by hash-consing, as in the
-Python code (:func:`acausal.codegen._repeated`: every sub-expression met
-twice gets a name; linear work, where ``sympy.cse`` took most of the time on
-a model with its sensitivity equations), and the iteration matrix's entries
-are the Python code's (:func:`acausal.codegen._jacobian_entries`); sympy's
-C99 printer writes the expressions (Piecewise as ``?:``).
+Python code (:func:`acausal.compiler.codegen.repeated_subexpressions`:
+every sub-expression met twice gets a name; linear work, where
+``sympy.cse`` took most of the time on a model with its sensitivity
+equations), and the iteration matrix's entries are the Python code's
+(:func:`acausal.compiler.codegen.jacobian_entries`); sympy's C99 printer
+writes the expressions (Piecewise as ``?:``).
 """
 from dataclasses import dataclass
 
@@ -18,13 +19,13 @@ import sympy as sp
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.codeprinter import PrintMethodNotImplementedError
 
-from .codegen import (NamedTemps, Names, _fixed_entries, _jacobian_entries, _repeated,
-                      replace_shared)
+from .codegen import (NamedTemps, Names, fixed_entries, jacobian_entries,
+                      repeated_subexpressions, replace_shared)
 
 
 class _Printer(NamedTemps, C99CodePrinter):
     """C of sympy expressions, common sub-expressions by name
-    (:class:`~acausal.codegen.NamedTemps`). The printer is strict: a
+    (:class:`~acausal.compiler.codegen.NamedTemps`). The printer is strict: a
     function with no C form raises ``PrintMethodNotImplementedError``."""
 
     def __init__(self, temps=None):
@@ -53,7 +54,7 @@ def _decls(n, has_yp):
 def _body(exprs, targets):
     if not exprs:
         return []
-    repeated = _repeated(exprs)
+    repeated = repeated_subexpressions(exprs)
     names = {e: f"c_{k}" for k, e in enumerate(repeated)}
     printer = _Printer(names)
     lines = [f"  const double {names[e]} = {printer.definition(e)};" for e in repeated]
@@ -76,10 +77,10 @@ def _jacs_entries(res, ysyms, ypsyms, n, columns=None):
     """(expressions, targets) of ``dF/dy`` and ``dF/dy'`` as two row-major
     ``n`` x ``n`` arrays (what the Python ``jacs`` callback fills): the
     initialisation and the re-initialisation at events need them apart.
-    The entries are the iteration matrix's (:func:`~acausal.codegen._jacobian_entries`,
+    The entries are the iteration matrix's (:func:`~acausal.compiler.codegen.jacobian_entries`,
     cached: no second differentiation)."""
     exprs, targets = [], []
-    for i, j, dy, dyp in _jacobian_entries(res, ysyms, ypsyms, columns):
+    for i, j, dy, dyp in jacobian_entries(res, ysyms, ypsyms, columns):
         if dy != 0:
             exprs.append(dy)
             targets.append(f"Jy[{i * n + j}]")
@@ -116,7 +117,7 @@ def _fixjac(cm, observed, ysyms, ypsyms):
     of the states), every entry written."""
     ns, n = cm.dae.n_states, len(ysyms)
     rows = [k for k, nm in enumerate(cm.var_names) if cm.flat.variables[nm].start.fixed]
-    entries = _fixed_entries(dict((k, observed[k]) for k in rows), rows, ysyms, ypsyms, ns)
+    entries = fixed_entries(dict((k, observed[k]) for k in rows), rows, ysyms, ypsyms, ns)
     width = n + ns
     return [f"  memset(F, 0, sizeof(double) * {max(len(rows), 1) * width});"] + \
         _body([e for _, _, e in entries], [f"F[{a * width + col}]" for a, col, _ in entries])
@@ -150,7 +151,7 @@ def generate_c(cm):
     cj = sp.Symbol("cj", real=True)
     jac, targets = [], []
     columns = dae.jacobian_columns
-    for i, j, dy, dyp in _jacobian_entries(res, ysyms, ypsyms, columns):
+    for i, j, dy, dyp in jacobian_entries(res, ysyms, ypsyms, columns):
         jac.append(dy + cj * dyp)
         targets.append(f"J[{j * n + i}]")
     decl = _decls(n, has_yp) + _pd_decls(len(cm.param_syms), len(cm.disc_syms))

@@ -19,6 +19,7 @@ import multiprocessing as mp
 import os
 
 from ..errors import AcausalError, UsageError
+from .result import Result, Rows
 
 _JOBS = {}              # token -> (compiled model, reduce, simulate keywords)
 _token = itertools.count()
@@ -43,7 +44,7 @@ def default_workers():
 
 def _payload(res):
     """What a worker sends back for a full result (no compiled model)."""
-    return dict(p=res.p, t=res.t, y=res.y, yp=res.yp, d=res.d, events=res.events,
+    return dict(p=res.p, rows=Rows(res.t, res.y, res.yp, res.d), events=res.events,
                 stats=res.stats, status=res.status, message=res.message)
 
 
@@ -69,12 +70,12 @@ def simulate_batch(cm, param_sets, *, workers=None, chunksize=None, reduce=None,
                    errors="raise", **simulate_kw):
     """Simulate ``cm`` once per parameter set (a dict of overrides, as
     ``simulate(params=...)``); returns a list in the order of
-    ``param_sets``: :class:`acausal.result.Result` objects, or
+    ``param_sets``: :class:`acausal.runtime.result.Result` objects, or
     ``reduce(result)`` computed in the worker (cheaper to send back: a few
     measures instead of trajectories). ``workers``: processes (default: the
     CPUs this process may use); ``chunksize``: parameter sets per task
     (default: about four tasks per worker). Other keywords go to
-    :meth:`CompiledModel.simulate`."""
+    :meth:`acausal.runtime.model.CompiledModel.simulate`."""
     if errors not in ("raise", "return"):
         raise UsageError(f"errors must be 'raise' or 'return', got {errors!r}")
     sets = [dict(p or {}) for p in param_sets]
@@ -99,7 +100,6 @@ def simulate_batch(cm, param_sets, *, workers=None, chunksize=None, reduce=None,
 
 
 def _assemble(cm, sets, raw, reduce, errors):
-    from .result import Result
     out = [None] * len(sets)
     first = None
     for status, index, value in sorted(raw, key=lambda r: r[1]):

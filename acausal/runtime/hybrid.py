@@ -4,22 +4,30 @@ IDA integrates until a root function crosses zero. Then the owning
 component's event action changes discrete values (a contact mode, a stick/
 slip mode), the algebraic unknowns and derivatives are recomputed
 consistently, events flagged ``recheck`` are iterated to a fixed point, and
-integration restarts. Output: requested times, plus both sides of every
-event. A burst of events in a tiny window stops the run with a
-:class:`ChatteringError` naming the component.
+integration restarts (the hybrid DAE scheme of Barton and Pantelides 1994,
+"Modeling of combined discrete/continuous processes", AIChE J. 40). Output:
+requested times, plus both sides of every event. A burst of events in a tiny
+window stops the run with a :class:`ChatteringError` naming the component.
+
+What a run does besides (the forward sensitivities) is a
+:class:`~acausal.runtime.observer.RunObserver` whose hooks the loop calls at
+fixed points (:mod:`.observer`); the loop itself has no branch for it.
 """
 import os
 import sys
 import time as _time
 from collections import Counter, deque
+from dataclasses import dataclass, fields
+from typing import NamedTuple
 
 import numpy as np
 
 from .backends import BACKENDS, BackendError, make_solver
-from ..errors import ChatteringError, LimitError, SolverError, UsageError
+from ..errors import ChatteringError, LimitError, ModelError, SolverError, UsageError
 from .events import EventState
-from .initialize import ask_components, initial_point, reinitialize, suspect_parameters
-from .result import Result
+from .initialize import ask_components, initial_point, suspect_parameters
+from .observer import Point, RunObserver
+from .result import Rows
 
 CHATTER_COUNT = 100     # this many firings of one event (root) ...
 CHATTER_SPAN = 1e-9     # ... within this fraction of the time span is chattering
@@ -28,6 +36,34 @@ DEFAULT_BACKEND = "sundae"
 MAX_ROWS = 1_000_000    # stored output rows, by default (each 8 bytes per unknown, twice)
 WINDOW_S = 0.25         # wall time per integration window when watched [s]
 PROGRESS_DELAY_S = 2.0  # a progress bar shows once a run has lasted this long [s]
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """The settings of one run: the keywords of :func:`simulate` besides
+    ``t_end``, ``t0``, ``params`` and ``sensitivities`` (see there)."""
+    rtol: float = 1e-6
+    atol: object = 1e-8
+    output_step: object = None
+    output_times: object = None
+    max_step: object = None
+    max_steps: int = 100000
+    atol_algebraic: object = None
+    backend: object = None
+    max_rows: object = MAX_ROWS
+    max_wall: object = None
+    max_total_steps: object = None
+    progress: bool = False
+    linsolver: str = "auto"
+
+    @classmethod
+    def of(cls, options):
+        """The settings of ``simulate``'s keywords ``options``."""
+        known = {f.name for f in fields(cls)}
+        for name in options:
+            if name not in known:
+                raise TypeError(f"simulate() got an unexpected keyword argument {name!r}")
+        return cls(**options)
 
 
 def _output_times(t0, t_end, output_step, output_times):
@@ -59,18 +95,18 @@ def _atol(cm, atol):
             continue
         hits = [i for i, names in enumerate(slots) if name in names]
         if not hits:
-            from ..errors import ModelError
             raise ModelError(f"atol: {name!r} is not (up to sign) one of the solver's "
                              "unknowns: " + ", ".join(n[0] for n in slots))
         out[hits[0]] = float(value)
     return out
 
 
-def _atol_vector(cm, atol, atol_algebraic):
-    """``atol`` (see :func:`_atol`), with ``atol_algebraic`` on the algebraic
-    unknowns (those after the states) when given: their magnitudes (forces,
-    accelerations) can be far from the states' and the local error test on
-    them can make IDA fail to make progress."""
+def atol_vector(cm, atol, atol_algebraic):
+    """The absolute tolerances of a run of ``cm``: ``atol`` (a scalar, or a
+    dict by variable name with ``"*"`` the default), with ``atol_algebraic``
+    on the algebraic unknowns (those after the states) when given: their
+    magnitudes (forces, accelerations) can be far from the states' and the
+    local error test on them can make IDA fail to make progress."""
     atol = _atol(cm, atol)
     if atol_algebraic is None:
         return atol
@@ -82,19 +118,20 @@ def _atol_vector(cm, atol, atol_algebraic):
 
 
 class _Run:
-    def __init__(self, cm, p, t0, t_end, rtol, atol, max_step, max_steps, backend="sundae",
-                 linsolver="auto"):
+    """One run: the model the solver integrates (``cm``), the parameters,
+    the solver options, the stored rows and events, and the observer."""
+
+    def __init__(self, cm, p, span, opts, backend="sundae", observer=None):
         self.cm, self.p = cm, np.asarray(p, float)
         self.backend = backend
-        self.t0, self.t_end = t0, t_end
-        self.opts = dict(rtol=rtol, atol=atol, max_step=max_step or 0.0,
-                         max_num_steps=max_steps, linsolver=linsolver)
-        self.T, self.Y, self.YP, self.D, self.SD = [], [], [], [], []
+        self.t0, self.t_end = span
+        self.opts = opts    # rtol, atol, max_step, max_num_steps, linsolver (the backend's)
+        self.observer = observer or RunObserver()
+        self.T, self.Y, self.YP, self.D = [], [], [], []
         self.events, self.event_log = [], []
         self.firings = {}    # (owner, event name) -> times of its last CHATTER_COUNT firings
         self.nfev = self.njev = self.steps = self.rows = 0
-        self.sens = None   # acausal.sensitivity.SensRun when sensitivities are asked for
-        self._cbs, self._served = {}, {}
+        self._served = {}
 
     def record(self, t, y, yp, d):
         self.T.append(np.atleast_1d(np.asarray(t, float)))
@@ -103,26 +140,18 @@ class _Run:
         D = np.empty((len(self.T[-1]), len(d)))
         D[:] = d
         self.D.append(D)
-        if self.sens is not None:
-            self.SD.append(np.tile(self.sens.sd_all.ravel(), (len(self.T[-1]), 1)))
+        self.observer.on_rows(self, len(self.T[-1]))
         self.rows += len(self.T[-1])
 
     def callbacks(self, d):
-        """Mode ``d``'s generated callbacks, as the backend serves them to
-        the loop (the compiled backend's call C: :meth:`SegmentSolver.callbacks`),
-        made once per mode of the run (contacts switch back and forth)."""
-        if self.sens is not None:   # the sensitivities of discrete values change at each event
-            return self.serve(self.cm, d)
-        key = tuple(map(float, d))
-        cb = self._cbs.get(key)
-        if cb is None:
-            cb = self._cbs[key] = self.solver().serve(self.cm, self.p, list(key))
-        return cb
+        """Mode ``d``'s callbacks of the integrated model (:meth:`serve`)."""
+        return self.serve(self.cm, d)
 
     def serve(self, model, d):
         """``model``'s callbacks in mode ``d`` as this run's backend serves
-        them (a sensitivity run's augmented model and its base model), made
-        once per model and mode of the run."""
+        them (the compiled backend's call C: :meth:`SegmentSolver.serve`),
+        made once per model and mode of the run (contacts switch back and
+        forth; a sensitivity run serves its augmented model and the base model)."""
         key = (id(model),) + tuple(map(float, d))
         cb = self._served.get(key)
         if cb is None:
@@ -130,7 +159,7 @@ class _Run:
         return cb
 
     def solver(self):
-        """The segment solver of this run (:mod:`acausal.backends`), made once."""
+        """The segment solver of this run (:mod:`acausal.runtime.backends`), made once."""
         if getattr(self, "_solver", None) is None:
             self._solver = make_solver(self.backend, self.cm, self.p, self.opts)
             self.backend = self._solver.name
@@ -145,45 +174,55 @@ class _Run:
         if solver is not None and solver.fallback:
             stats["backend_fallback"] = solver.fallback
         n = len(self.cm.dae.y)
-        cat = (lambda blocks, w: np.concatenate(blocks) if blocks else np.zeros((0, w)))
-        T, Y, YP = cat(self.T, 0) if self.T else np.zeros(0), cat(self.Y, n), cat(self.YP, n)
-        D = cat(self.D, len(self.cm.disc_syms))
-        if self.sens is None:
-            return Result(self.cm, self.p, T, Y, YP, D, list(self.events), stats, status,
-                          message)
-        sm = self.cm   # the augmented model (acausal.sensitivity)
-        res = Result(sm.base, self.p, T, sm.unpack(Y)[0], sm.unpack(YP)[0],
-                     D[:, :len(sm.base.disc_syms)], list(self.events), stats, status, message)
-        SD = cat(self.SD, self.sens.sd_all.size)
-        res.sensitivities = self.sens.result_data(T, Y, YP, D, SD, len(self.events))
-        return res
+        T = concat(self.T, 0) if self.T else np.zeros(0)
+        rows = Rows(T, concat(self.Y, n), concat(self.YP, n),
+                    concat(self.D, len(self.cm.disc_syms)))
+        return self.observer.finish(self, rows, stats, status, message)
 
 
-def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_step=None,
-             output_times=None, max_step=None, max_steps=100000, atol_algebraic=None,
-             backend=None, max_rows=MAX_ROWS, max_wall=None, max_total_steps=None,
-             progress=False, linsolver="auto", sensitivities=None):
-    """Simulate a :class:`CompiledModel` from ``t0`` to ``t_end`` (or until a
-    terminal event). ``params`` overrides parameter values, and the start
-    values of variables whose start is fixed, by dotted path (both are
-    runtime values: nothing is recompiled).
+def concat(blocks, width):
+    """The row blocks ``blocks`` as one array (``width`` columns when none)."""
+    return np.concatenate(blocks) if blocks else np.zeros((0, width))
 
-    ``atol`` applies to every unknown unless ``atol_algebraic`` is given: then
-    the algebraic unknowns (forces, torques, dummy derivatives, constrained
-    positions; everything but the selected states) get that absolute
-    tolerance instead. IDA puts them into its local error test (and Newton
-    convergence test); one that is computed as the small difference of large
-    terms (a cam force balancing a kilonewton preload) and crosses zero can
-    then fail the test with a tight SI ``atol`` at every step there, so that
-    the step size collapses. A large value (e.g. 1e-2) practically leaves
-    them out of the error test (like IDA's ``suppressalg``, which
-    scikit-sundae does not expose); their accuracy then follows from the
-    states'. Default ``None``: ``atol`` for all, as before.
 
-    ``backend`` chooses the integrator (:mod:`acausal.backends`): ``"sundae"``
-    (the reference) or ``"compiled"`` (IDA calling generated C); ``None`` takes
-    the environment variable ``ACAUSAL_BACKEND``, else :data:`DEFAULT_BACKEND`.
-    ``res.stats["backend"]`` says which one ran.
+class _Start(NamedTuple):
+    """The consistent start of a run, after the event iteration at ``t0``."""
+    y: np.ndarray
+    yp: np.ndarray
+    d: list
+    cb: object
+    stop: bool      # a terminal event fired
+
+
+def simulate(cm, t_end=1.0, t0=0.0, params=None, sensitivities=None, **options):
+    """Simulate a :class:`~acausal.runtime.model.CompiledModel` from ``t0``
+    to ``t_end`` (or until a terminal event). ``params`` overrides
+    parameter values, and the start values of variables whose start is
+    fixed, by dotted path (both are runtime values: nothing is recompiled).
+    The other keywords (:class:`RunOptions`):
+
+    ``rtol`` (1e-6), ``atol`` (1e-8; a scalar, or a dict by variable name,
+    ``"*"`` the default) and ``atol_algebraic``: ``atol`` applies to every
+    unknown unless ``atol_algebraic`` is given: then the algebraic unknowns
+    (forces, torques, dummy derivatives, constrained positions; everything
+    but the selected states) get that absolute tolerance instead. IDA puts
+    them into its local error test (and Newton convergence test); one that
+    is computed as the small difference of large terms (a cam force
+    balancing a kilonewton preload) and crosses zero can then fail the test
+    with a tight SI ``atol`` at every step there, so that the step size
+    collapses. A large value (e.g. 1e-2) practically leaves them out of the
+    error test (like IDA's ``suppressalg``, which scikit-sundae does not
+    expose); their accuracy then follows from the states'. Default
+    ``None``: ``atol`` for all, as before.
+
+    ``output_step`` (default: 500 intervals; 0: every internal step of the
+    solver) or ``output_times``; ``max_step``; ``max_steps`` (100000: IDA's
+    limit between two outputs).
+
+    ``backend`` chooses the integrator (:mod:`acausal.runtime.backends`):
+    ``"sundae"`` (the reference) or ``"compiled"`` (IDA calling generated
+    C); ``None`` takes the environment variable ``ACAUSAL_BACKEND``, else
+    :data:`DEFAULT_BACKEND`. ``res.stats["backend"]`` says which one ran.
 
     Limits (each stops the run with a :class:`~acausal.errors.LimitError`
     that keeps the partial result and names the component whose events
@@ -197,25 +236,26 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
     :class:`_Watch`).
 
     ``linsolver``: IDA's linear solver, see
-    :meth:`acausal.compile.CompiledModel.linear_solver` (``"auto"`` chooses
-    band for large models with a narrow band, else dense).
+    :meth:`acausal.runtime.model.CompiledModel.linear_solver` (``"auto"``
+    chooses band for large models with a narrow band, else dense).
 
     ``sensitivities``: names of free parameters; the run then also integrates
     the forward sensitivities of every unknown with respect to them, with
-    their jumps at events (:mod:`acausal.sensitivity`), on either backend:
-    ``res.sensitivity("body.x", "spring.c")`` is d(body.x)/d(spring.c) at
-    every ``res.t``, ``res.event_sensitivity("spring.c")`` the derivatives of
-    the event times."""
+    their jumps at events (:mod:`acausal.runtime.sensitivity`), on either
+    backend: ``res.sensitivity("body.x", "spring.c")`` is
+    d(body.x)/d(spring.c) at every ``res.t``,
+    ``res.event_sensitivity("spring.c")`` the derivatives of the event times."""
     wall0 = _time.perf_counter()
-    run, y, yp, d, cb, stop = _start(cm, t0, t_end, params, rtol, atol, atol_algebraic,
-                                     max_step, max_steps, _backend(backend), linsolver,
-                                     sensitivities)
-    _check_output_size(cm, t0, t_end, output_step, output_times, max_rows)
-    tout = _output_times(t0, t_end, output_step, output_times)
-    run.record(t0, y, yp, d)
-    watch = _Watch(run, wall0, max_rows, max_wall, max_total_steps, progress)
+    settings = RunOptions.of(options)
+    backend = _backend(settings.backend)
+    run, start = _start(cm, (t0, t_end), params, settings, backend, sensitivities)
+    _check_output_size(cm, t0, t_end, settings.output_step, settings.output_times,
+                       settings.max_rows)
+    tout = _output_times(t0, t_end, settings.output_step, settings.output_times)
+    run.record(t0, start.y, start.yp, start.d)
+    watch = _Watch(run, wall0, settings)
     try:
-        _integrate(run, watch, cb, t0, y, yp, d, stop, tout, output_step)
+        _integrate(run, watch, start, tout, settings.output_step == 0)
     except SolverError as exc:
         exc.result = exc.result or run.result("failed", str(exc))
         exc.result.stats["wall_s"] = _time.perf_counter() - wall0
@@ -228,40 +268,45 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
     return res
 
 
-def _start(cm, t0, t_end, params, rtol, atol, atol_algebraic, max_step, max_steps, backend,
-           linsolver, sensitivities):
-    """The run and its consistent start: (run, y, y', d, callbacks, stop),
-    after the event iteration at ``t0`` (``stop``: a terminal event fired)."""
+def _observer(cm, sensitivities):
+    """The run's observer: the plain run, or the forward sensitivities with
+    respect to the parameters ``sensitivities``."""
+    if not sensitivities:
+        return RunObserver()
+    from .sensitivity import sensitivity_model
+    from .sensitivity_run import SensitivityObserver
+    return SensitivityObserver(sensitivity_model(cm, sensitivities))
+
+
+def _start(cm, span, params, settings, backend, sensitivities):
+    """The run and its consistent start (:class:`_Start`), after the event
+    iteration at ``t0``."""
     params, starts = cm.split_overrides(params)
     p = cm.param_vector(params)
     d = cm.discrete_start()
-    atol = _atol_vector(cm, atol, atol_algebraic)
-    model = cm
-    if sensitivities:
-        from .sensitivity import SensRun, sensitivity_model
-        model = sensitivity_model(cm, sensitivities)
-        atol = model.atol(atol, p)
-    run = _Run(model, p, t0, t_end, rtol, atol, max_step, max_steps, backend, linsolver)
-    cb = run.serve(cm, d) if sensitivities else run.callbacks(d)
+    atol = atol_vector(cm, settings.atol, settings.atol_algebraic)
+    observer = _observer(cm, sensitivities)
+    model, atol = observer.system(cm, atol, p)
+    opts = dict(rtol=settings.rtol, atol=atol, max_step=settings.max_step or 0.0,
+                max_num_steps=settings.max_steps, linsolver=settings.linsolver)
+    run = _Run(model, p, span, opts, backend, observer)
+    cb = run.serve(cm, d)
+    y, yp = initial_point(cm, p, d, cb, span[0], starts)
+    y, yp, d, cb = observer.on_start(run, Point(span[0], y, yp), d, cb, starts)
     run.cb_d = list(d)
-    y, yp = initial_point(cm, p, d, cb, t0, starts)
-    if sensitivities:
-        run.sens = SensRun(model, p, t_end - t0, run.serve)
-        y, yp, d, cb = run.sens.start(p, d, t0, y, yp, starts)
-        run.cb_d = list(d)
-    y, yp, d, cb, stop = _event_iteration(run, cb, t0, y, yp, d, initial=True)
-    return run, y, yp, d, cb, stop
+    return run, _Start(*_event_iteration(run, cb, span[0], y, yp, d))
 
 
-def _integrate(run, watch, cb, t, y, yp, d, stop, tout, output_step):
+def _integrate(run, watch, start, tout, every_step):
     """The hybrid loop: segments between events (each ends at a terminal
     root, the end or a window of the watch), observer roots, event actions
     with re-initialisation and event iteration; output is recorded in ``run``."""
-    t_end = run.t_end
+    y, yp, d, cb, stop = start
+    t, t_end = run.t0, run.t_end
     while not stop and t < t_end:
         tspan = _tspan(t, tout, t_end, watch.horizon(t))
         seg = watch.solve(run.solver(), watch.wrap(cb, tspan), d, tspan, y, yp,
-                          every_step=output_step == 0)
+                          every_step=every_step)
         run.nfev += seg.nfev
         run.njev += seg.njev
         run.steps += seg.steps
@@ -281,10 +326,9 @@ def _integrate(run, watch, cb, t, y, yp, d, stop, tout, output_step):
                 continue
             break
         d_before = list(d)
-        y, yp, d, cb, stop = _handle(run, cb, t, y, yp, d, fired)
+        y, yp, d, cb, stop = _handle(run, cb, Point(t, y, yp), d, fired)
         if list(d) != d_before:
             run.record(t, y, yp, d)
-
 
 
 # ---------------------------------------------------------------------------
@@ -346,13 +390,14 @@ class _Watch:
     every step past ``max_rows``) is stopped; the rows of that call are lost,
     the earlier ones kept."""
 
-    def __init__(self, run, wall0, max_rows, max_wall, max_total_steps, progress):
+    def __init__(self, run, wall0, settings):
         self.run, self.wall0 = run, wall0
-        self.max_rows, self.max_wall, self.max_steps = max_rows, max_wall, max_total_steps
-        self.windowed = max_wall is not None or max_total_steps is not None
+        self.max_rows, self.max_wall = settings.max_rows, settings.max_wall
+        self.max_steps = settings.max_total_steps
+        self.windowed = self.max_wall is not None or self.max_steps is not None
         self.span = run.t_end - run.t0
         self.dt = self.span * 1e-4   # grows by up to 8x a window
-        self.bar = _progress_bar(self.span) if progress else None
+        self.bar = _progress_bar(self.span) if settings.progress else None
         self.t_call = None
         self.counter = None
         self.every_step = False
@@ -365,7 +410,7 @@ class _Watch:
         progress bar every 64 calls (when limits are set, a bar is shown or
         the call stores every step, as a two-point ``tspan`` does; else
         ``cb`` itself)."""
-        res, count, calls = cb[0], cb[5], [0]
+        res, count, calls = cb.res, cb.count, [0]
         self.counter = count
         if not self.windowed and self.bar is None and len(tspan) != 2:
             return cb
@@ -376,7 +421,7 @@ class _Watch:
                 self._hard(count[0])
                 self._show(t)
             res(t, y, yp, r)
-        return (checked,) + tuple(cb[1:])
+        return cb._replace(res=checked)
 
     def _show(self, t):
         if self.bar is not None and t - self.run.t0 > self.bar.n:
@@ -394,7 +439,7 @@ class _Watch:
             raise _HardStop("rows")  # every step is stored (a two-point span)
 
     def solve(self, solver, cb, d, tspan, y, yp, every_step):
-        """One segment of ``solver`` (:mod:`acausal.backends`) over ``tspan``;
+        """One segment of ``solver`` (:mod:`acausal.runtime.backends`) over ``tspan``;
         a limit far exceeded inside it (seen by the wrapped residual of a
         Python backend) stops the run."""
         self.t_call = _time.perf_counter()
@@ -471,16 +516,6 @@ def _dominant(run, last=1000):
             f"({', '.join(nm for nm, _ in names)})")
 
 
-def _reset_event_log(roots):
-    """scikit-sundae keeps the located roots (and per-event counts that decide
-    when to stop) on the events function; one IDA object serves every
-    segment of a run, so clear them before each segment."""
-    if roots is not None and hasattr(roots, "_i"):
-        for name in ("_i", "_t", "_y", "_yp"):
-            getattr(roots, name).clear()
-        roots._i_cnt[:] = 0
-
-
 def _backend(name):
     """The backend to run: ``name``, else the ``ACAUSAL_BACKEND`` environment
     variable, else :data:`DEFAULT_BACKEND`."""
@@ -488,6 +523,11 @@ def _backend(name):
     if name not in BACKENDS:
         raise BackendError(f"unknown backend {name!r}; choose one of: {', '.join(BACKENDS)}")
     return name
+
+
+# ---------------------------------------------------------------------------
+# Events: observer roots, the events that end a segment, the event iteration
+# ---------------------------------------------------------------------------
 
 
 def _observers(run, cb, seg, d):
@@ -507,11 +547,12 @@ def _observers(run, cb, seg, d):
         if not obs:
             continue
         te = root.t
-        state = EventState(cm, run.p, d, te, cb[4](te, root.y, root.yp))
+        point = Point(te, root.y, root.yp)
+        state = EventState(cm, run.p, d, te, cb.observe(te, root.y, root.yp))
         before = list(d)
-        taus = run.sens.event_times(te, root.y, root.yp, d, obs) if run.sens else None
+        run.observer.on_event(run, point, d, obs, "observer")
         for i in obs:
-            _log_event(run, te, cm.events[i], taus[i] if taus is not None else None)
+            _log_event(run, te, cm.events[i], i)
             cm.events[i].action(state)
         for j, (a, b) in enumerate(zip(before, d)):
             if a != b:
@@ -522,54 +563,45 @@ def _observers(run, cb, seg, d):
                         "make it a regular event", t=te, component=cm.events[obs[0]].owner)
                 rows = run.T[-1] >= te
                 run.D[-1][rows, j] = b
-        if run.sens is not None:
-            run.sens.observer_actions([cm.events[i] for i in obs], te, root.y, root.yp, before,
-                                      state._obs, taus)
-            run.SD[-1][run.T[-1] >= te] = run.sens.sd_all.ravel()
+        run.observer.on_actions(run, [cm.events[i] for i in obs], point, before,
+                                state.observed)
     return d, final
 
 
-def _handle(run, cb, t, y, yp, d, fired):
+def _handle(run, cb, point, d, fired):
+    """The events ``fired`` that ended a segment at ``point``: their actions,
+    the new mode re-initialised and the event iteration; returns (y, y', d,
+    callbacks, stop)."""
     cm = run.cm
     n_ev = len(cm.events)
+    t, y, yp = point
     d = list(d)
     d_before = list(d)
-    obs = cb[4](t, y, yp)
+    obs = cb.observe(t, y, yp)
     state = EventState(cm, run.p, d, t, obs)
     stop = False
-    taus = run.sens.event_times(t, y, yp, d, fired, current=True) if run.sens else None
+    run.observer.on_event(run, point, d, fired, "instant")
     for i in fired:
         if i >= n_ev:
             a = cm.assertions[i - n_ev]
             raise SolverError(f"{a.owner}: {a.message} (at t = {t:.6g} s)", t=t,
                               component=a.owner, result=run.result("failed", a.message))
         ev = cm.events[i]
-        _log_event(run, t, ev, taus[i] if taus is not None else None)
+        _log_event(run, t, ev, i)
         if ev.action is not None:
             ev.action(state)
         if ev.terminal:
             stop = True
     if state.changed:
-        d, cb, y, yp = _new_mode(run, [cm.events[i] for i in fired], t, y, yp, d_before, d,
-                                 obs)
+        d, cb, y, yp = run.observer.on_mode_change(run, [cm.events[i] for i in fired], point,
+                                                   d_before, d, obs)
         y, yp, d, cb, stop2 = _event_iteration(run, cb, t, y, yp, d)
         stop = stop or stop2
-    if run.sens is not None:
-        run.sens.dtau[:] = 0.0   # the instant is over
+    run.observer.on_instant_end(run)
     return y, yp, d, cb, stop
 
 
-def _new_mode(run, events, t, y, yp, d_before, d, obs):
-    """(d, callbacks, y, y') of the mode ``d`` that ``events`` set, re-initialised
-    at ``t``; with sensitivities, their jumps (:meth:`acausal.sensitivity.SensRun.mode_change`)."""
-    if run.sens is not None:
-        return run.sens.mode_change(events, t, y, yp, d_before, d, obs)
-    cb = run.callbacks(d)
-    y, yp = reinitialize(run.cm, cb, t, y, yp)
-    return d, cb, y, yp
-
-
-def _event_iteration(run, cb, t, y, yp, d, initial=False):
+def _event_iteration(run, cb, t, y, yp, d):
     """Fire ``recheck`` events whose condition is violated at this instant."""
     cm = run.cm
     checks = [i for i, e in enumerate(cm.events) if e.recheck]
@@ -577,36 +609,39 @@ def _event_iteration(run, cb, t, y, yp, d, initial=False):
         return y, yp, d, cb, False
     g = np.zeros(cm.n_roots)
     for _ in range(MAX_ITER):
-        cb[2](t, y, yp, g)
-        obs = cb[4](t, y, yp)
+        cb.roots(t, y, yp, g)
+        obs = cb.observe(t, y, yp)
         state = EventState(cm, run.p, list(d), t, obs)
+        violated = [i for i in checks if (cm.events[i].direction < 0 and g[i] < 0)
+                    or (cm.events[i].direction > 0 and g[i] > 0)]
+        if violated:
+            run.observer.on_event(run, Point(t, y, yp), d, violated, "recheck")
         fired = []
-        for i in checks:
+        for i in violated:
             ev = cm.events[i]
-            if (ev.direction < 0 and g[i] < 0) or (ev.direction > 0 and g[i] > 0):
-                _log_event(run, t, ev, run.sens.dtau if run.sens is not None else None)
-                fired.append(ev)
-                if ev.action is not None:
-                    ev.action(state)
+            _log_event(run, t, ev, i)
+            fired.append(ev)
+            if ev.action is not None:
+                ev.action(state)
         if not state.changed:
             return y, yp, d, cb, False
-        d, cb, y, yp = _new_mode(run, fired, t, y, yp, d, state.d, obs)
+        d, cb, y, yp = run.observer.on_mode_change(run, fired, Point(t, y, yp), d, state.d,
+                                                   obs)
     raise ChatteringError(f"event iteration did not settle at t = {t:.6g} s "
                           f"({MAX_ITER} mode changes at one instant) in "
                           + ", ".join(sorted({cm.events[i].owner for i in checks})), t=t)
 
 
-def _log_event(run, t, ev, dtau=None):
-    """Record an event in ``res.events`` (with its time's sensitivity
-    ``dtau`` in a sensitivity run), unless it is bookkeeping
-    (``Event(log=False)``); a ChatteringError when this same event (one root of
-    one component) has fired CHATTER_COUNT times within CHATTER_SPAN of the
-    run's span: its mode logic toggles without time advancing (Zeno). Many
-    different roots firing at one instant (199 contacts of a Newton's
-    cradle closing at t = 0) are not chattering: each fires once."""
+def _log_event(run, t, ev, i):
+    """Record event ``ev`` (index ``i``) in ``res.events`` (telling the
+    observer), unless it is bookkeeping (``Event(log=False)``); a
+    ChatteringError when this same event (one root of one component) has
+    fired CHATTER_COUNT times within CHATTER_SPAN of the run's span: its mode
+    logic toggles without time advancing (Zeno). Many different roots firing
+    at one instant (199 contacts of a Newton's cradle closing at t = 0) are
+    not chattering: each fires once."""
     if ev.log:
-        if dtau is not None:
-            run.sens.note(len(run.events), dtau)
+        run.observer.on_log(run, len(run.events), i)
         run.events.append((t, ev.name))
     run.event_log.append((t, ev.owner))
     times = run.firings.get((ev.owner, ev.name))
@@ -630,7 +665,7 @@ def _failure(run, cm, sol, cb):
     res = np.zeros(n)
     comp = None
     try:
-        cb[0](t, np.array(r.y), np.array(r.yp), res)
+        cb.res(t, np.array(r.y), np.array(r.yp), res)
         bad = ~np.isfinite(res)
         k = int(np.argmax(bad)) if bad.any() else int(np.argmax(np.abs(res)))
         org = cm.dae.origins[k]
@@ -665,6 +700,6 @@ def _failure(run, cm, sol, cb):
 
 def _safe_obs(cb, t, r):
     try:
-        return cb[4](t, np.array(r.y), np.array(r.yp))
+        return cb.observe(t, np.array(r.y), np.array(r.yp))
     except Exception:
         return []

@@ -7,28 +7,32 @@ states are added (chosen where they raise the rank of the Jacobian). The
 system is solved by least squares; fixed starts that contradict each other
 or the model raise :class:`InitializationError` naming them — they are never
 silently changed. After an event only the algebraic unknowns and ``y'`` are
-recomputed, the states are kept.
+recomputed, the states are kept (Newton on the DAE with the states fixed,
+the index-1 re-initialisation of Brown, Hindmarsh and Petzold 1998,
+"Consistent initial condition calculation for differential-algebraic
+systems"). The linear algebra is :mod:`.linalg`'s.
 """
 import math
+import weakref
 
 import numpy as np
-import scipy.linalg
 import scipy.sparse as sps
-import scipy.sparse.linalg
 import sympy as sp
 from scipy.optimize import least_squares
-from scipy.sparse.csgraph import structural_rank
 
+from . import linalg
+from .linalg import choose_guesses, event_matrix, jacobians, newton, solve_square
 from ..infra.blas import single_threaded
 from ..compiler.codegen import Triplets
 from ..errors import InitializationError
 
+# generated code of a compiled model (shared by its copies with other
+# parameter defaults) -> {(fixed starts, overridden starts): guess rows that
+# gave a consistent point}: the runtime's memo across the model's runs (see
+# _guesses_and_newton)
+_GUESS_ROWS = weakref.WeakKeyDictionary()
 
-def _jacobians(cb, t, y, yp, n):
-    Jy = np.zeros((n, n))
-    Jyp = np.zeros((n, n))
-    cb[3](t, y, yp, Jy, Jyp)
-    return Jy, Jyp
+
 
 
 def initial_point(cm, p, d, cb, t0, starts=None):
@@ -47,7 +51,7 @@ def initial_point(cm, p, d, cb, t0, starts=None):
 class _InitialSystem:
     """The initial equations at ``t0``: the residuals, one row per fixed
     start value and one per imposed guess, over z = (y, y' of the states);
-    dense, or sparse from :data:`SPARSE_MIN` unknowns."""
+    dense, or sparse from :data:`acausal.runtime.linalg.SPARSE_MIN` unknowns."""
 
     def __init__(self, cm, p, d, cb, t0, starts):
         self.cm, self.p, self.d, self.cb, self.t0 = cm, p, d, cb, t0
@@ -59,7 +63,7 @@ class _InitialSystem:
         # steep law near 0 (regularised friction) can stall it far from them
         _snap_fixed_states(cm, y0, self.fixed)
         self.z0 = np.concatenate([y0, np.zeros(self.ns)])
-        self.sparse = self.n + self.ns >= SPARSE_MIN
+        self.sparse = self.n + self.ns >= linalg.SPARSE_MIN
         self.fixed_jac = cm.fixed_jacobian(sparse=self.sparse)
         self.r = np.zeros(self.n)
 
@@ -71,8 +75,8 @@ class _InitialSystem:
 
     def residual(self, z, guess_rows=()):
         y, yp = self.split(z)
-        self.cb[0](self.t0, y, yp, self.r)
-        o = self.cb[4](self.t0, y, yp)
+        self.cb.res(self.t0, y, yp, self.r)
+        o = self.cb.observe(self.t0, y, yp)
         f = [o[k] - v for k, v, _ in self.fixed]
         gz = [z[k] - self.z0[k] for k in guess_rows]
         return np.concatenate([self.r, f, gz])
@@ -97,7 +101,7 @@ class _InitialSystem:
     def _c_check(self, z):
         """The backend's own consistency test (``cb.init_check``, the compiled
         backend's C: the same test), else NotImplemented."""
-        fast = getattr(self.cb, "init_check", None)
+        fast = self.cb.init_check
         return NotImplemented if fast is None else fast(self.t0, z, self.fixed)
 
 
@@ -135,7 +139,8 @@ def _solve_initial(cm, p, d, cb, t0, starts=None):
 
 def _guesses_and_newton(cm, cb, t0, sys_, starts):
     """(guess_rows, z, consistent(z)): the state guesses to impose
-    (:func:`_choose_guesses`) and Gauss-Newton from them (:func:`_first_newton`).
+    (:func:`~acausal.runtime.linalg.choose_guesses`) and Gauss-Newton from
+    them (:func:`_first_newton`).
 
     Which guesses make the Jacobian full rank is a matter of the model's
     structure, the same at every parameter set in practice, while the rank
@@ -150,42 +155,37 @@ def _guesses_and_newton(cm, cb, t0, sys_, starts):
     long steps (in variables with small Jacobian columns, such as lengths in
     m) can reach another solution."""
     key = (tuple(k for k, _, _ in sys_.fixed), tuple(sorted(starts or ())))
-    memo = cm.__dict__.setdefault("_guess_rows", {})
+    memo = _GUESS_ROWS.setdefault(cm.artefact.code, {})
     kept = memo.get(key)
     if kept is not None:
-        z, checked = _first_newton(cb, t0, sys_.z0, kept, sys_.fixed, sys_.residual,
-                                   sys_.jac, sys_.consistent)
+        z, checked = _first_newton(cb, t0, sys_, kept)
         if checked:
             return kept, z, True
-    rows = _choose_guesses(sys_.jac(sys_.z0), sys_.ns, cm.state_guess_order())
+    rows = choose_guesses(sys_.jac(sys_.z0), sys_.ns, cm.state_guess_order())
     if rows == kept:
         return rows, z, False
-    z, checked = _first_newton(cb, t0, sys_.z0, rows, sys_.fixed, sys_.residual, sys_.jac,
-                               sys_.consistent)
+    z, checked = _first_newton(cb, t0, sys_, rows)
     if checked:
         memo[key] = rows
     return rows, z, checked
 
 
-def _first_newton(cb, t0, z0, guess_rows, fixed, residual, jac, consistent):
-    """(z, consistent(z)) of Gauss-Newton from the guesses: the backend's
+def _first_newton(cb, t0, sys_, guess_rows):
+    """(z, consistent(z)) of Gauss-Newton from the guesses (the initial
+    system ``sys_`` with ``guess_rows`` imposed): the backend's
     own (``cb.init_newton``, the compiled backend's C) where it has one,
-    else :func:`_newton`; also :func:`_newton` when the C point fails the
-    check (its QR declines only below a 1e-10 ratio of R's diagonal, and a
-    nearly rank-deficient system, such as a 1e-12 kg*m^2 hook inertia, is
-    solved better by the SVD of numpy's least squares)."""
-    newton = getattr(cb, "init_newton", None)
-    z = newton(t0, z0, guess_rows, fixed) if newton is not None else NotImplemented
-    if z is not NotImplemented and z is not None and consistent(z):
+    else :func:`~acausal.runtime.linalg.newton`; also that one when the C
+    point fails the check (its QR declines only below a 1e-10 ratio of R's
+    diagonal, and a nearly rank-deficient system, such as a 1e-12 kg*m^2
+    hook inertia, is solved better by the SVD of numpy's least squares)."""
+    fast = cb.init_newton
+    z = fast(t0, sys_.z0, guess_rows, sys_.fixed) if fast is not None else NotImplemented
+    if z is not NotImplemented and z is not None and sys_.consistent(z):
         return z, True
-    z = _newton(lambda zz: residual(zz, guess_rows), lambda zz: jac(zz, guess_rows), z0)
-    return z, z is not None and consistent(z)
+    z = newton(lambda zz: sys_.residual(zz, guess_rows), lambda zz: sys_.jac(zz, guess_rows),
+               sys_.z0)
+    return z, z is not None and sys_.consistent(z)
 
-
-# unknowns (y and the states' y') from which the initialisation assembles
-# sparse Jacobians and solves them by sparse LU: the dense least squares grew
-# as n^3 (0.5 s per Newton step for a 200-mass chain, single-threaded)
-SPARSE_MIN = 200
 
 
 def _initial_jacobian(cb, t, y, yp, ns, F, guess_rows, sparse):
@@ -194,7 +194,7 @@ def _initial_jacobian(cb, t, y, yp, ns, F, guess_rows, sparse):
     n = len(y)
     if sparse:
         Jy, Jyp = Triplets((n, n)), Triplets((n, n))
-        cb[3](t, y, yp, Jy, Jyp)
+        cb.jacs(t, y, yp, Jy, Jyp)
         blocks = [[Jy.tocsr(), Jyp.tocsr()[:, :ns]]]
         if F is not None:
             blocks.append([F[:, :n], F[:, n:]])
@@ -203,7 +203,7 @@ def _initial_jacobian(cb, t, y, yp, ns, F, guess_rows, sparse):
                                shape=(len(guess_rows), n + ns))
             blocks.append([G[:, :n], G[:, n:]])
         return sps.bmat(blocks, format="csr")
-    Jy, Jyp = _jacobians(cb, t, y, yp, n)
+    Jy, Jyp = jacobians(cb, t, y, yp, n)
     rows = [np.hstack([Jy, Jyp[:, :ns]])]
     if F is not None:
         rows.append(np.asarray(F, dtype=float).reshape(-1, n + ns))
@@ -288,7 +288,7 @@ def _violated_assertion(cm, cb, t, y, yp):
         return None
     g = np.zeros(cm.n_roots)
     try:
-        cb[2](t, y, yp, g)
+        cb.roots(t, y, yp, g)
     except (ArithmeticError, ValueError):
         return None
     n_ev = len(cm.events)
@@ -298,95 +298,16 @@ def _violated_assertion(cm, cb, t, y, yp):
     return None
 
 
-def _newton(fun, jac, z, max_iter=50):
-    """Gauss-Newton with step halving from ``z``; the last iterate (the
-    caller checks it) or None when the residual is not finite."""
-    r = fun(z)
-    nr = np.linalg.norm(r)
-    for _ in range(max_iter):
-        if not np.all(np.isfinite(r)):
-            return None
-        dz = _lstsq_scaled(jac(z), -r)
-        step = 1.0
-        for _ in range(30):
-            if np.all(np.abs(step * dz) <= 1e-13 * (1 + np.abs(z))):
-                # a step this short is below the convergence test's own size
-                # (below): z is converged; do not spend up to 30 residuals
-                # halving a step that round-off no longer lets reduce |r|
-                return z
-            z2 = z + step * dz
-            r2 = fun(z2)
-            n2 = np.linalg.norm(r2)
-            if np.isfinite(n2) and n2 <= nr * (1 - 1e-4 * step) or n2 <= 1e-300:
-                break
-            step *= 0.5
-        else:
-            return z          # no more progress (converged to round-off, or stuck)
-        z, r, nr = z2, r2, n2
-        if np.all(np.abs(step * dz) <= 1e-13 * (1 + np.abs(z))) or nr == 0.0:
-            return z
-    return z
 
 
-def _lstsq_scaled(J, b):
-    """Least-squares solution of ``J x = b`` with the columns of ``J``
-    scaled to unit norm first: the unknowns mix positions, velocities,
-    accelerations and forces whose columns can differ by many orders of
-    magnitude (a stiff spring next to a light body), and an unscaled
-    solve would cut the small columns off as rank deficiency."""
-    if sps.issparse(J):
-        return _sparse_lstsq_scaled(J, b)
-    norms = np.linalg.norm(J, axis=0)
-    d = np.where(norms > 0, 1.0 / np.where(norms > 0, norms, 1.0), 1.0)
-    return d * np.linalg.lstsq(J * d, b, rcond=None)[0]
 
 
-def _sparse_scaled(J):
-    """(J with unit-norm columns as CSC, the column scale factors)."""
-    norms = np.sqrt(np.asarray(J.multiply(J).sum(axis=0)).ravel())
-    d = np.where(norms > 0, 1.0 / np.where(norms > 0, norms, 1.0), 1.0)
-    return (J @ sps.diags(d)).tocsc(), d
 
 
-def _sparse_lu(Js):
-    """A sparse LU (SuperLU) of ``Js`` when square, else of the augmented
-    system ``[[I, Js], [Js^T, 0]]``, whose solution is the least-squares
-    one (and which is non-singular exactly when Js has full column rank);
-    None when SuperLU finds it singular."""
-    m, k = Js.shape
-    K = Js if m == k else sps.bmat([[sps.identity(m), Js], [Js.T, None]], format="csc")
-    try:
-        return scipy.sparse.linalg.splu(K.tocsc())
-    except RuntimeError:      # "Factor is exactly singular"
-        return None
 
 
-def _sparse_lstsq_scaled(J, b):
-    """:func:`_lstsq_scaled` of a sparse ``J`` by sparse LU; the dense least
-    squares when the LU finds the system singular or gives no finite
-    solution."""
-    Js, d = _sparse_scaled(J)
-    m, k = Js.shape
-    lu = _sparse_lu(Js)
-    if lu is not None:
-        x = lu.solve(b if m == k else np.concatenate([b, np.zeros(k)]))[-k:]
-        if np.all(np.isfinite(x)):
-            return d * x
-    return d * np.linalg.lstsq(Js.toarray(), b, rcond=None)[0]
 
 
-def _sparse_full_rank(J, tol=1e-12):
-    """True when the sparse ``J`` (more rows than columns, or square) has
-    full column rank: structurally, and by its sparse LU, whose smallest
-    pivot must not fall below ``tol`` times the largest (columns scaled to
-    unit norm first)."""
-    if structural_rank(J) < J.shape[1]:
-        return False
-    lu = _sparse_lu(_sparse_scaled(J)[0])
-    if lu is None:
-        return False
-    piv = np.abs(lu.U.diagonal())
-    return bool(piv.min() > tol * piv.max())
 
 
 def _consistent(cm, full, J, z, fixed, n):
@@ -397,27 +318,6 @@ def _consistent(cm, full, J, z, fixed, n):
         return False
 
 
-def _choose_guesses(J, ns, order):
-    """Indices of state slots whose guess must be imposed so that the
-    Jacobian has full column rank."""
-    if sps.issparse(J):
-        if J.shape[0] >= J.shape[1] and _sparse_full_rank(J):
-            return []
-        J = J.toarray()
-    m = J.shape[1]
-    rank = np.linalg.matrix_rank(J) if J.size else 0
-    chosen = []
-    for k in order:
-        if rank >= m:
-            break
-        row = np.zeros((1, m))
-        row[0, k] = 1.0
-        J2 = np.vstack([J, row])
-        r2 = np.linalg.matrix_rank(J2)
-        if r2 > rank:
-            J, rank = J2, r2
-            chosen.append(k)
-    return chosen
 
 
 def _check(cm, full, J, z, fixed, n):
@@ -482,7 +382,7 @@ def reinitialize(cm, cb, t, y, yp):
     Callbacks that bring their own implementation of this algorithm
     (``cb.reinit``, the compiled backend's C) run it instead; it returns
     None where this one must run (a singular matrix)."""
-    fast = getattr(cb, "reinit", None)
+    fast = cb.reinit
     if fast is not None:
         out = fast(t, y, yp)
         if out is not None:
@@ -501,11 +401,11 @@ def _reinitialize(cm, cb, t, y, yp):
     z = np.concatenate([y[ns:], yp[:ns]])
     converged, last = False, np.inf
     for _ in range(50):
-        cb[0](t, y, yp, r)
+        cb.res(t, y, yp, r)
         if not r.any():
             break                     # exact: a further solve only adds round-off
-        J, _ = _event_matrix(cb, t, y, yp, ns)
-        dz = _solve_square(J, -r)
+        J, _ = event_matrix(cb, t, y, yp, ns)
+        dz = solve_square(J, -r)
         size = float(np.max(np.abs(dz))) if dz.size else 0.0
         if converged and not size < last:
             break                     # refined to the round-off floor
@@ -536,48 +436,18 @@ def _algebraic_rates(cm, cb, t, y, yp):
     if n == ns:
         return yp
     yp = np.array(yp, dtype=float)
-    J, Jy_states = _event_matrix(cb, t, y, yp, ns)
+    J, Jy_states = event_matrix(cb, t, y, yp, ns)
     dt = 1e-6 * max(1.0, abs(t))
     rp, rm = np.zeros(n), np.zeros(n)
-    count = cb[5] if len(cb) > 5 else None
-    saved = list(count) if count is not None else None
-    cb[0](t + dt, y, yp, rp)
-    cb[0](t - dt, y, yp, rm)
-    if count is not None:   # these are not solver step attempts
-        count[:] = saved
+    saved = list(cb.count)
+    cb.res(t + dt, y, yp, rp)
+    cb.res(t - dt, y, yp, rm)
+    cb.count[:] = saved     # these are not solver step attempts
     rhs = -((rp - rm) / (2 * dt) + Jy_states @ yp[:ns])
-    sol = _solve_square(J, rhs)
+    sol = solve_square(J, rhs)
     if np.all(np.isfinite(sol)):
         yp[ns:] = sol[:n - ns]
     return yp
 
 
-def _event_matrix(cb, t, y, yp, ns):
-    """(J = [dF/dy of the algebraic slots, dF/dy' of the states], dF/dy of
-    the states): the matrix of the re-initialisation, dense, or
-    ``scipy.sparse`` CSC from SPARSE_MIN unknowns."""
-    n = len(y)
-    if n + ns >= SPARSE_MIN:
-        Jy, Jyp = Triplets((n, n)), Triplets((n, n))
-        cb[3](t, y, yp, Jy, Jyp)
-        Jy, Jyp = Jy.tocsr().tocsc(), Jyp.tocsr().tocsc()
-        return sps.hstack([Jy[:, ns:], Jyp[:, :ns]], format="csc"), Jy[:, :ns]
-    Jy, Jyp = _jacobians(cb, t, y, yp, n)
-    return np.hstack([Jy[:, ns:], Jyp[:, :ns]]), Jy[:, :ns]
 
-
-def _solve_square(J, b):
-    """``J x = b`` for a square dense or sparse ``J`` (LU); least squares
-    when the LU finds it singular."""
-    if sps.issparse(J):
-        try:
-            x = scipy.sparse.linalg.splu(J).solve(b)
-            if np.all(np.isfinite(x)):
-                return x
-        except RuntimeError:      # "Factor is exactly singular"
-            pass
-        J = J.toarray()
-    try:
-        return scipy.linalg.solve(J, b)
-    except (scipy.linalg.LinAlgError, ValueError):
-        return np.linalg.lstsq(J, b, rcond=None)[0]

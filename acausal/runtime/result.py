@@ -1,9 +1,22 @@
-"""Simulation results: every variable by dotted path, events, statistics."""
+"""Simulation results: every variable by dotted path, events, statistics;
+variables the solver does not integrate are evaluated from the stored rows
+by the generated observe callback, once per mode."""
 import csv
+from typing import NamedTuple
 
 import numpy as np
 
 from ..errors import UnknownNameError
+
+
+class Rows(NamedTuple):
+    """The stored output rows of a run: times ``t``, unknowns ``y`` and
+    their derivatives ``yp`` (rows x unknowns), discrete values ``d``
+    (rows x discrete values)."""
+    t: np.ndarray
+    y: np.ndarray
+    yp: np.ndarray
+    d: np.ndarray
 
 
 class Result:
@@ -12,22 +25,25 @@ class Result:
     ``res["hook.phi"]`` is the time series of any variable (including those
     eliminated as aliases), discrete value or parameter; ``res.t`` the time
     points (requested output times plus both sides of every event);
-    ``res.events`` a list of ``(t, name)``; ``res.stats`` solver statistics.
+    ``res.events`` a list of ``(t, name)``; ``res.stats`` solver statistics;
+    ``res.sensitivities`` the :class:`acausal.runtime.sensitivity_run.Sensitivities`
+    of a run that asked for them (else None).
     """
 
-    def __init__(self, cm, p, t, y, yp, d, events, stats, status="ok", message=""):
+    def __init__(self, cm, p, rows, events, stats, status="ok", message="",
+                 sensitivities=None):
         self.model = cm
         self.p = np.asarray(p, dtype=float)
-        self.t = np.asarray(t, dtype=float)
-        self.y = np.asarray(y, dtype=float)
-        self.yp = np.asarray(yp, dtype=float)
-        self.d = np.asarray(d, dtype=float)
+        self.t = np.asarray(rows.t, dtype=float)
+        self.y = np.asarray(rows.y, dtype=float)
+        self.yp = np.asarray(rows.yp, dtype=float)
+        self.d = np.asarray(rows.d, dtype=float)
         self.events = events
         self.stats = stats
         self.status = status
         self.message = message
         self._obs = None
-        self.sensitivities = None   # acausal.sensitivity.Sensitivities of a run that asked
+        self.sensitivities = sensitivities
 
     # -- access ----------------------------------------------------------------
     @property
@@ -45,7 +61,7 @@ class Result:
                 cb = cache.get(key)
                 if cb is None:
                     cb = cache[key] = cm.callbacks(self.p, list(key))
-                out[k] = cb[4](self.t[k], self.y[k], self.yp[k])
+                out[k] = cb.observe(self.t[k], self.y[k], self.yp[k])
             self._obs = out
         return self._obs
 
@@ -101,7 +117,7 @@ class Result:
     def measure_sensitivity(self, fn, param):
         """d fn(res) / d(``param``) of a measure ``fn`` (a function of a
         result, as a model file's measures), from the sensitivities, with no
-        further simulation (:meth:`acausal.sensitivity.Sensitivities.measure`)."""
+        further simulation (:meth:`acausal.runtime.sensitivity_run.Sensitivities.measure`)."""
         return self._sens().measure(self, fn, param)
 
     def _sens(self):

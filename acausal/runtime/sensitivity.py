@@ -1,4 +1,4 @@
-"""Forward parameter sensitivities through events (the hybrid loop's stage 6b).
+"""Forward parameter sensitivities through events: the augmented model.
 
 For parameters ``p_j`` the sensitivities ``s_j = dy/dp_j`` of the reduced
 DAE ``F(t, y, y', p, d) = 0`` satisfy the sensitivity DAE (Maly & Petzold
@@ -8,9 +8,10 @@ DAE ``F(t, y, y', p, d) = 0`` satisfy the sensitivity DAE (Maly & Petzold
 
 (``sd_j``: sensitivities of the discrete values the equations use, constant
 between events). :func:`sensitivity_model` appends these rows, built
-symbolically from the same residuals with :func:`acausal.fastdiff.diff`, to
+symbolically from the same residuals with :func:`acausal.lang.fastdiff.diff`, to
 the DAE and generates the augmented system with the ordinary code
-generators (Python, :mod:`acausal.codegen`; C, :mod:`acausal.codegen_c`), so
+generators (Python, :mod:`acausal.compiler.codegen`; C,
+:mod:`acausal.compiler.codegen_c`), so
 each backend integrates it as any model, with no math of its own (CasADi's
 principle: one graph, several backends, sensitivities from the same graph).
 The augmented unknowns are ordered states first (the states, then their
@@ -20,8 +21,10 @@ unchanged. The augmented system's Jacobian is block lower triangular; its
 iteration matrix keeps the diagonal blocks, each the base model's
 (:meth:`SensitivityModel._generate`: IDAS's simultaneous corrector).
 
-At the start the sensitivities follow from the consistent-initialisation
-equations by the implicit function theorem (:meth:`SensRun.start`). At an
+The run integrates it as one observer of the hybrid loop
+(:class:`acausal.runtime.sensitivity_run.SensitivityObserver`): at the
+start the sensitivities follow from the consistent-initialisation
+equations by the implicit function theorem. At an
 event of root ``g`` at time ``tau`` (Galan, Feehery & Barton 1999,
 "Parametric sensitivity functions for hybrid discrete/continuous systems",
 Appl. Numer. Math. 31)::
@@ -43,27 +46,34 @@ The event time's derivative is taken at the located point polished
 algebraic unknowns and y'' of the states from the equations differentiated
 once), so roots of forces and rates are as exact as roots of positions.
 A measure (any function of a result) is differentiated over the result
-moved to first order along the sensitivities (:meth:`Sensitivities.measure`).
+moved to first order along the sensitivities
+(:meth:`acausal.runtime.sensitivity_run.Sensitivities.measure`).
 
 Limits: rates of observed variables read by actions are central
 differences in time; an action must be a function of what it reads.
-The generated augmented model is cached on disk (``sensitivities/`` in the
-model cache, :func:`_cache_key`).
+The generated augmented model is kept in the on-disk store (namespace
+``sensitivity``, :func:`_cache_key`).
 """
+import dataclasses
+import hashlib
+import json
+import os
 import weakref
 
 import numpy as np
 import sympy as sp
 
 from .backends import choose_linear_solver
+from ..compiler.cache import digest
 from ..compiler.causalize import DAE
-from ..compiler.codegen import (_IEEE_ERRORS, Names, Sparsity, _body, _unpack, exec_twins, generate,
-                      load)
+from ..compiler.codegen import Sparsity, generate, load, root_gradients
 from ..errors import ModelError, UsageError
-from .events import EventState
+from ..infra import store
 from ..lang.fastdiff import diff
+from .linalg import solve_square
 
-_models = weakref.WeakKeyDictionary()   # CompiledModel -> {names: SensitivityModel}
+# compiled model -> {names: SensitivityModel}: the runtime's cache of them
+_models = weakref.WeakKeyDictionary()
 
 
 def sensitivity_model(cm, names):
@@ -91,7 +101,7 @@ def sensitivity_model(cm, names):
 class SensitivityModel:
     """A compiled model with its sensitivity DAE appended, for parameters
     ``names``. It has what the hybrid loop and the backends use of a
-    :class:`~acausal.compile.CompiledModel` (``dae``, ``callbacks``,
+    :class:`~acausal.runtime.model.CompiledModel` (``dae``, ``callbacks``,
     ``disc_syms``, ``source``, ``sparsity``, ``linear_solver``); everything
     else (events, parameters, names, ``resolve``) is the base model's, read
     through :meth:`__getattr__`. Its discrete values are the base model's,
@@ -111,7 +121,7 @@ class SensitivityModel:
                for k, s in enumerate(dae.y)] for j in range(m)]
         SD = [[sp.Symbol(f"__sensd{j}__{cm.disc_syms[q].name}") for q in self.dyn]
               for j in range(m)]
-        self._sd_syms = [s for row in SD for s in row]
+        self.sd_syms = [s for row in SD for s in row]   # the discrete sensitivities
         lin = self._lin = _Linearize(dae, P, [cm.disc_syms[q] for q in self.dyn], S, Sp, SD)
         rows = [lin.total(r) for r in dae.residuals]      # rows[i][j]
         self.order = self._order()
@@ -125,7 +135,7 @@ class SensitivityModel:
                        ns * (1 + m), [res_all[k] for k in self.order],
                        [org_all[k] for k in self.order], dae.explicit,
                        tuple(frozenset(same[b]) for b in block))
-        self.disc_syms = list(cm.disc_syms) + self._sd_syms
+        self.disc_syms = list(cm.disc_syms) + self.sd_syms
         roots = [cm.resolve(e.expr) for e in cm.events] + \
             [cm.resolve(a.expr) for a in cm.assertions]
         key = _cache_key(cm, names, self.dae.residuals)
@@ -137,11 +147,11 @@ class SensitivityModel:
         else:
             self.source, self.sparsity = hit
         self._make = load(self.source)[0]
-        self.rootgrad = _root_gradients(cm, roots, P, self.dyn)
+        self.rootgrad = root_gradients(dae, cm.param_syms, cm.disc_syms, roots, P, self.dyn)
         self.inverse = np.argsort(self.order)
 
     def _generate(self, lin, roots):
-        """The augmented system's generated callbacks (:func:`acausal.codegen.generate`):
+        """The augmented system's generated callbacks (:func:`acausal.compiler.codegen.generate`):
         its residuals, the diagonal blocks of its Jacobian (see below), the
         base roots and the observed variables followed by their
         sensitivities.
@@ -154,7 +164,8 @@ class SensitivityModel:
         one iteration after the base unknowns' (the neglected part is
         nilpotent), and the sensitivities are those of the exact equations.
         Where the coupling is needed (the algebraic rates after an event),
-        it is a directional difference (:meth:`SensRun.rates`)."""
+        it is a directional difference
+        (:meth:`acausal.runtime.sensitivity_run.SensitivityObserver.rates`)."""
         return generate(self.dae, self.base.param_syms, self.disc_syms, roots,
                         self.observed_exprs())
 
@@ -198,7 +209,7 @@ class SensitivityModel:
         ``A``, block lower triangular: each parameter's block depends only
         on its own sensitivities and the base unknowns, with the base
         matrix on the diagonal. ``J``: its diagonal blocks (the generated
-        Jacobian, :func:`acausal.initialize._event_matrix`);
+        Jacobian, :func:`acausal.runtime.linalg.event_matrix`);
         ``coupling(x0)``: the off-diagonal blocks times the base block's
         solution ``x0`` (rows of the whole vector). Forward substitution
         with the base block (every diagonal block is the base model's
@@ -206,21 +217,20 @@ class SensitivityModel:
         per parameter for the rest; a dense solve of the whole would also
         mix blocks of very different scales (d/dp of a 1e-4 kg m^2
         inertia; rcond 1e-16 on the breaker)."""
-        from .initialize import _solve_square
-        rows, cols = self._event_blocks()
+        rows, cols = self.event_blocks()
         if not isinstance(J, np.ndarray):
             J = J.toarray()
         J0 = J[np.ix_(rows[0], cols[0])]
         x = np.empty_like(b)
-        x0 = _solve_square(J0, b[rows[0]])
+        x0 = solve_square(J0, b[rows[0]])
         x[cols[0]] = x0
         c0 = coupling(x0)
-        X = _solve_square(J0, np.column_stack([b[r] - c0[r] for r in rows[1:]]))
+        X = solve_square(J0, np.column_stack([b[r] - c0[r] for r in rows[1:]]))
         for j, c in enumerate(cols[1:]):
             x[c] = X[:, j]
         return x
 
-    def _event_blocks(self):
+    def event_blocks(self):
         """(rows, columns) of the re-initialisation matrix per block (base,
         then each parameter's), each in the base model's order."""
         if getattr(self, "_blocks", None) is None:
@@ -260,15 +270,12 @@ class SensitivityModel:
 
 
 def _cache_key(cm, names, residuals):
-    """Key of a sensitivity model in the on-disk cache: the base model's
-    generated source (which fixes its DAE), the parameter names, the
-    augmented residuals (which the derivative rules of the model's own
-    functions shape) and the generators' sources."""
-    import hashlib
-    import os
+    """Key of a sensitivity model in the store: the base model's generated
+    source (which fixes its DAE), the parameter names, the augmented
+    residuals (which the derivative rules of the model's own functions
+    shape) and the generators' sources."""
     h = hashlib.sha256(cm.source.encode())
     h.update("\0".join(names).encode())
-    from ..infra.store import digest
     h.update(digest(residuals).encode())
     here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))   # the acausal package
     for mod in ("runtime/sensitivity.py", "compiler/codegen.py", "lang/fastdiff.py"):
@@ -277,41 +284,23 @@ def _cache_key(cm, names, residuals):
     return h.hexdigest()[:24]
 
 
-def _cache_path(key):
-    from ..infra.store import cache_dir
-    d = cache_dir()
-    return None if d is None else d / "sensitivities" / f"sens_{key}.json"
-
-
 def _cache_load(key):
-    """(source, Sparsity) of a cached sensitivity model, or None."""
-    import json
-    path = _cache_path(key)
-    if path is None or not path.exists():
+    """(source, Sparsity) of a stored sensitivity model, or None."""
+    data = store.read_bytes("sensitivity", f"sens_{key}.json")
+    if data is None:
         return None
     try:
-        data = json.loads(path.read_text())
+        data = json.loads(data)
         return data["source"], Sparsity(**data["sparsity"])
-    except (OSError, ValueError, KeyError, TypeError):
+    except (ValueError, KeyError, TypeError):
         return None   # an unreadable entry is generated again
 
 
 def _cache_store(key, source, sparsity):
-    import dataclasses
-    import json
-    import os
-    import tempfile
-    path = _cache_path(key)
-    if path is None:
-        return
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
-        with os.fdopen(fd, "w") as fh:
-            json.dump({"source": source, "sparsity": dataclasses.asdict(sparsity)}, fh)
-        os.replace(tmp, path)   # atomic: a reader never sees a partial file
-    except OSError:
-        pass   # no cache then; the model is generated again next time
+    """Keep a sensitivity model in the store (atomically; nothing when the
+    store is off or cannot be written: it is generated again next time)."""
+    text = json.dumps({"source": source, "sparsity": dataclasses.asdict(sparsity)})
+    store.write_bytes("sensitivity", f"sens_{key}.json", text.encode())
 
 
 class _Linearize:
@@ -345,467 +334,3 @@ class _Linearize:
             if e.has(pj):
                 out[j].append(diff(e, pj))
         return [sp.Add(*terms) for terms in out]
-
-
-def _root_gradients(cm, roots, P, dyn):
-    """A function ``(t, y, yp, p, d)`` -> (G_y, G_y', G_t, G_p, G_d) of the root
-    functions (dense arrays, rows = roots), generated as the other callbacks."""
-    dae = cm.dae
-    n, nr, m = len(dae.y), len(roots), len(P)
-    names = Names(dae.y, dae.yp, cm.param_syms, cm.disc_syms)
-    from ..lang.symbols import time
-    cols = [("Gy", k, s) for k, s in enumerate(dae.y)]
-    cols += [("Gyp", k, s) for k, s in enumerate(dae.yp) if s is not None]
-    exprs, targets = [], []
-    for i, g in enumerate(roots):
-        fs = g.free_symbols
-        for arr, k, s in cols + [("Gp", j, x) for j, x in enumerate(P)] + \
-                [("Gd", q, cm.disc_syms[x]) for q, x in enumerate(dyn)]:
-            if s in fs:
-                exprs.append(diff(g, s))
-                targets.append(f"{arr}[{i}, {k}]")
-        if time in fs:
-            exprs.append(diff(g, time))
-            targets.append(f"Gt[{i}]")
-    L = ["def rootgrad(t, y, yp, p, d, Gy, Gyp, Gt, Gp, Gd):"]
-    L += _unpack("y", n, "y", "    ", False) + _unpack("yp", n, "yp", "    ", False)
-    L += _unpack("p", len(cm.param_syms), "p", "    ", False)
-    L += _unpack("d", len(cm.disc_syms), "d", "    ", False)
-    L += _body(exprs, targets, "    ", symbols=names.code) + ["    pass"]
-    ns, ieee = exec_twins(compile("\n".join(L) + "\n", "<acausal-root-gradients>", "exec"))
-    fill, fill_ieee = ns["rootgrad"], ieee["rootgrad"]
-
-    def rootgrad(t, y, yp, p, d):
-        G = (np.zeros((nr, n)), np.zeros((nr, n)), np.zeros(nr), np.zeros((nr, m)),
-             np.zeros((nr, len(dyn))))
-        try:
-            fill(t, list(map(float, y)), list(map(float, yp)), list(map(float, p)),
-                 list(map(float, d)), *G)
-        except _IEEE_ERRORS:      # a guarded domain: as the callbacks (acausal.codegen)
-            with np.errstate(all="ignore"):
-                fill_ieee(t, *(np.asarray(a, dtype=float) for a in (y, yp, p, d)), *G)
-        return G
-    return rootgrad
-
-
-class SensRun:
-    """The sensitivity bookkeeping of one run: initial sensitivities, the
-    event-time sensitivities and the jumps at mode changes."""
-
-    def __init__(self, sm, p, span, serve=None):
-        self.sm, self.p = sm, np.asarray(p, float)
-        # (model, d) -> that model's callbacks in mode d, as the run's backend
-        # serves them (compiled C on the compiled backend)
-        self.serve = serve or (lambda model, d: model.callbacks(self.p, d))
-        self.span = max(float(span), 1e-300)
-        self.dtau = np.zeros(sm.m)       # of the instant being handled
-        self.sd_all = np.zeros((sm.m, len(sm.base.disc_syms)))   # of every discrete value
-        self.noted = {}                  # index in run.events -> dtau/dp (m)
-        self._polished = None            # the last polished point (see polish)
-
-    # -- start -----------------------------------------------------------------
-    def start(self, p, d, t0, y, yp, starts):
-        """(Y, Y', d, callbacks) of the augmented system at the consistent
-        initial point ``(y, yp)`` of the base model: the states'
-        sensitivities from the initial equations (implicit function
-        theorem), the rest re-solved."""
-        sm, cm = self.sm, self.sm.base
-        d_aug = list(d) + [0.0] * len(sm._sd_syms)
-        cb = self.serve(sm, d_aug)
-        ds = _initial_state_sensitivities(sm, cm, cb, self.serve(cm, d), p, d, t0, y, yp,
-                                          starts)
-        S = np.zeros((sm.m, sm.n))
-        S[:, :sm.ns] = ds
-        Y, YP = sm.pack(y, S), sm.pack(yp, np.zeros((sm.m, sm.n)))
-        Y, YP = self.reinit(t0, Y, YP, d_aug)
-        return Y, YP, d_aug, cb
-
-    def reinit(self, t, Y, YP, d_aug, rates=True):
-        """The re-initialisation of the augmented system at ``t`` (states and
-        their sensitivities kept): the base model's
-        (:func:`acausal.initialize.reinitialize`), then the sensitivity rows,
-        linear in ``(s_alg, s'_states)`` with the base iteration matrix, in
-        one solve; with ``rates``, y' of every algebraic slot as
-        :func:`acausal.initialize._algebraic_rates` gives it."""
-        from .initialize import _jacobians, reinitialize
-        sm, cm = self.sm, self.sm.base
-        n, ns = sm.n, sm.ns
-        cb = self.serve(cm, d_aug[:len(cm.disc_syms)])
-        (y, S), (yp, Sp) = sm.unpack(Y), sm.unpack(YP)
-        y, yp = reinitialize(cm, cb, t, y, yp)
-        S, Sp = S.copy(), Sp.copy()
-        S[:, ns:] = 0.0
-        Sp[:, :ns] = 0.0
-        cba = self.serve(sm, d_aug)
-        r = np.zeros(len(sm.dae.y))
-        cba[0](t, sm.pack(y, S), sm.pack(yp, Sp), r)
-        Jy, Jyp = _jacobians(cb, t, y, yp, n)
-        J = np.hstack([Jy[:, ns:], Jyp[:, :ns]])
-        rhs = -sm.unpack(r)[1].T                          # n x m
-        try:
-            X = np.linalg.solve(J, rhs)
-        except np.linalg.LinAlgError:
-            X = np.linalg.lstsq(J, rhs, rcond=None)[0]
-        S[:, ns:] = X[:n - ns].T
-        Sp[:, :ns] = X[n - ns:].T
-        Y, YP = sm.pack(y, S), sm.pack(yp, Sp)
-        if rates:
-            YP = self.rates(cba, t, Y, YP)
-        return Y, YP
-
-    def rates(self, cb, t, Y, YP):
-        """``YP`` with y' of every algebraic slot of the augmented system
-        (callbacks ``cb``), as :func:`acausal.initialize._algebraic_rates`
-        gives it: ``J x = -(F_t + F_y(states) y'_states)`` for x = (y' of the
-        algebraic slots, y'' of the states), solved by blocks with the base
-        model's matrix ``J0`` (:meth:`SensitivityModel.block_solve`). The
-        right side, and the coupling of each parameter's rows to the base
-        block's solution, are directional central differences of the
-        augmented residual (the generated Jacobian has only the diagonal
-        blocks)."""
-        from .initialize import _event_matrix
-        sm = self.sm
-        N, nsa = len(sm.dae.y), sm.ns * (1 + sm.m)
-        if N == nsa:
-            return YP
-        Y, YP = np.asarray(Y, float), np.array(YP, dtype=float)
-        J, _ = _event_matrix(cb, t, Y, YP, nsa)
-        move = np.zeros(N)
-        move[:nsa] = YP[:nsa]
-        dt = 1e-6 * max(1.0, abs(t))
-        count = cb[5] if len(cb) > 5 else None
-        saved = list(count) if count is not None else None
-        rhs = -_central(lambda h: _residual(cb, t + h, Y + h * move, YP), dt)
-        x = sm.block_solve(J, rhs, lambda x0: self._coupling(cb, t, Y, YP, x0))
-        if count is not None:   # these are not solver step attempts
-            count[:] = saved
-        if np.all(np.isfinite(x)):
-            YP[nsa:] = x[:N - nsa]
-        return YP
-
-    def _coupling(self, cb, t, Y, YP, x0):
-        """(rows of the parameters' blocks) the augmented residual's
-        derivative along the base block's unknowns moved by ``x0`` (its
-        re-initialisation columns: the algebraic slots' y, the states' y')."""
-        sm = self.sm
-        N, nsa = len(sm.dae.y), sm.ns * (1 + sm.m)
-        rows, cols = sm._event_blocks()
-        v = np.zeros(N)                              # event-matrix column space
-        v[cols[0]] = x0
-        dY, dYP = np.zeros(N), np.zeros(N)
-        dY[nsa:] = v[:N - nsa]
-        dYP[:nsa] = v[N - nsa:]
-        base = np.concatenate([Y[nsa:], YP[:nsa]])
-        h = 1e-7 * (1.0 + np.max(np.abs(base))) / max(np.max(np.abs(x0)), 1e-300)
-        return _central(lambda e: _residual(cb, t, Y + e * dY, YP + e * dYP), h)
-
-    # -- events ------------------------------------------------------------------
-    def polish(self, t, Y, YP, d_aug):
-        """The point IDA located a root at, with its algebraic unknowns and
-        derivatives re-solved from the (augmented) equations: IDA's
-        interpolated values there meet them only to the tolerance. The last
-        one is kept: a mode change polishes the point its event time did."""
-        last = self._polished
-        if (last is not None and last[0] == t and np.array_equal(last[1], Y)
-                and np.array_equal(last[2], YP) and last[3] == list(d_aug)):
-            return last[4], last[5]
-        out = self.reinit(t, Y, YP, d_aug, rates=False)
-        self._polished = (t, np.array(Y), np.array(YP), list(d_aug)) + out
-        return out
-
-    def event_time(self, t, Y, YP, d_aug, i, rates):
-        """dtau/dp (m) of root ``i`` at the (polished) point ``(t, Y, Y')``;
-        ``rates`` = (y', y'') of the base model there."""
-        sm = self.sm
-        nd = len(sm.base.disc_syms)
-        (y, S), (yp, Sp) = sm.unpack(Y), sm.unpack(YP)
-        Gy, Gyp, Gt, Gp, Gd = sm.rootgrad(t, y, yp, self.p, d_aug[:nd])
-        sd = sm.sd_of(d_aug)
-        num = S @ Gy[i] + Sp @ Gyp[i] + Gp[i] + sd @ Gd[i]
-        rate = Gy[i] @ rates[0] + Gyp[i] @ rates[1] + Gt[i]
-        if rate == 0 or not np.isfinite(rate):
-            return np.full(sm.m, np.nan)   # a grazing root: tau is not differentiable
-        return -num / rate
-
-    def event_times(self, t, Y, YP, d_aug, fired, current=False):
-        """index -> dtau/dp of each fired event; with ``current`` the first
-        one is the instant's (the one its mode changes jump by)."""
-        n_ev = len(self.sm.base.events)
-        fired = [i for i in fired if i < n_ev]
-        if not fired:
-            return {}
-        Y, YP = self.polish(t, Y, YP, d_aug)
-        rates = _rates(self.sm, self.serve(self.sm.base, d_aug[:len(self.sm.base.disc_syms)]),
-                       t, Y, YP)
-        taus = {i: self.event_time(t, Y, YP, d_aug, i, rates) for i in fired}
-        if current and taus:
-            first = taus[min(taus)]
-            self.dtau[:] = np.where(np.isfinite(first), first, 0.0)
-        return taus
-
-    def note(self, k, dtau):
-        self.noted[k] = np.asarray(dtau, float)
-
-    def mode_change(self, events, t, Y, YP, d_before, d_after, obs):
-        """After ``events``' actions changed the discrete values from
-        ``d_before`` to ``d_after`` (augmented, the sensitivities still those
-        before) at the point ``(t, Y, Y')`` with base observed values
-        ``obs``: the new discrete sensitivities, the re-initialised point and
-        the jump of the states' sensitivities. Returns (d, callbacks, Y, Y')."""
-        sm = self.sm
-        nd = len(sm.base.disc_syms)
-        Y, YP = self.polish(t, Y, YP, d_before)
-        self.sd_all = self._action_sensitivities(events, t, Y, YP, d_before, obs, self.dtau)
-        d_new = list(d_after[:nd]) + self.sd_all[:, sm.dyn].ravel().tolist()
-        cb = self.serve(sm, d_new)
-        Y1, YP1 = self.reinit(t, Y, YP, d_new, rates=False)
-        ns = sm.ns
-        jump = (np.asarray(YP)[:ns] - YP1[:ns])[None, :] * self.dtau[:, None]   # m x ns
-        if np.any(jump != 0):
-            y, S = sm.unpack(Y1)
-            S[:, :ns] += jump
-            Y1, YP1 = self.reinit(t, sm.pack(y, S), YP1, d_new, rates=False)
-        YP1 = self.rates(cb, t, Y1, YP1)
-        return d_new, cb, Y1, YP1
-
-    def _action_sensitivities(self, events, t, Y, YP, d_before, obs, dtau):
-        """The sensitivities of every discrete value after ``events``' actions
-        (m x nd; ``self.sd_all`` before them): the actions' directional
-        derivative along the total derivative of what they read (the
-        observed values at the event time ``t + dtau dp``, the parameters,
-        the discrete values), by central differences."""
-        sm, cm = self.sm, self.sm.base
-        nd, nobs = len(cm.disc_syms), len(cm.var_names)
-        sd = self.sd_all.copy()
-        if not any(ev.action is not None for ev in events):
-            return sd
-        out = np.asarray(self.serve(sm, d_before)[4](t, Y, YP), float)
-        dobs = out[nobs:].reshape(sm.m, nobs)
-        odot = self._observed_rate(t, Y, YP, d_before)
-        obs = np.asarray(obs, float)[:nobs]
-        for j, k in enumerate(sm.pidx):
-            h = 1e-6 * (abs(self.p[k]) if self.p[k] != 0 else 1.0)
-            vals, written = [], np.zeros(nd, bool)
-            for sgn in (1.0, -1.0):
-                q = self.p.copy()
-                q[k] += sgn * h
-                given = np.asarray(d_before[:nd], float) + sgn * h * sd[j]
-                st = EventState(cm, q, list(given), t + sgn * h * dtau[j],
-                                list(obs + sgn * h * (dobs[j] + odot * dtau[j])))
-                for ev in events:
-                    if ev.action is not None:
-                        ev.action(st)
-                vals.append(np.array(st.d[:nd], float))
-                written |= vals[-1] != given
-            # a value no action wrote keeps its sensitivity exactly
-            sd[j] = np.where(written, (vals[0] - vals[1]) / (2 * h), sd[j])
-        return sd
-
-    def observer_actions(self, events, t, Y, YP, d_before, obs, taus):
-        """Observer events' actions ran at ``t``: the sensitivities of the
-        discrete values they record (``taus``: index -> dtau/dp)."""
-        cm = self.sm.base
-        for ev in events:
-            i = cm.events.index(ev)
-            dtau = np.nan_to_num(taus.get(i, np.zeros(self.sm.m)))
-            self.sd_all = self._action_sensitivities([ev], t, Y, YP, d_before, obs, dtau)
-
-    def _observed_rate(self, t, Y, YP, d_aug):
-        """d(observed)/dt along the solution, by a central difference."""
-        sm = self.sm
-        nobs = len(sm.base.var_names)
-        obs = self.serve(sm, d_aug)[4]
-        dt = 1e-7 * self.span
-        Y, YP = np.asarray(Y, float), np.asarray(YP, float)
-        a = np.asarray(obs(t + dt, Y + dt * YP, YP), float)[:nobs]
-        b = np.asarray(obs(t - dt, Y - dt * YP, YP), float)[:nobs]
-        return (a - b) / (2 * dt)
-
-    # -- result ------------------------------------------------------------------
-    def result_data(self, T, Y, YP, D, SD, n_events):
-        """A :class:`Sensitivities` of the stored rows."""
-        E = np.full((n_events, self.sm.m), np.nan)
-        for k, v in self.noted.items():
-            if k < n_events:
-                E[k] = v
-        SD = SD.reshape(len(T), self.sm.m, len(self.sm.base.disc_syms))
-        return Sensitivities(self.sm, self.p, T, Y, YP, D, SD, E)
-
-
-def _residual(cb, t, Y, YP):
-    r = np.zeros(len(Y))
-    cb[0](t, Y, YP, r)
-    return r
-
-
-def _central(f, h):
-    """(f(h) - f(-h)) / 2h."""
-    return (f(h) - f(-h)) / (2 * h)
-
-
-def _rates(sm, cb, t, Y, YP):
-    """(y', y'') of the base model (its callbacks ``cb``) at a consistent point: y' of the states
-    from ``YP``, y' of the algebraic unknowns and y'' of the states from the
-    equations differentiated once along the solution,
-    ``[F_y(alg) F_y'(states)] [y'_alg; y''_states] = -(F_t + F_y(states) y'_states)``
-    (as :func:`acausal.initialize._algebraic_rates`; F_t by a central
-    difference)."""
-    from .initialize import _jacobians
-    cm, n, ns = sm.base, sm.n, sm.ns
-    y, yp = sm.unpack(Y)[0], sm.unpack(YP)[0]
-    ydot, ydd = np.array(yp, float), np.zeros(n)
-    if n == ns and not any(s is not None for s in cm.dae.yp):
-        return ydot, ydd
-    Jy, Jyp = _jacobians(cb, t, y, yp, n)
-    dt = 1e-7 * max(1.0, abs(t))
-    rp, rm = np.zeros(n), np.zeros(n)
-    cb[0](t + dt, y, yp, rp)
-    cb[0](t - dt, y, yp, rm)
-    rhs = -((rp - rm) / (2 * dt) + Jy[:, :ns] @ yp[:ns])
-    J = np.hstack([Jy[:, ns:], Jyp[:, :ns]])
-    try:
-        sol = np.linalg.solve(J, rhs)
-    except np.linalg.LinAlgError:
-        sol = np.linalg.lstsq(J, rhs, rcond=None)[0]
-    ydot[ns:] = sol[:n - ns]
-    ydd[:ns] = sol[n - ns:]
-    return ydot, ydd
-
-
-def _initial_state_sensitivities(sm, cm, cb, cb_base, p, d, t0, y, yp, starts):
-    """d(states)/dp (m x ns) at the consistent initial point (``cb``, ``cb_base``:
-    the augmented and the base model's callbacks): the initial
-    system (residuals, fixed starts, imposed guesses; see
-    :mod:`acausal.initialize`) differentiated with respect to each parameter
-    and solved for ``dz = (dy, dy'_states)`` (implicit function theorem)."""
-    from .initialize import _choose_guesses, _jacobians, _lstsq_scaled
-    n, ns, m = sm.n, sm.ns, sm.m
-    Jy, Jyp = _jacobians(cb_base, t0, y, yp, n)
-    rows = [np.hstack([Jy, Jyp[:, :ns]])]
-    fixed = cm.fixed_starts(p, starts)
-    if fixed:
-        F = np.asarray(cm.fixed_jacobian()(t0, *y, *yp, *p, *d), float)
-        rows.append(F.reshape(len(fixed), n + ns))
-    A = np.vstack(rows)
-    guesses = _choose_guesses(A, ns, cm.state_guess_order())
-    # F_p and the observed variables' o_p: the sensitivity rows at s = 0
-    zero = sm.pack(y, np.zeros((m, n))), sm.pack(yp, np.zeros((m, n)))
-    r = np.zeros(len(sm.dae.y))
-    cb[0](t0, zero[0], zero[1], r)
-    Fp = sm.unpack(r)[1]                              # m x n (rows ordered as y)
-    nobs = len(cm.var_names)
-    op = np.asarray(cb[4](t0, *zero), float)[nobs:].reshape(m, nobs)
-    G = np.zeros((len(guesses), n + ns))
-    for a, k in enumerate(guesses):
-        G[a, k] = 1.0
-    A = np.vstack([A, G])
-    out = np.zeros((m, ns))
-    for j, k in enumerate(sm.pidx):
-        h = 1e-6 * (abs(p[k]) if p[k] != 0 else 1.0)
-        qp, qm = np.array(p, float), np.array(p, float)
-        qp[k] += h
-        qm[k] -= h
-        dv = np.array([_start_derivative(cm, name, k, p, starts) for _, _, name in fixed])
-        dg = (cm.guess_vector(qp, starts) - cm.guess_vector(qm, starts)) / (2 * h)
-        rhs = [-Fp[j]]
-        if fixed:
-            rhs.append(-(op[j][[kk for kk, _, _ in fixed]] - dv))
-        rhs.append(np.array([dg[kk] for kk in guesses]))
-        dz = _lstsq_scaled(A, np.concatenate(rhs))
-        out[j] = dz[:ns]
-    return out
-
-
-def _start_derivative(cm, name, k, p, starts):
-    """d(fixed start value of variable ``name``)/d(parameter ``k``): the start
-    value is a number (0), an override for this run (0) or an expression of
-    parameters (differentiated symbolically)."""
-    value = cm.flat.variables[name].start.value
-    if (starts and name in starts) or not isinstance(value, sp.Basic) or value.is_number:
-        return 0.0
-    e = value.xreplace(cm._subs)
-    de = diff(e, cm.param_syms[k])
-    return float(de.xreplace(dict(zip(cm.param_syms, map(float, p)))))
-
-
-class Sensitivities:
-    """The sensitivities a run stored (``Result.sensitivity`` reads them)."""
-
-    def __init__(self, sm, p, T, Y, YP, D, SD, E):
-        self.sm, self.p, self.t = sm, p, T
-        self.Y, self.YP, self.D, self.SD, self.events = Y, YP, D, SD, E
-        self._obs = None
-
-    def names(self):
-        return list(self.sm.names)
-
-    def _j(self, param):
-        if param not in self.sm.names:
-            raise UsageError(f"no sensitivity with respect to {param!r}: the run computed "
-                             f"them for {', '.join(self.sm.names)} (simulate(sensitivities=...))")
-        return self.sm.names.index(param)
-
-    def observed(self):
-        """rows x m x len(var_names): d(variable)/d(parameter) at every row."""
-        if self._obs is None:
-            sm = self.sm
-            nobs = len(sm.base.var_names)
-            out = np.empty((len(self.t), sm.m, nobs))
-            cache = {}
-            for k in range(len(self.t)):
-                key = tuple(self.D[k])
-                cb = cache.get(key)
-                if cb is None:
-                    cb = cache[key] = sm.callbacks(self.p, list(key))
-                o = np.asarray(cb[4](self.t[k], self.Y[k], self.YP[k]), float)
-                out[k] = o[nobs:].reshape(sm.m, nobs)
-            self._obs = out
-        return self._obs
-
-    def of(self, var, param):
-        j = self._j(param)
-        names = self.sm.base.var_names
-        discretes = [s.name for s in self.sm.base.disc_syms]
-        if var in discretes:
-            return self.SD[:, j, discretes.index(var)]
-        if var not in names:
-            if var in self.sm.names or var in [e.name for e in self.sm.base.params]:
-                return np.full(len(self.t), 1.0 if var == param else 0.0)
-            from ..errors import UnknownNameError
-            raise UnknownNameError(f"no variable {var!r} in the result", variable=var)
-        return self.observed()[:, j, names.index(var)]
-
-    def event(self, param):
-        return self.events[:, self._j(param)]
-
-    def measure(self, result, fn, param, rel_step=1e-6):
-        """d fn(result) / d param for a measure ``fn`` (any function of a
-        result): a central difference of ``fn`` over the result moved to
-        first order along the sensitivities (unknowns, discrete values, event
-        times and the rows at events with them, the parameter itself), so no
-        simulation is repeated and the difference is exact for measures that
-        are linear in what they read (event times, values at events,
-        discrete values) and second-order accurate for others."""
-        j = self._j(param)
-        k = self.sm.pidx[j]
-        h = rel_step * (abs(self.p[k]) if self.p[k] != 0 else 1.0)
-        return (fn(self._moved(result, j, h)) - fn(self._moved(result, j, -h))) / (2 * h)
-
-    def _moved(self, result, j, h):
-        """``result`` with parameter j moved by ``h``, to first order."""
-        from .result import Result
-        sm = self.sm
-        y, S = sm.unpack(self.Y)
-        yp, Sp = sm.unpack(self.YP)
-        dtau = np.nan_to_num(self.events[:, j])
-        shift = np.zeros(len(self.t))
-        for (te, _), dt in zip(result.events, dtau):
-            shift[self.t == te] = dt      # rows at an event move with it
-        p = np.array(self.p, float)
-        p[sm.pidx[j]] += h
-        T = self.t + h * shift
-        Ym = y + h * (S[:, j] + yp * shift[:, None])
-        D = self.D[:, :self.SD.shape[2]] + h * self.SD[:, j]
-        events = [(te + h * dt, name) for (te, name), dt in zip(result.events, dtau)]
-        return Result(sm.base, p, T, Ym, yp + h * Sp[:, j], D, events, result.stats,
-                      result.status, result.message)

@@ -248,14 +248,14 @@ def test_breaker_backends_are_equally_accurate():
 
 
 def test_missing_compiler_falls_back_to_the_reference(monkeypatch, tmp_path):
-    """No C compiler (CC names none, empty cache): the run completes on
+    """No C compiler (CC names none, empty store): the run completes on
     scikit-sundae and says why."""
     import weakref
 
     from acausal.runtime.backends import compiled
     monkeypatch.setattr(compiled, "_loaded", weakref.WeakKeyDictionary())  # nothing loaded
     monkeypatch.setenv("CC", str(tmp_path / "no-such-cc"))
-    monkeypatch.setenv("ACAUSAL_CACHE_DIR", str(tmp_path))
+    monkeypatch.setenv("ACAUSAL_CACHE", str(tmp_path))
     _, cm = compile_file(os.path.join(ROOT, "models/examples/oscillator.py"))
     res = cm.simulate(t_end=0.05, backend="compiled")
     assert res.stats["backend"] == "sundae"

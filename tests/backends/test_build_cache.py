@@ -1,6 +1,7 @@
-"""The compiled backend builds its driver's C sources once per cache: each
-model's library compiles only its own generated code and links the cached
-driver objects."""
+"""The compiled backend builds its driver's C sources once per store: each
+model's library compiles only its own generated code and links the stored
+driver objects (the store's ``c-build`` namespace, $ACAUSAL_CACHE; the old
+$ACAUSAL_CACHE_DIR still works, with a DeprecationWarning)."""
 import glob
 import os
 
@@ -25,10 +26,10 @@ def test_driver_objects_built_once_and_shared(tmp_path, monkeypatch):
     pytest.importorskip("acausal.runtime.backends.compiled")
     from acausal.runtime.backends import compiled
     try:
-        compiled._compiler()
+        compiled.c_compiler()
     except compiled.Unavailable:
         pytest.skip("no C compiler")
-    monkeypatch.setenv("ACAUSAL_CACHE_DIR", str(tmp_path))
+    monkeypatch.setenv("ACAUSAL_CACHE", str(tmp_path))
     a = compile_model(_oscillator(100.0), cache=False)
     m2 = _oscillator(100.0)
     m2.mass2 = Mass(m=2.0)            # another structure (rigidly joined): another library
@@ -36,7 +37,7 @@ def test_driver_objects_built_once_and_shared(tmp_path, monkeypatch):
     b = compile_model(m2, cache=False)
     ra = a.simulate(t_end=0.5, backend="compiled")
     rb = b.simulate(t_end=0.5, backend="compiled")
-    d = os.path.join(str(tmp_path), "compiled")
+    d = os.path.join(str(tmp_path), "c-build")
     assert len(glob.glob(os.path.join(d, "acs_*.so"))) == 2
     assert len(glob.glob(os.path.join(d, "ida_driver_*.o"))) == 1
     assert len(glob.glob(os.path.join(d, "reinit_*.o"))) == 1

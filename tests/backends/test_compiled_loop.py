@@ -1,5 +1,5 @@
 """The compiled backend's C for the hybrid loop between segments
-(acausal/backends/compiled.py ``CCallbacks``, reinit.c): the residual, root
+(acausal/runtime/backends/compiled.py ``c_callbacks``, reinit.c): the residual, root
 functions, Jacobians and observed variables equal the generated Python's;
 the consistent re-initialisation and the initialisation's Newton give the
 Python implementation's point to round-off, and hand over to it where they
@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from acausal.runtime.backends import compiled_available, make_solver
-from acausal.runtime.initialize import _newton, initial_point, reinitialize
+from acausal.runtime.initialize import initial_point, reinitialize
+from acausal.runtime.linalg import newton as py_newton
 from acausal.modelfile import compile_file
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -61,11 +62,8 @@ def test_initial_point_and_reinitialisation_in_c(model):
     cm, p, d, py, c = model
     taken = []
     newton = c.init_newton
-    c.init_newton = lambda *a: taken.append(newton(*a)) or taken[-1]
-    try:
-        y1, yp1 = initial_point(cm, p, d, c, 0.0)
-    finally:
-        c.init_newton = newton
+    watched = c._replace(init_newton=lambda *a: taken.append(newton(*a)) or taken[-1])
+    y1, yp1 = initial_point(cm, p, d, watched, 0.0)
     y2, yp2 = initial_point(cm, p, d, py, 0.0)
     assert taken and taken[0] is not NotImplemented and taken[0] is not None
     scale = max(np.max(np.abs(y2)), 1.0)
@@ -94,4 +92,4 @@ def test_c_hands_over_at_a_non_finite_point(model):
         r = np.zeros(n)
         py[0](0.0, z[:n], np.r_[z[n:], np.zeros(n - ns)], r)
         return r
-    assert _newton(fun, None, z0) is None
+    assert py_newton(fun, None, z0) is None

@@ -1,5 +1,5 @@
 """simulate(..., atol_algebraic=...): a separate absolute tolerance for the
-algebraic unknowns (see acausal.simulate.simulate; found with the two-stage
+algebraic unknowns (see acausal.runtime.hybrid.simulate; found with the two-stage
 breaker variant, tests/models/test_breaker_variants.py)."""
 import os
 
@@ -8,7 +8,7 @@ import pytest
 
 from acausal import Experiment
 from acausal.modelfile import compile_file, run_file
-from acausal.runtime.hybrid import _atol_vector
+from acausal.runtime.hybrid import atol_vector
 from acausal.mechanics.fourbar import fourbar_angles
 from acausal.errors import UsageError
 
@@ -20,8 +20,8 @@ def test_vector_puts_the_algebraic_tolerance_after_the_states():
     _, cm = compile_file(EXAMPLE)
     n, ns = len(cm.dae.y), cm.dae.n_states
     assert 0 < ns < n                       # main shaft, cam angles, torques: algebraic
-    assert _atol_vector(cm, 1e-10, None) == 1e-10
-    vec = _atol_vector(cm, 1e-10, 1e-3)
+    assert atol_vector(cm, 1e-10, None) == 1e-10
+    vec = atol_vector(cm, 1e-10, 1e-3)
     assert vec.shape == (n,)
     assert np.all(vec[:ns] == 1e-10) and np.all(vec[ns:] == 1e-3)
 
@@ -67,8 +67,9 @@ def test_error_test_failure_suggests_the_algebraic_tolerance():
                                yp=np.zeros((2, n)), status=-3,
                                message="Error tests failed too many times, or reached "
                                        "min step size."))
-    for atol, advised in [(1e-10, True), (_atol_vector(cm, 1e-10, 1e-2), False)]:
-        run = _Run(cm, p, 0.0, 1.0, 1e-8, atol, None, 1000)
+    for atol, advised in [(1e-10, True), (atol_vector(cm, 1e-10, 1e-2), False)]:
+        run = _Run(cm, p, (0.0, 1.0), dict(rtol=1e-8, atol=atol, max_step=0.0,
+                                           max_num_steps=1000, linsolver="auto"))
         err = _failure(run, cm, sol, cb)
         assert "IDA failed at t = 0.001 s" in str(err)
         assert ("atol_algebraic" in str(err)) is advised

@@ -39,7 +39,7 @@ def run(cm):
 
 def test_second_compile_is_a_hit_with_identical_results(cache):
     cm1 = compile_model(two_masses())
-    assert not cm1.cache_hit and len(list(cache.glob("*.pkl"))) == 1
+    assert not cm1.cache_hit and len(list(cache.glob("compile/*.pkl"))) == 1
     cm2 = compile_model(two_masses())
     assert cm2.cache_hit and cm2.source == cm1.source
     r1, r2 = run(cm1), run(cm2)
@@ -56,7 +56,7 @@ def test_a_changed_model_misses(cache):
     assert not compile_model(two_masses(c=300.0)).cache_hit        # a parameter value
     assert not compile_model(two_masses(s0=0.06)).cache_hit        # a start value
     changed = compile_model(two_masses(damper=True))               # the structure
-    assert not changed.cache_hit and len(list(cache.glob("*.pkl"))) == 4
+    assert not changed.cache_hit and len(list(cache.glob("compile/*.pkl"))) == 4
     # it is the damped model that runs, not the cached undamped one
     assert not np.allclose(run(changed)["b.s"], run(compile_model(two_masses()))["b.s"],
                            rtol=1e-3, atol=1e-6)
@@ -64,7 +64,7 @@ def test_a_changed_model_misses(cache):
 
 def test_corrupt_entry_is_rebuilt(cache):
     compile_model(two_masses())
-    (entry,) = cache.glob("*.pkl")
+    (entry,) = cache.glob("compile/*.pkl")
     entry.write_bytes(b"not a pickle")
     cm = compile_model(two_masses())
     assert not cm.cache_hit
@@ -79,4 +79,4 @@ def test_cache_can_be_disabled(tmp_path, monkeypatch):
     assert not compile_model(two_masses()).cache_hit
     monkeypatch.setenv("ACAUSAL_CACHE", str(tmp_path))
     compile_model(two_masses(), cache=False)
-    assert not list(tmp_path.glob("*.pkl"))
+    assert not list(tmp_path.glob("**/*.pkl"))

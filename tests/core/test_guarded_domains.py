@@ -45,7 +45,7 @@ def test_guarded_terms_outside_their_domain(backend):
     if backend == "compiled":
         from acausal.runtime.backends import compiled
         try:
-            compiled._compiler()
+            compiled.c_compiler()
         except compiled.Unavailable:
             pytest.skip("no C compiler")
     res = cm.simulate(t_end=0.3, rtol=1e-9, atol=1e-12, backend=backend)

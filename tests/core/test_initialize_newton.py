@@ -4,7 +4,7 @@ import numpy as np
 import sympy as sp
 
 from acausal import Model, compile_model
-from acausal.runtime.initialize import _lstsq_scaled
+from acausal.runtime.linalg import lstsq_scaled
 from acausal.mechanics.levers import TwoArmLever
 from acausal.mechanics.translational import Force, Mass
 
@@ -37,4 +37,4 @@ def test_scaled_least_squares_keeps_small_columns():
     J = np.array([[1e9, 0.0], [0.0, 1e-9]])
     b = J @ np.array([1.0, 1.0])
     assert abs(np.linalg.lstsq(J, b, rcond=None)[0][1]) < 1e-6
-    assert np.allclose(_lstsq_scaled(J, b), [1.0, 1.0], rtol=1e-12)
+    assert np.allclose(lstsq_scaled(J, b), [1.0, 1.0], rtol=1e-12)

@@ -184,6 +184,7 @@ def test_sparse_initialisation_equals_the_dense_one(cm12, monkeypatch):
     spring-damper force, a row that is not a unit vector, and a free mass
     whose start is a guess), it gives the dense path's point."""
     import acausal.runtime.initialize as ini
+    import acausal.runtime.linalg as linalg
     m = Model()
     m.ground = Fixed()
     m.a = Mass(m=M, s=0.01, v=0.0)
@@ -196,9 +197,9 @@ def test_sparse_initialisation_equals_the_dense_one(cm12, monkeypatch):
     for cm in (cm12, compile_model(m, cache=False)):
         p, d = cm.param_vector(), cm.discrete_start()
         cb = cm.callbacks(p, d)
-        monkeypatch.setattr(ini, "SPARSE_MIN", 10 ** 9)
+        monkeypatch.setattr(linalg, "SPARSE_MIN", 10 ** 9)
         y_dense, yp_dense = ini.initial_point(cm, p, d, cb, 0.0)
-        monkeypatch.setattr(ini, "SPARSE_MIN", 0)
+        monkeypatch.setattr(linalg, "SPARSE_MIN", 0)
         y_sparse, yp_sparse = ini.initial_point(cm, p, d, cb, 0.0)
         scale = 1 + np.abs(y_dense)
         assert np.all(np.abs(y_sparse - y_dense) <= 1e-12 * scale)

@@ -13,7 +13,7 @@ import sympy as sp
 
 from acausal import Model, time
 from acausal.runtime.backends import compiled_available
-from acausal.compiler.pipeline import compile_model
+from acausal.runtime.model import compile_model
 from acausal.errors import ParameterError, UsageError
 from acausal.mechanics.contact import Contact, contact_period
 from acausal.mechanics.translational import Damper, Fixed, Force, Mass, Spring

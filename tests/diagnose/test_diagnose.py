@@ -15,7 +15,7 @@ import pytest
 from click.testing import CliRunner
 
 from acausal.cli import main
-from acausal.compiler.pipeline import CompiledModel
+from acausal.runtime.model import CompiledModel
 from acausal.diagnose.problem import FitSettings
 from acausal.diagnose.report.markdown import write_report
 from acausal.diagnose.report.result import summary

@@ -200,7 +200,7 @@ def test_build_extended_is_cached_per_structure_not_per_value():
     mf0, cm0 = compile_file(BREAKER)
     mf1, cm1 = build_extended(BREAKER, "contact_damping_law", "contact")
     mf2, cm2 = build_extended(BREAKER, "contact_damping_law", "contact", {"hyp_cd.a": 0.02})
-    assert mf1 is mf2 and cm2._make is cm1._make          # no recompilation
+    assert mf1 is mf2 and cm2.artefact.code is cm1.artefact.code   # no recompilation
     assert cm1.params[cm1.param_index("hyp_cd.a")].default == 0.0
     assert cm2.params[cm2.param_index("hyp_cd.a")].default == 0.02
     assert "hyp_cd" not in mf0.model.children()          # the cached nominal is untouched

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from acausal.compiler.pipeline import CompiledModel
+from acausal.runtime.model import CompiledModel
 from acausal.data import Dataset, Experiment, Instrument, Trace, write_dataset
 from acausal.diagnose.problem import FitSettings
 from acausal.diagnose.report.markdown import write_report

@@ -57,7 +57,6 @@ imports the original, and :func:`build_extended` the compiled extended
 model (cached per file version, hypothesis and location).
 """
 import copy
-import dataclasses
 import os
 from dataclasses import dataclass
 
@@ -65,7 +64,7 @@ import numpy as np
 import sympy as sp
 
 from ...lang import Model
-from ...compiler.pipeline import compile_model
+from ...runtime.model import compile_model
 from ...errors import ModelError
 from ...modelfile import load_model_file
 from .domain import domain_of
@@ -982,17 +981,9 @@ def build_pair(path, pair):
 
 
 def with_defaults(cm, values):
-    """A shallow copy of a compiled model whose free parameters default to
-    ``values`` (checked against their bounds); shares the generated code."""
-    new = {}
-    for name, v in values.items():
-        e = cm.params[cm.param_index(name)]
-        e.decl.check_bounds(float(v), name)
-        new[name] = float(v)
-    out = copy.copy(cm)
-    out.params = [dataclasses.replace(e, default=new[e.name]) if e.name in new else e
-                  for e in cm.params]
-    return out
+    """A compiled model whose free parameters default to ``values`` (checked
+    against their bounds); shares the generated code."""
+    return cm.with_defaults(values)
 
 
 def _fmt_value(v):

@@ -1,5 +1,5 @@
-"""Segment solvers: what the hybrid loop (:mod:`acausal.simulate`) asks of an
-integrator.
+"""Segment solvers: what the hybrid loop (:mod:`acausal.runtime.hybrid`) asks
+of an integrator.
 
 A *segment* is a stretch of integration in one mode (one set of discrete
 values) from a consistent point ``(t, y, y')``: the backend integrates it
@@ -13,11 +13,11 @@ Backends:
 
 ``"sundae"``
     scikit-sundae's IDA calling the generated Python callbacks (the
-    reference); :mod:`acausal.backends.sundae`.
+    reference); :mod:`.sundae`.
 ``"compiled"``
     SUNDIALS IDA (the library the scikit-sundae wheel ships) calling
     generated C compiled with the system's C compiler, with no Python call
-    per residual, Jacobian or root evaluation; :mod:`acausal.backends.compiled`.
+    per residual, Jacobian or root evaluation; :mod:`.compiled`.
     Without a C compiler it falls back to ``"sundae"`` and says so in
     ``res.stats["backend_fallback"]``.
 """
@@ -34,9 +34,10 @@ BAND_MAX_FRACTION = 0.25  # a band at most this fraction of n wide counts as nar
 @dataclass
 class LinearSolver:
     """IDA's linear solver for a model: its ``kind``, the keyword ``options``
-    for ``sksundae.ida.IDA`` and ``jac_index``, the position in
-    :meth:`acausal.compile.CompiledModel.callbacks` of the Jacobian callback that fills the
-    storage this solver uses (1: 2-D array, 6: CSC array)."""
+    for ``sksundae.ida.IDA`` and ``jac_index``, the position in the
+    :class:`~acausal.compiler.codegen.Callbacks` of the Jacobian callback
+    that fills the storage this solver uses (1: ``jac``, a 2-D array; 6:
+    ``jac_csc``, a CSC array)."""
     kind: str
     options: dict
     jac_index: int
@@ -95,9 +96,10 @@ class SegmentSolver:
         """The callbacks the hybrid loop uses between segments
         (initialisation, event actions, re-initialisation) in mode ``d``:
         those of ``model`` (this solver's, or one run beside it:
-        a sensitivity run's base model, :mod:`acausal.sensitivity`) with
-        parameters ``p``: the generated Python callbacks, or a backend's faster
-        equivalent of them (same tuple, same results)."""
+        a sensitivity run's base model, :mod:`acausal.runtime.sensitivity`)
+        with parameters ``p``: the generated Python callbacks, or a backend's
+        faster equivalent of them (same :class:`~acausal.compiler.codegen.Callbacks`,
+        same results)."""
         return model.callbacks(p, d)
 
 
@@ -126,10 +128,10 @@ def make_solver(name, cm, p, opts):
 
 def compiled_available():
     """None when the compiled backend can run here, else the reason."""
-    from .compiled import Unavailable, _compiler, _sundials_libs
+    from .compiled import Unavailable, c_compiler, sundials_libraries
     try:
-        _compiler()
-        _sundials_libs()
+        c_compiler()
+        sundials_libraries()
     except Unavailable as exc:
         return str(exc)
     return None
@@ -137,7 +139,7 @@ def compiled_available():
 
 def choose_linear_solver(sparsity, kind="auto"):
     """IDA's linear solver for an iteration matrix of pattern ``sparsity``
-    (:class:`acausal.codegen.Sparsity`): ``"dense"``, ``"band"`` (bandwidths
+    (:class:`acausal.compiler.codegen.Sparsity`): ``"dense"``, ``"band"`` (bandwidths
     from the pattern), ``"sparse"`` (SuperLU_MT on the CSC pattern) or
     ``"auto"``: dense below :data:`BAND_MIN_SIZE` unknowns or when the band
     is not narrow, else band. Raises UsageError for another ``kind``."""

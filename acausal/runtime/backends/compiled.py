@@ -2,18 +2,20 @@
 call per residual, Jacobian or root evaluation.
 
 The model's residual, iteration matrix and root functions are generated as
-C (:mod:`acausal.codegen_c`), compiled with the system's C compiler together
-with a small segment driver (``ida_driver.c``), and linked against the
-SUNDIALS 7 libraries that the scikit-sundae wheel ships, so nothing but pip
-and a C compiler is needed. The library is cached on disk, keyed by a hash
-of its sources, the compiler and the SUNDIALS libraries. Python sees one
-call per segment (and one per located root or full output buffer).
+C (:mod:`acausal.compiler.codegen_c`), compiled with the system's C compiler
+together with a small segment driver (``ida_driver.c``) and the
+re-initialisation Newton (``reinit.c``), and linked against the SUNDIALS 7
+libraries that the scikit-sundae wheel ships, so nothing but pip and a C
+compiler is needed. The library is kept in the on-disk store (namespace
+``c-build``, :mod:`acausal.infra.store`), keyed by a hash of its sources, the
+compiler and the SUNDIALS libraries. Python sees one call per segment (and
+one per located root or full output buffer).
 
-IDA is set up as :mod:`acausal.backends.sundae` sets it up, so both
-backends run the same integrator; the hybrid loop is shared.
+IDA is set up as :mod:`.sundae` sets it up, so both backends run the same
+integrator; the hybrid loop is shared.
 
 When there is no C compiler or no SUNDIALS library to link against,
-:class:`Unavailable` says why and :func:`acausal.backends.make_solver`
+:class:`Unavailable` says why and :func:`acausal.runtime.backends.make_solver`
 falls back to the reference backend (``res.stats["backend_fallback"]``).
 """
 import ctypes
@@ -27,14 +29,11 @@ import tempfile
 import weakref
 
 import numpy as np
-
-try:
-    import fcntl
-except ImportError:   # pragma: no cover - not on Windows (where the backend falls back)
-    fcntl = None
 from sympy.printing.codeprinter import PrintMethodNotImplementedError
 
+from ...compiler.codegen import Callbacks
 from ...compiler.codegen_c import generate_c
+from ...infra import store
 from . import Root, Segment, SegmentSolver
 
 _HERE = os.path.dirname(os.path.abspath(__file__))
@@ -53,14 +52,16 @@ _MESSAGES = {
     -8: "the residual function failed",
     -10: "the root function failed",
 }
-_loaded = weakref.WeakKeyDictionary()   # CompiledModel -> _Library
+_loaded = weakref.WeakKeyDictionary()   # compiled model -> _Library (the runtime's cache)
 
 
 class Unavailable(Exception):
     """The compiled backend cannot run here (the message says why)."""
 
 
-def _compiler():
+def c_compiler():
+    """The C compiler command (``$CC``, else cc, gcc or clang); Unavailable
+    when there is none."""
     cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc") or \
         shutil.which("clang")
     if not cc or not shutil.which(cc.split()[0]):
@@ -68,7 +69,7 @@ def _compiler():
     return cc
 
 
-def _sundials_libs():
+def sundials_libraries():
     """Full paths of the SUNDIALS shared libraries of the scikit-sundae wheel."""
     try:
         import sksundae
@@ -85,14 +86,10 @@ def _sundials_libs():
     return paths
 
 
-def _cache_dir():
-    """``compiled/`` in the compiled-model cache (:func:`acausal.cache.cache_dir`,
-    ``$ACAUSAL_CACHE``), or in ``$ACAUSAL_CACHE_DIR``; a library has to live
-    somewhere, so with the model cache off it is ``~/.cache/acausal``."""
-    from ...infra.store import cache_dir
-    d = os.environ.get("ACAUSAL_CACHE_DIR") or cache_dir() or os.path.join(
-        os.path.expanduser("~"), ".cache", "acausal")
-    d = os.path.join(str(d), "compiled")
+def _build_dir():
+    """The store's ``c-build`` namespace (created): a library has to live
+    somewhere, so with the store off it is the default location's."""
+    d = str(store.namespace("c-build", required=True))
     os.makedirs(d, exist_ok=True)
     return d
 
@@ -111,16 +108,16 @@ def _key(cm, cc, libs):
 
 
 def _build(cm):
-    """Path of the shared library of ``cm`` (compiled once per cache) and
+    """Path of the shared library of ``cm`` (compiled once per store) and
     whether it was compiled now."""
-    cc, libs = _compiler(), _sundials_libs()
+    cc, libs = c_compiler(), sundials_libraries()
     try:
-        out = os.path.join(_cache_dir(), f"acs_{_key(cm, cc, libs)}.so")
-        if not _once(out, lambda: _compile(cm, cc, libs, out)):
+        out = os.path.join(_build_dir(), f"acs_{_key(cm, cc, libs)}.so")
+        if not store.make_once(out, lambda: _compile(cm, cc, libs, out)):
             return out, False
     except OSError as exc:
-        raise Unavailable(f"cannot write the compiled-library cache: {exc} "
-                          "(set ACAUSAL_CACHE_DIR to a writable folder)") from None
+        raise Unavailable(f"cannot write the compiled-library store: {exc} "
+                          f"(set {store.ENV} to a writable folder)") from None
     return out, True
 
 
@@ -136,12 +133,11 @@ def _compile(cm, cc, libs, out):
         model_c = os.path.join(tmpdir, "model.c")
         with open(model_c, "w") as fh:
             fh.write(csrc.text)
-        tmp_so = os.path.join(tmpdir, "lib.so")
         libdir = os.path.dirname(libs[0])
         objs = [_driver_object(cc, src) for src in (_DRIVER, _REINIT)]
-        _run_cc(cc.split() + ["-O1", "-shared", "-fPIC", "-o", tmp_so, model_c, *objs] + libs
-                + [f"-Wl,-rpath,{libdir}", "-lm"], "the generated code")
-        os.replace(tmp_so, out)   # atomic: a reader never sees a partial file
+        with store.atomic(out) as tmp_so:      # a reader never sees a partial file
+            _run_cc(cc.split() + ["-O1", "-shared", "-fPIC", "-o", tmp_so, model_c, *objs]
+                    + libs + [f"-Wl,-rpath,{libdir}", "-lm"], "the generated code")
     finally:
         shutil.rmtree(tmpdir, ignore_errors=True)
 
@@ -155,33 +151,18 @@ def _run_cc(cmd, what):
 
 def _driver_object(cc, src):
     """The object file of one of the driver's C sources (the same for every
-    model: compiled once per cache, keyed by the compiler and the source
+    model: compiled once per store, keyed by the compiler and the source
     text), so that a model's build compiles only its own generated code."""
     with open(src) as fh:
         key = hashlib.sha256("\0".join([cc, fh.read()]).encode()).hexdigest()[:24]
-    out = os.path.join(_cache_dir(), f"{os.path.basename(src)[:-2]}_{key}.o")
+    out = os.path.join(_build_dir(), f"{os.path.basename(src)[:-2]}_{key}.o")
 
     def make():
-        tmp = f"{out}.{os.getpid()}.tmp.o"
-        _run_cc(cc.split() + ["-O1", "-fPIC", "-c", src, "-o", tmp], os.path.basename(src))
-        os.replace(tmp, out)    # atomic: a reader never sees a partial file
-    _once(out, make)
+        with store.atomic(out) as tmp:      # a reader never sees a partial file
+            _run_cc(cc.split() + ["-O1", "-fPIC", "-c", src, "-o", tmp],
+                    os.path.basename(src))
+    store.make_once(out, make)
     return out
-
-
-def _once(out, make):
-    """Make the file ``out`` with ``make()`` unless it exists; concurrent
-    processes (sweep workers) wait for one build. Returns whether it was
-    made now."""
-    if os.path.exists(out):
-        return False
-    with open(out + ".lock", "w") as lock:
-        if fcntl is not None:
-            fcntl.flock(lock, fcntl.LOCK_EX)
-        if os.path.exists(out):
-            return False
-        make()
-    return True
 
 
 class _Library:
@@ -207,7 +188,7 @@ class _Library:
         lib.acs_eval.argtypes = [ctypes.c_int, ctypes.c_double, dp, dp, dp, ctypes.c_double,
                                  dp]
         # the generated functions and the re-initialisation, called from
-        # Python with raw addresses (see CCallbacks)
+        # Python with raw addresses (see c_callbacks)
         lib.acs_res.argtypes = [ctypes.c_double, vp, vp, vp, vp]
         lib.acs_roots.argtypes = [ctypes.c_double, vp, vp, vp, vp]
         lib.acs_jacs.argtypes = [ctypes.c_double, vp, vp, vp, vp, vp]
@@ -346,7 +327,7 @@ class CompiledSolver(SegmentSolver):
         """Mode ``d``'s callbacks of ``model`` calling the compiled library;
         its generated Python callbacks are made only if one of theirs is
         called (the dense and sparse Jacobians, which IDA here takes from C)."""
-        return CCallbacks(library(model), model, p, d, lambda: model.callbacks(p, d))
+        return c_callbacks(library(model), model, p, d, lambda: model.callbacks(p, d))
 
 
 def _f64(a):
@@ -372,87 +353,97 @@ def _fixed_arrays(fixed):
             np.array([v for _, v, _ in fixed] or [0.0], dtype=float))
 
 
-class CCallbacks(tuple):
-    """The callbacks tuple of one mode (``cm.callbacks(p, d)``, same order
-    and signatures) with the residual, the root functions and the two
-    Jacobians ``jacs`` calling the compiled C instead of the generated
-    Python (the same expressions), for what the hybrid loop computes in
-    Python between segments: the initialisation, event actions and
-    re-initialisation. ``reinit(t, y, yp)`` is the re-initialisation in C
-    (``reinit.c``; :func:`acausal.initialize.reinitialize` calls it), or
-    None where the Python version must run; ``init_newton(t, z0,
-    guess_rows, fixed)`` the initialisation's Gauss-Newton in C (the same
-    return as :func:`acausal.initialize._newton`, or NotImplemented where the
-    Python version must run); ``init_check(t, z, fixed)`` the consistency
-    test of :func:`acausal.initialize._check` in C (True, False, or
-    NotImplemented where the Python test must run). The observed variables (``cb[4]``, an array
-    here) are C too unless one has no C form. ``make()`` returns the mode's
-    generated Python callbacks; it is called only when one of those runs."""
+class _CMode:
+    """The compiled library's functions bound to one mode: ``pd`` (the
+    parameters, then the discrete values) passed by its address, the array
+    kept alive with the functions that use it."""
 
-    def __new__(cls, L, cm, p, d, make):
-        lib, n, ns = L.lib, len(cm.dae.y), cm.dae.n_states
-        pd = np.ascontiguousarray(np.concatenate([np.asarray(p, float),
-                                                  np.asarray(d, float)]))
-        pdp = pd.ctypes.data or 0
+    def __init__(self, L, cm, p, d):
+        self.L, self.lib = L, L.lib
+        self.n, self.ns = len(cm.dae.y), cm.dae.n_states
+        self.pd = np.ascontiguousarray(np.concatenate([np.asarray(p, float),
+                                                       np.asarray(d, float)]))
+        self.pdp = self.pd.ctypes.data or 0
 
-        def res(t, y, yp, r):
-            y, yp = _f64(y), _f64(yp)
-            _into(lib.acs_res, r, t, y.ctypes.data, yp.ctypes.data, pdp)
+    def res(self, t, y, yp, r):
+        y, yp = _f64(y), _f64(yp)
+        _into(self.lib.acs_res, r, t, y.ctypes.data, yp.ctypes.data, self.pdp)
 
-        def roots(t, y, yp, g):
-            y, yp = _f64(y), _f64(yp)
-            _into(lib.acs_roots, g, t, y.ctypes.data, yp.ctypes.data, pdp)
+    def roots(self, t, y, yp, g):
+        y, yp = _f64(y), _f64(yp)
+        _into(self.lib.acs_roots, g, t, y.ctypes.data, yp.ctypes.data, self.pdp)
 
-        def jacs(t, y, yp, Jy, Jyp):
-            y, yp = _f64(y), _f64(yp)
-            jy = _f64(Jy)
-            _into(lib.acs_jacs, Jyp, t, y.ctypes.data, yp.ctypes.data, pdp, jy.ctypes.data)
-            if jy is not Jy:
-                Jy[...] = jy.reshape(np.shape(Jy))
+    def jacs(self, t, y, yp, Jy, Jyp):
+        y, yp = _f64(y), _f64(yp)
+        jy = _f64(Jy)
+        _into(self.lib.acs_jacs, Jyp, t, y.ctypes.data, yp.ctypes.data, self.pdp,
+              jy.ctypes.data)
+        if jy is not Jy:
+            Jy[...] = jy.reshape(np.shape(Jy))
 
-        def observe(t, y, yp):
-            y, yp = _f64(y), _f64(yp)
-            o = np.empty(L.n_obs)
-            lib.acs_observe(t, y.ctypes.data, yp.ctypes.data, pdp, o.ctypes.data)
-            return o
+    def observe(self, t, y, yp):
+        y, yp = _f64(y), _f64(yp)
+        o = np.empty(self.L.n_obs)
+        self.lib.acs_observe(t, y.ctypes.data, yp.ctypes.data, self.pdp, o.ctypes.data)
+        return o
 
-        def init_newton(t, z0, guess_rows, fixed, max_iter=50):
-            if L.n_obs is None or len(fixed) != L.n_fixed:
-                return NotImplemented
-            z = np.array(z0, dtype=float)
-            fk, fv = _fixed_arrays(fixed)
-            gk = np.array(list(guess_rows) or [0], dtype=np.intc)
-            flag = lib.acs_init_newton(n, ns, float(t), z.ctypes.data, pdp, len(fixed),
-                                       fk.ctypes.data, fv.ctypes.data, len(guess_rows),
-                                       gk.ctypes.data, max_iter)
-            return z if flag == 0 else (None if flag == 1 else NotImplemented)
+    def init_newton(self, t, z0, guess_rows, fixed, max_iter=50):
+        if self.L.n_obs is None or len(fixed) != self.L.n_fixed:
+            return NotImplemented
+        z = np.array(z0, dtype=float)
+        fk, fv = _fixed_arrays(fixed)
+        gk = np.array(list(guess_rows) or [0], dtype=np.intc)
+        flag = self.lib.acs_init_newton(self.n, self.ns, float(t), z.ctypes.data, self.pdp,
+                                        len(fixed), fk.ctypes.data, fv.ctypes.data,
+                                        len(guess_rows), gk.ctypes.data, max_iter)
+        return z if flag == 0 else (None if flag == 1 else NotImplemented)
 
-        def init_check(t, z, fixed):
-            if L.n_obs is None or len(fixed) != L.n_fixed:
-                return NotImplemented
-            z = _f64(z)
-            fk, fv = _fixed_arrays(fixed)
-            ok = lib.acs_init_check(n, ns, float(t), z.ctypes.data, pdp, len(fixed),
-                                    fk.ctypes.data, fv.ctypes.data)
-            return NotImplemented if ok < 0 else bool(ok)
+    def init_check(self, t, z, fixed):
+        if self.L.n_obs is None or len(fixed) != self.L.n_fixed:
+            return NotImplemented
+        z = _f64(z)
+        fk, fv = _fixed_arrays(fixed)
+        ok = self.lib.acs_init_check(self.n, self.ns, float(t), z.ctypes.data, self.pdp,
+                                     len(fixed), fk.ctypes.data, fv.ctypes.data)
+        return NotImplemented if ok < 0 else bool(ok)
 
-        def reinit(t, y, yp):
-            y2, yp2 = np.array(y, dtype=float), np.array(yp, dtype=float)
-            flag = lib.acs_reinit(n, ns, float(t), y2.ctypes.data, yp2.ctypes.data, pdp)
-            return (y2, yp2) if flag == 0 else None
+    def reinit(self, t, y, yp):
+        y2, yp2 = np.array(y, dtype=float), np.array(yp, dtype=float)
+        flag = self.lib.acs_reinit(self.n, self.ns, float(t), y2.ctypes.data,
+                                   yp2.ctypes.data, self.pdp)
+        return (y2, yp2) if flag == 0 else None
 
-        made = []
 
-        def python(k):   # the generated Python callback k, made on first use
-            def call(*args):
-                if not made:
-                    made.append(make())
-                return made[0][k](*args)
-            return call
+def c_callbacks(L, cm, p, d, make):
+    """The :class:`~acausal.compiler.codegen.Callbacks` of one mode of ``cm``
+    (parameters ``p``, discrete values ``d``; library ``L``) with the
+    residual, the root functions and the two Jacobians ``jacs`` calling the
+    compiled C instead of the generated Python (the same expressions), for
+    what the hybrid loop computes in Python between segments: the
+    initialisation, event actions and re-initialisation. ``reinit(t, y,
+    yp)`` is the re-initialisation in C (``reinit.c``;
+    :func:`acausal.runtime.initialize.reinitialize` calls it), or None where
+    the Python version must run; ``init_newton(t, z0, guess_rows, fixed)``
+    the initialisation's Gauss-Newton in C (the same return as
+    :func:`acausal.runtime.linalg.newton`, or NotImplemented where the Python
+    version must run); ``init_check(t, z, fixed)`` the initialisation's
+    consistency test in C (True, False, or NotImplemented where the Python
+    test must run). The observed variables (``observe``, an array here) are
+    C too unless one has no C form. ``make()`` returns the mode's generated
+    Python callbacks; it is called only when one of those runs (the dense
+    and sparse Jacobians, which IDA here takes from C)."""
+    mode = _CMode(L, cm, p, d)
+    made = []
 
-        obs = python(4) if L.n_obs is None else observe
-        # count: the step attempts the Python residual sees (none here)
-        self = super().__new__(cls, (res, python(1), roots, jacs, obs, [0, None], python(6)))
-        self.pd, self.reinit, self.init_newton = pd, reinit, init_newton
-        self.init_check = init_check
-        return self
+    def python(name):   # the generated Python callback ``name``, made on first use
+        def call(*args):
+            if not made:
+                made.append(make())
+            return getattr(made[0], name)(*args)
+        return call
+
+    # count: the step attempts the Python residual sees (none here)
+    return Callbacks(mode.res, python("jac"), mode.roots, mode.jacs,
+                     python("observe") if L.n_obs is None else mode.observe, [0, None],
+                     python("jac_csc"), reinit=mode.reinit, init_newton=mode.init_newton,
+                     init_check=mode.init_check)

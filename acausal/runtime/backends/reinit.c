@@ -1,7 +1,7 @@
 /* Consistent re-initialisation in C for acausal's compiled backend.
  *
- * The algorithm of acausal.initialize.reinitialize followed by
- * acausal.initialize._algebraic_rates, step for step, on the generated
+ * The algorithm of acausal.runtime.initialize.reinitialize followed by
+ * its _algebraic_rates, step for step, on the generated
  * acs_res and acs_jacs: keep the states, solve F(t, y, y') = 0 for the
  * algebraic unknowns and the states' y' by Newton (LU with partial
  * pivoting, as LAPACK's gesv behind scipy.linalg.solve), refined while the
@@ -136,8 +136,8 @@ int acs_reinit(int n, int ns, double t, double* y, double* yp, const double* pd)
 }
 
 /* ---------------------------------------------------------------------------
- * The initialisation's Gauss-Newton (acausal.initialize._newton with
- * _lstsq_scaled) on z = (y, y' of the states), for the system
+ * The initialisation's Gauss-Newton (acausal.runtime.linalg.newton with
+ * lstsq_scaled) on z = (y, y' of the states), for the system
  *   F(t, y, y') = 0,  observed[fk[a]] - fv[a] = 0 (fixed starts),
  *   z[gk[b]] - z0[gk[b]] = 0 (imposed guesses),
  * its Jacobian from acs_jacs, acs_fixjac (the fixed-start rows) and unit
@@ -268,7 +268,7 @@ static int lstsq_scaled(int m, int c, double* J, double* b, double* x, double* d
 }
 
 /* z (length n + ns): in the start z0, out the last iterate. Returns 0 (z
- * is the iterate _newton returns), 1 (_newton returns None: a non-finite
+ * is the iterate newton returns), 1 (newton returns None: a non-finite
  * residual) or -1 (run the Python version). */
 int acs_init_newton(int n, int ns, double t, double* z, const double* pd, int nf,
                     const int* fk, const double* fv, int ng, const int* gk, int max_iter) {
@@ -313,7 +313,7 @@ done:
   return flag;
 }
 
-/* The consistency test of acausal.initialize._check at z (length n + ns):
+/* The consistency test of acausal.runtime.initialize._check at z (length n + ns):
  * every row i of the residuals and the fixed starts (no guess rows) has
  * |r_i| <= 1e-7 (|J_i| . (|z| + 1e-12) + 1e-12) + 1e-10, written as that
  * function writes it (a NaN row passes there and here). Returns 1 when it

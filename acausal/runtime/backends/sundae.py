@@ -48,14 +48,14 @@ class SundaeSolver(SegmentSolver):
         kw.update(lin.options)
 
         def res(t, y, yp, r):
-            self.cb[0](t, y, yp, r)
+            self.cb.res(t, y, yp, r)
 
         def jac(t, y, yp, r, cj, J):
             self.cb[lin.jac_index](t, y, yp, r, cj, J)
         self.roots = None
         if cm.n_roots:
             def roots(t, y, yp, g):
-                self.cb[2](t, y, yp, g)
+                self.cb.roots(t, y, yp, g)
             roots.terminal = [not e.observer for e in cm.events] + [True] * len(cm.assertions)
             roots.direction = [e.direction for e in cm.events] + [-1] * len(cm.assertions)
             self.roots = roots
@@ -68,7 +68,7 @@ class SundaeSolver(SegmentSolver):
         tspan = np.concatenate([[t], np.asarray(tout, float)])
         _clear_event_log(self.roots, self.solved)
         self.solved = True
-        cb[5][0] = 0
+        cb.count[0] = 0
         sol = self.ida.solve(tspan, y, yp)
         st, sy, syp = np.atleast_1d(sol.t), np.atleast_2d(sol.y), np.atleast_2d(sol.yp)
         if len(tspan) == 2 and not every_step and len(st) > 2:
@@ -81,7 +81,7 @@ class SundaeSolver(SegmentSolver):
                 roots.append(Root(float(te), np.array(ye), np.array(ype),
                                   [i for i, s in enumerate(flags) if s != 0]))
         return Segment(st, sy, syp, int(sol.status), str(sol.message), roots,
-                       int(sol.nfev), int(sol.njev), int(cb[5][0]))
+                       int(sol.nfev), int(sol.njev), int(cb.count[0]))
 
 
 def _clear_event_log(roots, solved):
