@@ -12,6 +12,10 @@ dataclass and returns a new one:
 5. :mod:`.codegen` (Python) and :mod:`.codegen_c` (C) -- residual, analytic
    Jacobian, roots, observed variables.
 
-:mod:`.pipeline` runs them (cached on disk by :mod:`acausal.infra.store`).
-Nothing here imports the runtime.
+:mod:`.pipeline` runs them and returns a frozen
+:class:`~acausal.compiler.artefact.Artefact` (:mod:`.artefact`: parameter
+space, start plan, slot lookups, generated code), kept in the on-disk store's
+``compile`` namespace (:mod:`.cache`, :mod:`acausal.infra.store`). Nothing
+here imports the runtime, which simulates the artefact
+(:func:`acausal.runtime.model.compile_model`).
 """

@@ -174,13 +174,13 @@ class _Run:
         if solver is not None and solver.fallback:
             stats["backend_fallback"] = solver.fallback
         n = len(self.cm.dae.y)
-        T = concat(self.T, 0) if self.T else np.zeros(0)
-        rows = Rows(T, concat(self.Y, n), concat(self.YP, n),
-                    concat(self.D, len(self.cm.disc_syms)))
+        T = _concat(self.T, 0) if self.T else np.zeros(0)
+        rows = Rows(T, _concat(self.Y, n), _concat(self.YP, n),
+                    _concat(self.D, len(self.cm.disc_syms)))
         return self.observer.finish(self, rows, stats, status, message)
 
 
-def concat(blocks, width):
+def _concat(blocks, width):
     """The row blocks ``blocks`` as one array (``width`` columns when none)."""
     return np.concatenate(blocks) if blocks else np.zeros((0, width))
 
