@@ -34,8 +34,8 @@ FORMAT = 3
 NAMESPACE = "compile"
 _COMPILER_MODULES = ("compiler/flatten", "compiler/aliases", "compiler/structure",
                      "compiler/causalize", "compiler/codegen", "compiler/pipeline",
-                     "compiler/artefact", "compiler/cache", "lang/fastdiff", "lang/symbols",
-                     "lang/declare")
+                     "compiler/artefact", "compiler/cache", "compiler/units", "lang/fastdiff",
+                     "lang/symbols", "lang/declare")
 _source_hash = []
 
 

@@ -34,6 +34,7 @@ class VarInfo:
     desc: str
     owner: str
     port: bool = False     # a connector variable
+    unit_declared: bool = True   # False: no unit was given (not checked)
 
 
 @dataclass
@@ -94,9 +95,11 @@ def _declare(flat, comp):
         if isinstance(d, Parameter):
             flat.params[sym.name] = ParamInfo(sym, comp.value(name), d, path)
         elif isinstance(d, Variable):
-            flat.variables[sym.name] = VarInfo(sym, comp.start(name), d.unit, d.desc, path)
+            flat.variables[sym.name] = VarInfo(sym, comp.start(name), d.unit, d.desc, path,
+                                               unit_declared=d.unit_declared)
         elif isinstance(d, Discrete):
-            flat.discretes[sym.name] = VarInfo(sym, Start(d.start, True), d.unit, d.desc, path)
+            flat.discretes[sym.name] = VarInfo(sym, Start(d.start, True), d.unit, d.desc, path,
+                                               unit_declared=d.unit_declared)
     for name, ctype in comp.connectors().items():
         port = comp.port(name)
         for decls, syms in zip(ctype.pairs(), port.pairs()):

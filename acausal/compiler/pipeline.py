@@ -1,5 +1,5 @@
 """The pipeline from a model to generated callbacks, run once per model
-structure: flatten -> aliases -> structure check -> Pantelides (1988) ->
+structure: flatten -> units -> aliases -> structure check -> Pantelides (1988) ->
 dummy derivatives (Mattsson and Soederlind 1993) -> causalize -> codegen.
 The result, a frozen :class:`~acausal.compiler.artefact.Artefact`, serves
 any number of simulations (parameter sets, start values) without
@@ -23,6 +23,7 @@ from ..lang.declare import Start
 from ..errors import ModelError
 from ..lang.fastdiff import diff
 from .flatten import flatten
+from .units import check_units
 from .structure import Graph, check_structure, dummy_derivatives, pantelides
 from ..lang.symbols import base_and_order, time
 
@@ -56,9 +57,11 @@ def compile_artefact(model, cache=True):
 def _compile(model, flat, stage_s, key):
     """The compile stages after flattening: a
     :class:`acausal.compiler.cache.Entry` and the generated code."""
-    clock = _Stages(stage_s)
     param_syms = ParameterSpace.of(flat, {}).symbols
     disc_syms = [d.symbol for d in flat.discretes.values()]
+    clock = _Stages(stage_s)
+    check_units(flat)
+    clock.lap("units")
     red = eliminate_aliases(flat)
     clock.lap("aliases")
     check_structure(red.equations, red.unknowns, flat)
