@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 import sympy as sp
 
 from ..lang.component import Model
+from ..lang.connectors import SignalPort
 from ..lang.declare import Discrete, Parameter, Start, Variable
 from ..errors import ConnectionError_, ModelError
 from ..lang.symbols import base_and_order, time
@@ -99,6 +100,11 @@ def _declare(flat, comp):
             flat.discretes[sym.name] = VarInfo(sym, Start(d.start, True), d.unit, d.desc, path)
     for name, ctype in comp.connectors().items():
         port = comp.port(name)
+        if isinstance(port, SignalPort):
+            sym = port.symbol
+            flat.variables[sym.name] = VarInfo(sym, Start(0.0, False), ctype.unit, ctype.desc,
+                                               path, True)
+            continue
         for decls, syms in zip(ctype.pairs(), port.pairs()):
             for (vname, unit, desc), sym in zip(decls, syms):
                 flat.variables[sym.name] = VarInfo(sym, Start(0.0, False), unit, desc, path,
@@ -220,16 +226,21 @@ def _connections(flat, model, comps):
     sets = {}
     for port in parent:
         sets.setdefault(find(port), []).append(port)
+    dangling = []
     for members in sets.values():
-        if len(members) == 1 and members[0].ctype.optional:
-            for _, through in members[0].pairs():   # unconnected optional: no force
-                flat.equations.append(Equation(through, members[0].path,
-                                               "unconnected optional connector"))
+        members.sort(key=lambda p: p.path)
+        if isinstance(members[0], SignalPort):
+            dangling += _signal_node(flat, members)
             continue
         if len(members) == 1:
-            flat.unconnected.append(members[0].path)
+            # Modelica's rule: an unconnected connector's through variables
+            # are zero; the check lists it (flat.unconnected), it is no error
+            for _, through in members[0].pairs():
+                flat.equations.append(Equation(through, members[0].path,
+                                               "unconnected connector (no force)"))
+            if not members[0].ctype.optional:
+                flat.unconnected.append(members[0].path)
             continue
-        members.sort(key=lambda p: p.path)
         where = "connect(" + ", ".join(p.path for p in members) + ")"
         for k, (a0, _) in enumerate(members[0].pairs()):
             for p in members[1:]:
@@ -237,3 +248,31 @@ def _connections(flat, model, comps):
                                                "connection (across equal)"))
             flat.equations.append(Equation(sp.Add(*[p.pairs()[k][1] for p in members]),
                                            where, "connection (through sum to zero)"))
+    if dangling:
+        dangling.sort()
+        if len(dangling) == 1:
+            msg = (f"{dangling[0]}: input not connected (connect it to an output, e.g. a "
+                   "signal source's y)")
+        else:
+            msg = "inputs not connected: " + ", ".join(dangling) + \
+                " (connect each to an output, e.g. a signal source's y)"
+        raise ConnectionError_(msg, component=dangling[0])
+
+
+def _signal_node(flat, members):
+    """Equations of a node of signal connectors: every input equals the one
+    output. Returns the inputs of a node without an output (not connected)."""
+    outputs = [p for p in members if p.causality == "output"]
+    inputs = [p for p in members if p.causality == "input"]
+    if len(outputs) > 1:
+        raise ConnectionError_(
+            f"outputs {outputs[0].path} and {outputs[1].path} are connected to each other: "
+            "a signal has one source (connect an output to inputs only)",
+            component=outputs[1].path)
+    if not outputs:
+        return [p.path for p in inputs]
+    out = outputs[0].symbol
+    where = "connect(" + ", ".join(p.path for p in members) + ")"
+    for p in inputs:
+        flat.equations.append(Equation(p.symbol - out, where, "connection (input = output)"))
+    return []
