@@ -37,6 +37,7 @@ class VarInfo:
     owner: str
     port: bool = False     # a connector variable
     internal: bool = False  # made by the compiler (a time switch), not declared
+    nominal: float = None   # Modelica's nominal value (scales the absolute tolerance)
 
 
 @dataclass
@@ -101,7 +102,8 @@ def _declare(flat, comp):
         if isinstance(d, Parameter):
             flat.params[sym.name] = ParamInfo(sym, comp.value(name), d, path)
         elif isinstance(d, Variable):
-            flat.variables[sym.name] = VarInfo(sym, comp.start(name), d.unit, d.desc, path)
+            flat.variables[sym.name] = VarInfo(sym, comp.start(name), d.unit, d.desc, path,
+                                               nominal=comp.nominal(name))
         elif isinstance(d, Discrete):
             flat.discretes[sym.name] = VarInfo(sym, Start(d.start, True), d.unit, d.desc, path)
     for name, ctype in comp.connectors().items():
