@@ -41,6 +41,19 @@ def _check_start(value, label, unit):
                              "number", variable=label)
 
 
+def _binding(value, label):
+    """An input's binding: a number or a sympy expression (of time and
+    parameters), else a ParameterError."""
+    try:
+        expr = sp.sympify(value, strict=True)
+    except (sp.SympifyError, TypeError):
+        expr = None
+    if isinstance(value, bool) or not isinstance(expr, sp.Basic):
+        raise ParameterError(f"input {label} can be bound to a number or a sympy expression "
+                             f"of time and parameters, got {value!r}", variable=label)
+    return expr
+
+
 class Component:
     """Base of every component and model. Keyword arguments set parameter
     values (numbers, or sympy expressions of other parameters) and start
@@ -54,6 +67,7 @@ class Component:
         object.__setattr__(self, "_ports", {})
         object.__setattr__(self, "_values", {})
         object.__setattr__(self, "_starts", {})
+        object.__setattr__(self, "_bindings", {})
         for name, d in self.declarations().items():
             if isinstance(d, Parameter):
                 self._values[name] = d.default
@@ -75,10 +89,16 @@ class Component:
         return _collect(type(self), Connector)
 
     def set(self, **kw):
-        """Set parameter values and start values; checks bounds."""
+        """Set parameter values and start values; checks bounds. A value
+        given for an input connector (``Position(s_ref=sin(time))``) binds
+        that input to the expression, as a Modelica modifier does: it is
+        then set by it instead of by a connection."""
         decls = self.declarations()
         for key, value in kw.items():
             d = decls.get(key)
+            if d is None and getattr(self.connectors().get(key), "causality", None) == "input":
+                self._bindings[key] = _binding(value, f"{self.path or type(self).__name__}.{key}")
+                continue
             if d is None:
                 valid = ", ".join(n for n, x in decls.items() if not isinstance(x, Discrete))
                 raise ParameterError(
@@ -124,6 +144,11 @@ class Component:
     # -- behaviour (overridden by subclasses) --------------------------------
     def equations(self):
         """Equations of this class only (sympy ``Eq`` or expressions = 0)."""
+        return []
+
+    def initial_equations(self):
+        """Equations of this class that hold at the start only (Modelica's
+        ``initial equation``, e.g. a filter starting at its input)."""
         return []
 
     def events(self):

@@ -26,6 +26,7 @@ CHATTER_COUNT = 100     # this many firings of one event (root) ...
 CHATTER_SPAN = 1e-9     # ... within this fraction of the time span is chattering
 MAX_ITER = 20           # event iterations at one instant
 DEFAULT_BACKEND = "sundae"
+SAME_INSTANT = 256 * np.finfo(float).eps   # (relative) times closer than this are one
 MAX_ROWS = 1_000_000    # stored output rows, by default (each 8 bytes per unknown, twice)
 WINDOW_S = 0.25         # wall time per integration window when watched [s]
 PROGRESS_DELAY_S = 2.0  # a progress bar shows once a run has lasted this long [s]
@@ -261,7 +262,7 @@ def _integrate(run, watch, cb, t, y, yp, d, stop, tout, output_step):
     root, the end or a window of the watch), observer roots, event actions
     with re-initialisation and event iteration; output is recorded in ``run``."""
     t_end = run.t_end
-    while not stop and t < t_end:
+    while not stop and t < t_end - SAME_INSTANT * max(abs(t), abs(t_end)):
         if not run.schedule.empty():
             y, yp, d, cb, stop = _time_events(run, cb, t, y, yp, d)
             if stop:
@@ -329,9 +330,12 @@ def _tspan(t, tout, t_end, horizon, t_event=np.inf):
     cuts the run into windows (at least one output time), or up to the
     next time event ``t_event`` (which then ends the span: the solver
     stops exactly there)."""
+    # an output time closer to t than IDA can step (it refuses a tout within
+    # 100 unit round-offs of t: an output 1 ulp after a time event) is t
+    after = t + SAME_INSTANT * max(abs(t), abs(t_end))
     if t_event < t_end and (horizon is None or t_event <= horizon):
-        return np.concatenate([[t], tout[(tout > t) & (tout < t_event)], [t_event]])
-    later = tout[tout > t]
+        return np.concatenate([[t], tout[(tout > after) & (tout < t_event)], [t_event]])
+    later = tout[tout > after]
     if horizon is not None and horizon < t_end:
         cut = later[later <= horizon]
         if len(cut) == 0:

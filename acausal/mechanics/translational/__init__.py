@@ -12,13 +12,14 @@ connected to it add up there).
 from .components import Fixed, Mass, Rod, Spring, Damper, SpringDamper, ElastoGap
 from ..rotational.components import IdealGearR2T, IdealRollingWheel
 from .sources import (Force, Force2, RelativeForce, ConstantForce, SignForce,
-                      QuadraticSpeedDependentForce, LinearSpeedDependentForce, ForceStep, Position)
+                      QuadraticSpeedDependentForce, LinearSpeedDependentForce, ForceStep, Position, Speed,
+                      Accelerate, Move)
 from .sensors import (PositionSensor, SpeedSensor, AccSensor, ForceSensor, PowerSensor,
                       MultiSensor, RelPositionSensor, RelSpeedSensor, RelAccSensor)
 
 __all__ = ["Fixed", "Mass", "Rod", "Spring", "Damper", "SpringDamper", "ElastoGap",
            "IdealGearR2T", "IdealRollingWheel", "Force", "Force2", "RelativeForce",
            "ConstantForce", "SignForce", "QuadraticSpeedDependentForce",
-           "LinearSpeedDependentForce", "ForceStep", "Position", "PositionSensor", "SpeedSensor",
+           "LinearSpeedDependentForce", "ForceStep", "Position", "Speed", "Accelerate", "Move", "PositionSensor", "SpeedSensor",
            "AccSensor", "ForceSensor", "PowerSensor", "MultiSensor", "RelPositionSensor",
            "RelSpeedSensor", "RelAccSensor"]
