@@ -182,7 +182,7 @@ class PartialRotCompliantWithRelativeStates(PartialRotCompliant):
 
 
 # -- support flanges (MSL's useSupport) ------------------------------------------
-def _declared(ctype, name, desc):
+def declared_connector(ctype, name, desc):
     """A connector declaration named ``name`` outside a class body."""
     decl = ctype(desc)
     decl.name = name
@@ -237,7 +237,7 @@ class _WithSupport(PartialConditionalConnectors):
 
     useSupport = Parameter(False, "1", "true: a support flange (housing); false: grounded",
                            structural=True, choices=(False, True))
-    _conditional = {"support": ("useSupport", _declared(Flange, "support",
+    _conditional = {"support": ("useSupport", declared_connector(Flange, "support",
                                                         "support/housing of the component"))}
 
     def support_across(self):
@@ -253,7 +253,7 @@ class _WithSupport(PartialConditionalConnectors):
         return []
 
 
-_ROT_SUPPORT = {"support": ("useSupport", _declared(RotFlange, "support",
+_ROT_SUPPORT = {"support": ("useSupport", declared_connector(RotFlange, "support",
                                                     "support/housing of the component"))}
 
 
@@ -401,9 +401,9 @@ class PartialElementaryRotationalToTranslational(PartialConditionalConnectors):
     useSupportT = Parameter(False, "1", "true: a translational support flange; false: "
                             "grounded", structural=True, choices=(False, True))
     _conditional = {
-        "supportR": ("useSupportR", _declared(RotFlange, "supportR",
+        "supportR": ("useSupportR", declared_connector(RotFlange, "supportR",
                                               "rotational support/housing of the component")),
-        "supportT": ("useSupportT", _declared(Flange, "supportT",
+        "supportT": ("useSupportT", declared_connector(Flange, "supportT",
                                               "translational support/housing of the component")),
     }
 
