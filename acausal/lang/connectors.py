@@ -161,15 +161,18 @@ class Frame(Connector):
 
 
 class RealSignal(Connector):
-    """A causal signal connector: one real variable (unit ``unit``), no
-    through part. Use :class:`RealInput` or :class:`RealOutput`."""
+    """A causal signal connector: one real variable (unit ``unit``; none, as
+    MSL's plain ``Real`` signals, is not checked), no through part. Use
+    :class:`RealInput` or :class:`RealOutput`."""
 
     domain = "signal"
     causality = None     # "input" or "output"
 
-    def __init__(self, desc="", unit="1"):
+    def __init__(self, desc="", unit=None):
         super().__init__(desc)
-        self.unit = unit
+        # no unit (MSL's plain Real signal): shown as "1", not checked
+        self.unit_declared = unit is not None
+        self.unit = "1" if unit is None else unit
 
     @classmethod
     def pairs(cls):
