@@ -7,7 +7,8 @@
  * Compiled by acausal.interop.fmu at export, with
  *   -DACS_MODEL_ID="<id>"    (the model identifier; the fmi2 names are exported
  *                              without prefix, as a shared library does)
- *   -DACS_PYTHONHOME="..."   (sys.base_prefix of the exporting Python)
+ *   -DACS_PYTHON="..."       (sys.executable of the exporting Python)
+ *   -DACS_LIBPYTHON="..."    (the libpython it is linked to)
  *   -DACS_SYSPATH="a:b:..."  (its sys.path, appended when acausal is not found)
  * FMI's types and calling conventions are written out below (FMI 2.0
  * standard, section 2.1); this file needs only Python.h.
@@ -17,6 +18,7 @@
  * fmi2Error with the exception's text logged (never a crash). */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
+#include <dlfcn.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -56,8 +58,11 @@ typedef struct {
 #ifndef ACS_MODEL_ID
 #define ACS_MODEL_ID ""
 #endif
-#ifndef ACS_PYTHONHOME
-#define ACS_PYTHONHOME ""
+#ifndef ACS_PYTHON
+#define ACS_PYTHON ""
+#endif
+#ifndef ACS_LIBPYTHON
+#define ACS_LIBPYTHON ""
 #endif
 #ifndef ACS_SYSPATH
 #define ACS_SYSPATH ""
@@ -72,14 +77,25 @@ typedef struct {
     char *name;
 } Inst;
 
-/* The interpreter: the host's when it has one, else started once here. */
+/* The interpreter: the host's when it has one, else started once here as
+ * the exporting Python would start (its executable as the program name:
+ * a virtual environment's pyvenv.cfg and site-packages are found as when
+ * that executable runs). */
 static int ensure_python(void) {
     if (Py_IsInitialized())
         return 0;
-    if (ACS_PYTHONHOME[0] && !getenv("PYTHONHOME"))
-        setenv("PYTHONHOME", ACS_PYTHONHOME, 0);
-    Py_InitializeEx(0);
-    if (!Py_IsInitialized())
+    /* an importer that loaded this library with RTLD_LOCAL hid libpython's
+     * symbols from the extension modules Python loads: make them global */
+    if (ACS_LIBPYTHON[0] && !dlopen(ACS_LIBPYTHON, RTLD_NOW | RTLD_GLOBAL | RTLD_NOLOAD))
+        dlopen(ACS_LIBPYTHON, RTLD_NOW | RTLD_GLOBAL);
+    PyConfig config;
+    PyConfig_InitPythonConfig(&config);
+    config.install_signal_handlers = 0;   /* the importer's signals stay its own */
+    if (ACS_PYTHON[0])
+        PyConfig_SetBytesString(&config, &config.program_name, ACS_PYTHON);
+    PyStatus status = Py_InitializeFromConfig(&config);
+    PyConfig_Clear(&config);
+    if (PyStatus_Exception(status) || !Py_IsInitialized())
         return -1;
     PyEval_SaveThread();   /* release the GIL: every call takes it */
     return 0;

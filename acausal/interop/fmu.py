@@ -383,15 +383,17 @@ def _compile_shim(model_id, binary):
                              "missing (install the python3-dev package of this Python)")
     libdir = sysconfig.get_config_var("LIBDIR") or ""
     ldlib = sysconfig.get_config_var("LDLIBRARY") or ""
-    link = []
+    link, libpython = [], ""
     if sysconfig.get_config_var("Py_ENABLE_SHARED") and ldlib.endswith(".so"):
         name = ldlib[3:-3]   # libpython3.11.so -> python3.11
         link = [f"-L{libdir}", f"-l{name}", f"-Wl,-rpath,{libdir}"]
+        soname = sysconfig.get_config_var("INSTSONAME") or ldlib
+        libpython = os.path.join(libdir, soname)
     paths = [p for p in sys.path if p and os.path.isdir(p) and ":" not in p]
-    defs = [f'-DACS_MODEL_ID="{model_id}"', f'-DACS_PYTHONHOME="{_c(sys.base_prefix)}"',
-            f'-DACS_SYSPATH="{_c(":".join(paths))}"']
+    defs = [f'-DACS_MODEL_ID="{model_id}"', f'-DACS_PYTHON="{_c(sys.executable)}"',
+            f'-DACS_LIBPYTHON="{_c(libpython)}"', f'-DACS_SYSPATH="{_c(":".join(paths))}"']
     cmd = cc.split() + ["-O1", "-shared", "-fPIC", "-fvisibility=hidden", f"-I{inc}", *defs,
-                        SHIM, "-o", binary] + link
+                        SHIM, "-o", binary] + link + ["-ldl"]
     proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:
         first = (proc.stderr.strip().splitlines() or ["(no message)"])[0]
