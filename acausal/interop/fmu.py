@@ -43,8 +43,7 @@ import sympy as sp
 
 from ..errors import AcausalError, UsageError
 from ..lang.experiment import Measure
-from ..modelfile import compile_file
-from .fmu_instance import SPEC_FILE
+from .fmu_instance import SPEC_FILE, load_for_fmu
 
 SHIM = os.path.join(os.path.dirname(os.path.abspath(__file__)), "fmi2_python.c")
 PLATFORM = {"linux": "linux64", "darwin": "darwin64", "win32": "win64"}
@@ -70,8 +69,8 @@ def export_fmu(model_path, out, outputs=(), inputs=(), measures=True, backend=No
     out = _check_out(out)
     if sys.platform not in PLATFORM:
         raise FmuExportError(f"FMU export: platform {sys.platform!r} is not supported")
-    mf, cm = compile_file(model_path)
-    table = _variables(mf, cm, list(outputs), list(inputs), measures)
+    mf, cm, opened = load_for_fmu(model_path)
+    table = _variables(mf, cm, list(outputs), list(inputs), measures, opened)
     if not any(v["kind"] in ("output", "measure") or v.get("output") for v in table):
         raise UsageError(f"{mf.path}: the FMU would have no outputs: the model file declares "
                          "no measures; choose variables with --output NAME (e.g. "
@@ -129,22 +128,30 @@ def _experiment(mf):
 # The variable table (resources/acausal_fmu.json and modelDescription.xml)
 # ---------------------------------------------------------------------------
 
-def _variables(mf, cm, outputs, inputs, with_measures):
+def _variables(mf, cm, outputs, inputs, with_measures, opened=()):
     """The FMU's variables, one dict each: vr, name, kind (parameter, input,
     calculated, start, output, measure), unit, description, variability,
     start (where the importer may set it), output (a start value also
-    exported as an output)."""
+    exported as an output), param (the parameter behind an input). The
+    inputs are the declared ones (free parameters) and ``opened``, the
+    input connectors with no source (:func:`bind_open_inputs`)."""
     known = set(cm.var_names) | {d.symbol.name for d in cm.discretes}
     for name in outputs:
         if name not in known and name not in mf.measures:
             raise UsageError(f"--output {name}: the model has no variable {name!r}"
                              + _close(name, known | set(mf.measures)))
-    free = {e.name: e for e in cm.params}
+    behind = {o["param"] for o in opened}
+    free = {e.name: e for e in cm.params if e.name not in behind}
     for name in inputs:
         if name not in free:
             raise UsageError(f"--input {name}: not a free parameter of the model"
                              + _close(name, set(free)) + " (an input is a free parameter "
                              "the importer drives)")
+    driven = {o["name"] for o in opened}
+    for name in outputs:
+        if name in driven:
+            raise UsageError(f"--output {name}: an input of the FMU (an input connector "
+                             "nothing sets) cannot also be an output")
     wanted = [n for n in dict.fromkeys(outputs) if n in known]
     used = _used_parameters(cm)
     table = []
@@ -154,7 +161,7 @@ def _variables(mf, cm, outputs, inputs, with_measures):
         table.append(v)
 
     for e in cm.params:
-        if e.name in inputs:
+        if e.name in inputs or e.name in behind:
             continue
         add(name=e.name, kind="parameter", unit=e.unit, description=e.desc,
             variability="tunable" if sp.Symbol(e.name) in used else "fixed",
@@ -196,6 +203,9 @@ def _variables(mf, cm, outputs, inputs, with_measures):
         e = free[name]
         add(name=name, kind="input", unit=e.unit, description=e.desc, variability="continuous",
             start=float(e.default), param=name)
+    for o in opened:
+        add(name=o["name"], kind="input", unit=o["unit"], description=o["description"],
+            variability="continuous", start=0.0, param=o["param"])
     return table
 
 

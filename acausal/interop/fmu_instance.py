@@ -22,8 +22,10 @@ from urllib.parse import unquote, urlparse
 import numpy as np
 import sympy as sp
 
-from ..errors import AcausalError
-from ..modelfile import compile_file, measure_values
+from ..compiler.flatten import flatten
+from ..compiler.pipeline import compile_model
+from ..errors import AcausalError, ConnectionError_
+from ..modelfile import load_model_file, measure_values
 from ..runtime.hybrid import Stepper
 
 SPEC_FILE = "acausal_fmu.json"   # in the FMU's resources: the variables and settings
@@ -38,6 +40,51 @@ INSTANTIATED, INITIALIZING, STEPPING, TERMINATED_STATE, FAILED = (
 
 class FmuError(AcausalError):
     """What an FMI call asked that this instance cannot do (logged, fmi2Error)."""
+
+
+def load_for_fmu(path):
+    """(ModelFile, CompiledModel, open inputs) of a model file as an FMU runs
+    it: every causal input connector (``RealInput``) with no source is
+    bound to a new top-level parameter, which the FMU's input of the same
+    name (the connector's path) drives (:func:`bind_open_inputs`); then it
+    is compiled as :func:`acausal.modelfile.compile_file` does."""
+    mf = load_model_file(path)
+    opened = bind_open_inputs(mf.model)
+    if mf.experiment.stop is not None:
+        mf.model.event(mf.experiment.stop.event(mf.model))
+    return mf, compile_model(mf.model), opened
+
+
+def bind_open_inputs(model):
+    """Bind each input connector that nothing sets (no output connected to
+    it, no expression bound to it: what compiling refuses as 'input not
+    connected') to a new parameter of ``model``, default 0 in the
+    connector's unit; returns one dict per input: ``name`` (the connector's
+    path), ``param`` (the parameter), ``unit``, ``description``. Flattening
+    names the open inputs one at a time; a model without input connectors
+    is not flattened here."""
+    ports = {}
+    for comp in model.walk():
+        for name, ctype in comp.connectors().items():
+            if getattr(ctype, "causality", None) == "input":
+                port = comp.port(name)
+                ports[port.path] = port
+    opened = []
+    while ports:
+        try:
+            flatten(model)
+            break
+        except ConnectionError_ as exc:
+            port = ports.pop(exc.component, None)
+            if port is None or "not connected" not in str(exc):
+                raise
+        param = "fmu_input_" + port.path.replace(".", "_")
+        unit = getattr(port.ctype, "unit", None)
+        desc = f"the FMU's input {port.path}"
+        port.owner.set(**{port.name: model.parameter(param, 0.0, unit, desc)})
+        opened.append(dict(name=port.path, param=param, unit=unit or "1",
+                           description=port.ctype.desc or desc))
+    return opened
 
 
 def resource_path(uri):
@@ -69,7 +116,8 @@ class Instance:
             raise FmuError(f"GUID {guid!r} is not this FMU's ({self.spec['guid']}): the "
                            "modelDescription.xml and the binary come from different exports")
         self.vars = {v["vr"]: v for v in self.spec["variables"]}
-        self.mf, self.cm = compile_file(os.path.join(self.resources, self.spec["model_file"]))
+        self.mf, self.cm, _ = load_for_fmu(os.path.join(self.resources,
+                                                        self.spec["model_file"]))
         self.var_index = {n: k for k, n in enumerate(self.cm.var_names)}
         self.disc_index = {d.symbol.name: j for j, d in enumerate(self.cm.discretes)}
         self.reset()
