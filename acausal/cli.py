@@ -1,4 +1,4 @@
-"""The ``acausal`` command: simulate, animate, variables, calibrate, sweep, diagnose.
+"""The ``acausal`` command: simulate, animate, variables, calibrate, sweep, diagnose, fmu.
 
 Exit codes: 0 success, 2 a model or input error (an AcausalError: one
 readable line on stderr), 3 a solver failure (time and component named).
@@ -529,6 +529,32 @@ def diagnose(file, data, json_path, report_dir, scheduler, workers, hypotheses, 
     if out["extended_model"]:
         click.echo(f"extended model: {out['extended_model']}")
     click.echo(f"report: {report_dir}/report.md" + (f"; JSON: {json_path}" if json_path else ""))
+
+
+@main.command()
+@click.argument("file", type=click.Path(dir_okay=False))
+@click.option("-o", "--out", required=True, type=click.Path(dir_okay=False),
+              help="the FMU to write (.fmu)")
+@click.option("--output", "outputs", multiple=True, metavar="NAME",
+              help="a variable exported as an output (repeat for more); the model file's "
+                   "measures are outputs too")
+@click.option("--input", "inputs", multiple=True, metavar="PARAMETER",
+              help="a free parameter the importer drives as an input, held over each "
+                   "communication step (repeat for more)")
+@click.option("--measures/--no-measures", default=True,
+              help="export the model file's measures as outputs (default: yes)")
+@click.option("--fmu-backend", type=click.Choice(["sundae", "compiled"]),
+              help="the integrator inside the FMU (default: the library's, or "
+                   "ACAUSAL_BACKEND where it runs)")
+def fmu(file, out, outputs, inputs, measures, fmu_backend):
+    """Export a model file as an FMU (FMI 2.0 Co-Simulation)."""
+    from .interop.fmu import export_fmu
+    try:
+        path = export_fmu(file, out, outputs=outputs, inputs=inputs, measures=measures,
+                          backend=fmu_backend)
+    except AcausalError as exc:
+        _fail(exc)
+    click.echo(f"wrote {path}")
 
 
 if __name__ == "__main__":  # pragma: no cover
