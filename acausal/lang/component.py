@@ -150,7 +150,7 @@ class Component:
         port = self._ports.get(name)
         if port is None:
             ctype = self.connectors()[name]
-            port = self._ports[name] = Port(self, name, ctype)
+            port = self._ports[name] = ctype.make_port(self, name)
         return port
 
     # -- behaviour (overridden by subclasses) --------------------------------
