@@ -64,7 +64,7 @@ from ..compiler.codegen import Names
 from ..errors import AcausalError, AnalysisError, UsageError
 from ..lang.fastdiff import diff
 from ..lang.symbols import time
-from ..runtime.initialize import reinitialize
+from ..runtime.initialize import ask_components, reinitialize
 
 __all__ = ["linearize", "trim", "Linearization", "Equilibrium"]
 
@@ -199,6 +199,11 @@ def _residual_check(cm, pt, what):
         k = int(np.argmax(np.where(bad, np.abs(r) / scale, -1)))
         origin = cm.dae.origins[k]
         text = origin.describe() if hasattr(origin, "describe") else str(origin)
+        paths = [getattr(cm.dae.origins[i], "origin", None) for i in np.flatnonzero(bad)]
+        own = ask_components(cm.model, "initialization_failure", [q for q in paths if q],
+                             f" ({text} is violated by {r[k]:.3g})")
+        if own is not None:       # a component's own words (a loop that cannot close)
+            raise AnalysisError(f"inconsistent {what}: {own}", component=own.component)
         raise AnalysisError(f"inconsistent {what}: {text} is violated by {r[k]:.3g}",
                             component=getattr(origin, "origin", None))
 
@@ -259,34 +264,94 @@ def _show(values):
 # inputs, outputs and their derivatives
 # ---------------------------------------------------------------------------
 
-def _input_names(cm, inputs):
-    """(names, values given): ``inputs`` as a list of names or a dict name ->
-    value; every name a free parameter (a declared input)."""
-    if isinstance(inputs, str):
-        inputs = [s for s in inputs.split(",") if s.strip()]
+@dataclass
+class _Input:
+    """An input: ``name`` as the user gave it, the free parameter ``param``
+    it moves, and ``value = a * param + b`` (a parameter itself: a = 1, b =
+    0; a signal fed by a constant source, ``force.f`` from ``u.k``: its
+    resolved expression, affine in that one parameter)."""
+    name: str
+    param: str
+    a: object
+    b: object
+
+    def coefficients(self, cm, p):
+        """(a, b) as numbers at the parameter vector ``p``."""
+        vals = dict(zip(cm.param_syms, map(float, p)))
+        return float(sp.sympify(self.a).xreplace(vals)), float(sp.sympify(self.b).xreplace(vals))
+
+
+def _split(names):
+    if isinstance(names, str):
+        names = [s for s in names.split(",") if s.strip()]
+    return names
+
+
+def _inputs(cm, inputs, what="inputs"):
+    """(list of :class:`_Input`, {name: value given}) of ``inputs``: a list
+    of names or a dict name -> value. A name is a free parameter (a
+    declared input, ``model.parameter("u", ...)``; a source's level, a
+    force's ``f_const``) or a variable -- a causal signal, ``force.f`` --
+    that the model makes an affine function of one free parameter (a
+    ``Constant`` block's ``k`` wired into it)."""
+    inputs = _split(inputs)
     values = dict(inputs) if isinstance(inputs, dict) else {}
     names = [str(n).strip() for n in inputs]
     if len(set(names)) != len(names):
-        raise AnalysisError(f"inputs: a name is given twice in {names}")
+        raise AnalysisError(f"{what}: a name is given twice in {names}")
     free = {e.name for e in cm.params}
+    out = []
     for n in names:
-        if n not in free:
-            why = ""
-            try:
-                cm.param_index(n)
-            except AcausalError as exc:
-                why = f" ({exc})"
-            shown = ", ".join(sorted(free)[:10]) + (" ..." if len(free) > 10 else "")
+        if n in free:
+            out.append(_Input(n, n, 1, 0))
+            continue
+        if n in cm.flat.variables:
+            e = cm.resolve(sp.Symbol(n))
+            ps = [q for q in e.free_symbols if q.name in free]
+            if len(ps) == 1 and all(q.name in free for q in e.free_symbols):
+                a = diff(e, ps[0])
+                if not a.has(ps[0]) and a != 0:
+                    out.append(_Input(n, ps[0].name, a, e.xreplace({ps[0]: 0})))
+                    continue
             raise AnalysisError(
-                f"inputs: {n!r} is not an input of the model{why}; an input is a free "
-                f"parameter (a declared model.parameter, a source's level such as a force's "
-                f"f); the model has: {shown}", variable=n)
-    return names, values
+                f"{what}: {n} is a variable that the model computes (from "
+                f"{', '.join(sorted(q.name for q in e.free_symbols)) or 'constants'}), not an "
+                "input: wire a Constant source (acausal.blocks) into it, or name a free "
+                "parameter", variable=n)
+        why = ""
+        try:
+            cm.param_index(n)
+        except AcausalError as exc:
+            why = f" ({exc})"
+        shown = ", ".join(sorted(free)[:10]) + (" ..." if len(free) > 10 else "")
+        raise AnalysisError(
+            f"{what}: {n!r} is not an input of the model{why}; an input is a free parameter "
+            "(a declared model.parameter, a source's level such as a force's f_const) or a "
+            f"signal fed by a Constant source; the model's parameters: {shown}", variable=n)
+    return out, values
+
+
+def _input_params(cm, ins, values, params):
+    """``params`` with the inputs' given ``values`` turned into values of
+    the parameters they move."""
+    params = dict(params)
+    given = [u for u in ins if u.name in values]
+    if given:
+        p = cm.param_vector({k: v for k, v in params.items() if k in
+                             {e.name for e in cm.params}})
+        for u in given:
+            try:
+                v = float(values[u.name])
+            except (TypeError, ValueError):
+                raise AnalysisError(f"input {u.name} = {values[u.name]!r} is not a number",
+                                    variable=u.name) from None
+            a, b = u.coefficients(cm, p)
+            params[u.param] = (v - b) / a
+    return params
 
 
 def _output_names(cm, outputs):
-    if isinstance(outputs, str):
-        outputs = [s for s in outputs.split(",") if s.strip()]
+    outputs = _split(outputs)
     names = [str(n).strip() for n in outputs]
     for n in names:
         if n not in cm.flat.variables:
@@ -370,14 +435,16 @@ class Linearization:
 
     def to_statespace(self):
         """The python-control ``StateSpace`` (``pip install control``) with
-        the state, input and output names."""
+        the state, input and output names (python-control refuses dots in
+        signal names: ``rev.phi`` is labelled ``rev_phi``)."""
         try:
             import control
         except ImportError:
             raise UsageError("to_statespace needs python-control: pip install control "
                              "(or acausal[control])") from None
-        return control.ss(self.A, self.B, self.C, self.D, states=list(self.states),
-                          inputs=list(self.inputs), outputs=list(self.outputs))
+        label = (lambda names: [n.replace(".", "_") for n in names])
+        return control.ss(self.A, self.B, self.C, self.D, states=label(self.states),
+                          inputs=label(self.inputs), outputs=label(self.outputs))
 
     def as_dict(self):
         """Plain lists (JSON): the matrices, names, point and eigenvalues."""
@@ -456,22 +523,21 @@ def linearize(cm, at=None, inputs=(), outputs=(), *, params=None, t=None, backen
     states, ``C = I``). ``params``: other parameter and fixed-start
     overrides. ``rtol``, ``atol``, ``backend``: of the simulation to ``at``.
     Discrete modes are the point's (held fixed)."""
-    in_names, in_values = _input_names(cm, inputs)
+    ins, in_values = _inputs(cm, inputs)
     out_names = _output_names(cm, outputs)
-    params = dict(params or {})
-    params.update(in_values)
+    params = _input_params(cm, ins, in_values, params or {})
     pt = _point(cm, at, params, t, backend, rtol, atol)
-    return _linearize_at(cm, pt, in_names, out_names)
+    return _linearize_at(cm, pt, ins, out_names)
 
 
-def _linearize_at(cm, pt, in_names, out_names):
+def _linearize_at(cm, pt, ins, out_names):
     dae = cm.dae
     n, ns = len(dae.y), dae.n_states
     states = state_names(cm)
     default_out = not out_names
     if default_out:
         out_names = list(states)
-    der = _derivatives(cm, in_names, [] if default_out else out_names)
+    der = _derivatives(cm, [u.param for u in ins], [] if default_out else out_names)
     cb = cm.callbacks(pt.p, pt.d)
     Jy, Jyp = np.zeros((n, n)), np.zeros((n, n))
     cb[3](pt.t, pt.y, pt.yp, Jy, Jyp)
@@ -480,20 +546,25 @@ def _linearize_at(cm, pt, in_names, out_names):
     rhs = -np.hstack([Jy[:, :ns], Fu])
     W = _solve(cm, E, rhs, pt)
     dz, dxp = W[:n - ns], W[n - ns:]
-    A, B = dxp[:, :ns], dxp[:, ns:]
+    ab = [u.coefficients(cm, pt.p) for u in ins]
+    per = np.array([1.0 / a for a, _ in ab]) if ins else np.zeros(0)   # d(param)/d(input)
+    A, B = dxp[:, :ns], dxp[:, ns:] * per
     if default_out:
-        C, D = np.eye(ns), np.zeros((ns, len(in_names)))
+        C, D = np.eye(ns), np.zeros((ns, len(ins)))
         y0 = np.array(pt.y[:ns])
     else:
         C = Hy[:, :ns] + Hy[:, ns:] @ dz[:, :ns] + Hyp[:, :ns] @ A
-        D = Hu + Hy[:, ns:] @ dz[:, ns:] + Hyp[:, :ns] @ B
+        D = Hu * per + Hy[:, ns:] @ dz[:, ns:] * per + Hyp[:, :ns] @ B
         obs = dict(zip(cm.var_names, cb[4](pt.t, pt.y, pt.yp)))
         y0 = np.array([obs[o] for o in out_names], dtype=float)
-    u0 = np.array([pt.p[cm.param_index(u)] for u in in_names], dtype=float)
+    u0 = np.array([a * pt.p[cm.param_index(u.param)] + b for u, (a, b) in zip(ins, ab)],
+                  dtype=float)
     units = {name: cm.flat.variables[name].unit for name in list(states) + out_names
              if name in cm.flat.variables}
-    units.update({u: cm.params[cm.param_index(u)].unit for u in in_names})
-    return Linearization(A, B, C, D, states, list(in_names), list(out_names), float(pt.t),
+    units.update({u.name: (cm.flat.variables[u.name].unit if u.name in cm.flat.variables
+                           else cm.params[cm.param_index(u.param)].unit) for u in ins})
+    return Linearization(A, B, C, D, states, [u.name for u in ins], list(out_names),
+                         float(pt.t),
                          np.array(pt.y[:ns], dtype=float), u0, y0, units)
 
 
@@ -541,14 +612,12 @@ def trim(cm, inputs=None, *, hold=None, free=(), start=None, params=None, t=0.0,
     Returns an :class:`Equilibrium`; an :class:`~acausal.errors.AnalysisError`
     in one line when there is none (the equation left unbalanced, and its
     component), or when it lies where an event changes the mode."""
-    in_names, in_values = _input_names(cm, inputs or {})
-    free = [free] if isinstance(free, str) else list(free)
-    free_names, _ = _input_names(cm, free)
-    both = set(in_names) & set(free_names)
+    ins, in_values = _inputs(cm, inputs or {})
+    frees, _ = _inputs(cm, free, "free")
+    both = {u.param for u in ins} & {u.param for u in frees}
     if both:
         raise AnalysisError(f"trim: {sorted(both)[0]} is both a fixed input and a free one")
-    params = dict(params or {})
-    params.update(in_values)
+    params = _input_params(cm, ins, in_values, params or {})
     pt = _start(cm, params, float(t), backend)
     dae = cm.dae
     n, ns = len(dae.y), dae.n_states
@@ -558,14 +627,14 @@ def trim(cm, inputs=None, *, hold=None, free=(), start=None, params=None, t=0.0,
     held = set()
     if hold:
         y, held = _set_states(cm, _Point(pt.t, y, pt.yp, pt.d, pt.p), hold, "trim hold")
-    if len(free_names) > len(held):
-        raise AnalysisError(f"trim: {len(free_names)} free inputs for {len(held)} held "
+    if len(frees) > len(held):
+        raise AnalysisError(f"trim: {len(frees)} free inputs for {len(held)} held "
                             "states: each free input needs a held state to determine it")
     rest = _zero_at_rest(cm) - held
     y[list(rest)] = 0.0
     cols = [k for k in range(n) if k not in held and k not in rest]
-    fidx = [cm.param_index(u) for u in free_names]
-    der = _derivatives(cm, free_names, [])
+    fidx = [cm.param_index(u.param) for u in frees]
+    der = _derivatives(cm, [u.param for u in frees], [])
     p = np.array(pt.p, dtype=float)
     yp = np.zeros(n)
     d = pt.d
@@ -633,9 +702,12 @@ def trim(cm, inputs=None, *, hold=None, free=(), start=None, params=None, t=0.0,
     y_eq, p_eq = best.y, best.p
     eq_pt = _Point(pt.t, y_eq, yp, d, p_eq)
     _check_modes(cm, pt, eq_pt)
-    solved = {u: float(p_eq[k]) for u, k in zip(free_names, fidx)}
     out_params = dict(params)
-    out_params.update(solved)
+    out_params.update({u.param: float(p_eq[k]) for u, k in zip(frees, fidx)})
+    solved = {}
+    for u, k in zip(frees, fidx):
+        a, b = u.coefficients(cm, p_eq)
+        solved[u.name] = a * float(p_eq[k]) + b
     return Equilibrium(cm, eq_pt, {**in_values, **solved}, out_params)
 
 
