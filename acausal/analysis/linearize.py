@@ -198,7 +198,7 @@ def _residual_check(cm, pt, what):
     if bad.any():
         k = int(np.argmax(np.where(bad, np.abs(r) / scale, -1)))
         origin = cm.dae.origins[k]
-        text = origin.describe() if hasattr(origin, "describe") else str(origin)
+        text = _equation(origin)
         paths = [getattr(cm.dae.origins[i], "origin", None) for i in np.flatnonzero(bad)]
         own = ask_components(cm.model, "initialization_failure", [q for q in paths if q],
                              f" ({text} is violated by {r[k]:.3g})")
@@ -253,6 +253,17 @@ def _point(cm, at, params, t, backend, rtol, atol):
         return new
     raise AnalysisError(f"at: expected 'start', 'equilibrium', a time [s], a dict of state "
                         f"values, a Result or an Equilibrium, got {at!r}")
+
+
+def _equation(origin, longest=100):
+    """An equation named for a one-line message: its label and component,
+    and its text when that is short."""
+    if not hasattr(origin, "describe"):
+        return str(origin)
+    text = origin.describe()
+    if len(text) <= longest + 40:
+        return text
+    return f"{origin.label or 'equation'} of {origin.origin or 'the model'}"
 
 
 def _show(values):
@@ -806,8 +817,7 @@ def _no_equilibrium(cm, r, J, w, inputs):
                "is not finite)"
     scale = np.abs(J) @ (np.abs(w) + 1.0) + 1e-300
     k = int(np.argmax(np.abs(r) / scale))
-    origin = cm.dae.origins[k]
-    text = origin.describe() if hasattr(origin, "describe") else str(origin)
+    text = _equation(cm.dae.origins[k])
     return (f"no static equilibrium{loads}: with every state at rest, {text} stays "
             f"unbalanced by {r[k]:.4g} at the closest point found")
 
