@@ -54,6 +54,7 @@ body's position) where they start. The modes are the start's (after its
 event iteration); a point where one of the model's events would change the
 mode is refused, naming the event.
 """
+import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -67,6 +68,8 @@ from ..lang.symbols import time
 from ..runtime.initialize import ask_components, reinitialize
 
 __all__ = ["linearize", "trim", "Linearization", "Equilibrium"]
+
+_memo = weakref.WeakKeyDictionary()     # compiled model -> {what: made once per model}
 
 
 # ---------------------------------------------------------------------------
@@ -168,12 +171,12 @@ def _set_states(cm, pt, values, what):
             raise AnalysisError(f"{what}: {name} = {v!r} is not a number", variable=name) from None
         k, fn = _state_setter(cm, name, pt.p)
         val = fn(v)
-        if k in slots and abs(slots[k][1] - val) > 1e-12 * (1 + abs(val)):
+        if k in slots and abs(slots[k][2] - val) > 1e-12 * (1 + abs(val)):
             raise AnalysisError(
-                f"inconsistent {what}: {slots[k][0]} = {values[slots[k][0]]:g} and {name} = "
+                f"inconsistent {what}: {slots[k][0]} = {slots[k][1]:g} and {name} = "
                 f"{v:g} name the same state ({state_names(cm)[k]}) with different values",
                 variable=name)
-        slots[k] = (name, val)
+        slots[k] = (name, v, val)
         y[k] = val
     return y, {k for k in slots}
 
@@ -581,8 +584,8 @@ def _linearize_at(cm, pt, ins, out_names):
 
 def _derivatives(cm, inputs, outputs):
     """:class:`_Derivatives` made once per model, inputs and outputs."""
-    memo = cm.__dict__.setdefault("_analysis_derivatives", {})
-    key = (tuple(inputs), tuple(outputs))
+    memo = _memo.setdefault(cm, {})
+    key = ("derivatives", tuple(inputs), tuple(outputs))
     if key not in memo:
         memo[key] = _Derivatives(cm, inputs, outputs)
     return memo[key]
@@ -726,7 +729,7 @@ def _zero_at_rest(cm):
     """The unknowns that are zero in every static equilibrium: those a
     state's row equates to its derivative (``x' = v``: ``v = 0`` at rest),
     found as rows that are ``c * y_j`` once the derivatives are 0."""
-    memo = cm.__dict__.get("_zero_at_rest")
+    memo = _memo.setdefault(cm, {}).get("zero at rest")
     if memo is None:
         dae = cm.dae
         zero = {s: 0 for s in dae.yp if s is not None}
@@ -739,7 +742,7 @@ def _zero_at_rest(cm):
                 c = diff(e, syms[0])
                 if c.is_number and c != 0 and sp.simplify(e - c * syms[0]) == 0:
                     memo.add(index[syms[0]])
-        cm.__dict__["_zero_at_rest"] = memo
+        _memo[cm]["zero at rest"] = memo
     return set(memo)
 
 
