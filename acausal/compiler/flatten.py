@@ -37,6 +37,7 @@ class VarInfo:
     owner: str
     port: bool = False     # a connector variable
     internal: bool = False  # made by the compiler (a time switch), not declared
+    unit_declared: bool = True   # False: no unit was given (not checked)
 
 
 @dataclass
@@ -100,9 +101,11 @@ def _declare(flat, comp):
         if isinstance(d, Parameter):
             flat.params[sym.name] = ParamInfo(sym, comp.value(name), d, path)
         elif isinstance(d, Variable):
-            flat.variables[sym.name] = VarInfo(sym, comp.start(name), d.unit, d.desc, path)
+            flat.variables[sym.name] = VarInfo(sym, comp.start(name), d.unit, d.desc, path,
+                                               unit_declared=d.unit_declared)
         elif isinstance(d, Discrete):
-            flat.discretes[sym.name] = VarInfo(sym, Start(d.start, True), d.unit, d.desc, path)
+            flat.discretes[sym.name] = VarInfo(sym, Start(d.start, True), d.unit, d.desc, path,
+                                               unit_declared=d.unit_declared)
     for name, ctype in comp.connectors().items():
         port = comp.port(name)
         if isinstance(port, SignalPort):
