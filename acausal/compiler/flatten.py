@@ -111,7 +111,7 @@ def _declare(flat, comp):
         if isinstance(port, SignalPort):
             sym = port.symbol
             flat.variables[sym.name] = VarInfo(sym, Start(0.0, False), ctype.unit, ctype.desc,
-                                               path, True)
+                                               path, True, unit_declared=ctype.unit_declared)
             continue
         for decls, syms in zip(ctype.pairs(), port.pairs()):
             for (vname, unit, desc), sym in zip(decls, syms):
