@@ -30,9 +30,11 @@ The matrix ``E = [F_z  F_x']`` is square and regular exactly when the DAE
 has index 1 at the point (the compiler's index reduction guarantees it away
 from singular configurations), so the algebraic part is eliminated by one
 solve: ``[dz; dx'] = -E^-1 [F_x  F_u] [dx; du]``. Its lower block rows give
-``A = dx'/dx`` and ``B = dx'/du`` -- the Schur complement of the algebraic
-block, ``A = -(F_x' - F_z F_zz^-1 F_zx')^-1 (F_x - F_z F_zz^-1 ...)``
-written as one block solve rather than by its formula. An output
+``A = dx'/dx`` and ``B = dx'/du``: with the rows ordered so that ``F_z``'s
+upper part ``Z1`` is square and regular, ``A = -S^-1 (X2 - Z2 Z1^-1 X1)``,
+``S = P2 - Z2 Z1^-1 P1`` the Schur complement of the algebraic block (``X``,
+``P`` the matching parts of ``F_x``, ``F_x'``); one LU solve of ``E`` gives
+the same without forming it, whatever the rows' order. An output
 ``h(t, x, z, x', u)`` (any variable of the model, resolved to the DAE's
 unknowns) gives ``C = h_x + h_z dz/dx + h_x' A``, ``D = h_u + h_z dz/du +
 h_x' B``.
@@ -47,12 +49,17 @@ Trim
 ----
 A static equilibrium is a consistent point with ``x' = 0``:
 ``F(t, x, z, 0, u) = 0`` for the unknowns ``(x, z)`` -- and, for a trim
-with held states, the inputs named ``free`` instead of those states. It is
-solved by Gauss-Newton from the model's start (or given guesses), the
-minimum-norm step leaving the coordinates that no force pins (a free
-body's position) where they start. The modes are the start's (after its
-event iteration); a point where one of the model's events would change the
-mode is refused, naming the event.
+with held states, the inputs named ``free`` instead of those states. The
+unknowns that a state's row equates to a derivative (``v`` in ``x' = v``)
+are zero at rest and taken out. The rest is solved by trust-region least
+squares (scipy's ``trf``, the exact Jacobian, each unknown scaled by its
+size) from the model's start or given guesses. A start between equilibria
+-- where the unbalance does not change to first order along some states,
+a pendulum released horizontal -- is also left both ways along those
+directions, and the stable equilibrium found is kept (the largest real part
+of its eigenvalues smallest): a pendulum at rest hangs. The modes are the
+start's (after its event iteration); a point where one of the model's
+events would change the mode is refused, naming the event.
 """
 import weakref
 from dataclasses import dataclass, field

@@ -314,3 +314,28 @@ def test_cli_bad_input_exits_2_with_one_line(args, words):
     assert r.exit_code == 2
     lines = [ln for ln in r.output.splitlines() if ln.strip()]
     assert len(lines) == 1 and words in lines[0]
+
+
+def test_double_pendulum_of_boxes_about_its_hanging_equilibrium():
+    """models/msl/MultiBody/DoublePendulum.py (two steel BodyBoxes, m =
+    7700*0.5*0.06^2 = 13.86 kg, centre c = 0.25 m, I_z = m (0.5^2 + 0.06^2)/12)
+    trimmed to hanging (from its horizontal start) and linearised: the
+    eigenvalues of [[0, I], [-M^-1 K, -M^-1 Dm]] with, in the joint angles,
+    M = [[2I + m(2c^2 + L^2 + 2Lc), I + m(c^2 + Lc)], [., I + m c^2]],
+    K = m g [[2c + L, c], [c, c]], Dm = diag(d, 0) (docs/msl_laws.md, section 6)."""
+    _, cm = compile_file(ROOT / "models" / "msl" / "MultiBody" / "DoublePendulum.py")
+    eq = trim(cm)
+    assert eq["revolute1.phi"] == pytest.approx(-math.pi / 2, abs=1e-12)
+    assert eq["revolute2.phi"] == pytest.approx(0.0, abs=1e-12)
+    m, L, c, d = 7700 * 0.5 * 0.06**2, 0.5, 0.25, 0.1
+    Iz = m * (L**2 + 0.06**2) / 12
+    Mm = np.array([[2 * Iz + m * (2 * c**2 + L**2 + 2 * L * c), Iz + m * (c**2 + L * c)],
+                   [Iz + m * (c**2 + L * c), Iz + m * c**2]])
+    K = m * G_N * np.array([[2 * c + L, c], [c, c]])
+    Dm = np.array([[d, 0.0], [0.0, 0.0]])
+    A_ref = np.block([[np.zeros((2, 2)), np.eye(2)],
+                      [-np.linalg.solve(Mm, K), -np.linalg.solve(Mm, Dm)]])
+    ref = np.linalg.eigvals(A_ref)
+    ev = linearize(cm, at=eq).eigenvalues
+    key = (lambda e: (round(e.imag, 6), e.real))
+    assert np.allclose(sorted(ev, key=key), sorted(ref, key=key), rtol=1e-9, atol=1e-12)
