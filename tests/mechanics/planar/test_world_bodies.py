@@ -241,7 +241,8 @@ def test_support_flange_equals_a_fixed_on_the_axis():
 
 
 @pytest.mark.parametrize("make, words", [
-    (lambda: BodyBox(rx=0.5, width=0.05, innerWidth=0.05), "innerWidth = 0.05 m must be less than width"),
+    (lambda: BodyBox(rx=0.5, width=0.05, innerWidth=0.05),
+     "innerWidth = 0.05 m must be less than width"),
     (lambda: BodyBox(rx=0.5, width=0.05, height=0.02, innerHeight=0.03), "innerHeight"),
     (lambda: BodyCylinder(rx=0.5, diameter=0.02, innerDiameter=0.03), "innerDiameter"),
     (lambda: BodyBox(rx=0.0, ry=0.0), "its length is 0"),
