@@ -36,7 +36,8 @@ class Item:
 
 def _kinds():
     from ..mechanics.planar import bodies, forces, joints, parts
-    return [(parts.FixedTranslation, "link"), (bodies.BodyShape, "link"),
+    return [(parts.FixedTranslation, "link"), (parts.FixedRotation, "link"),
+            (bodies.BodyShape, "link"),
             (parts.Body, "body"), (joints.Revolute, "pin"),
             (joints.Prismatic, "slider"), (parts.Fixed, "ground"),
             (forces.Spring, "force"), (forces.Damper, "force"), (forces.SpringDamper, "force")]

@@ -8,7 +8,7 @@ from acausal.lang import Eq, Parameter
 from .geometry import rotate
 from .partials import PartialBody, PartialOneFrame, PartialRigidLink
 
-__all__ = ["Fixed", "Body", "FixedTranslation"]
+__all__ = ["Fixed", "Body", "FixedTranslation", "FixedRotation"]
 
 
 class Fixed(PartialOneFrame):
@@ -67,3 +67,25 @@ class FixedTranslation(PartialRigidLink):
         a, b = self.frame_a, self.frame_b
         dx, dy = rotate(a.phi, self.rx, self.ry)
         return [Eq(b.x, a.x + dx), Eq(b.y, a.y + dy), Eq(b.phi, a.phi)]
+
+
+class FixedRotation(PartialRigidLink):
+    """A massless rigid link that also turns the frame: frame_b sits at
+    ``(rx, ry)`` from frame_a in frame_a's axes and is turned by ``angle``
+    about z (MSL's ``Parts.FixedRotation`` with ``n = {0, 0, 1}``)::
+
+        r_b = r_a + R(frame_a.phi) (rx, ry),   frame_b.phi = frame_a.phi + angle
+
+    Parameters: ``rx``, ``ry`` [m] position of frame_b in frame_a's axes,
+    ``angle`` [rad] rotation of frame_b from frame_a (counter-clockwise).
+    Connectors: ``frame_a``, ``frame_b``.
+    """
+
+    rx = Parameter(0.0, "m", "x of frame_b in frame_a's axes")
+    ry = Parameter(0.0, "m", "y of frame_b in frame_a's axes")
+    angle = Parameter(0.0, "rad", "rotation of frame_b from frame_a about z")
+
+    def equations(self):
+        a, b = self.frame_a, self.frame_b
+        dx, dy = rotate(a.phi, self.rx, self.ry)
+        return [Eq(b.x, a.x + dx), Eq(b.y, a.y + dy), Eq(b.phi, a.phi + self.angle)]

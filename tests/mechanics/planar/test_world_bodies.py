@@ -260,3 +260,27 @@ def test_computed_parameters_cannot_be_given_and_zero_gravity_direction_is_refus
         BodyBox(rx=0.5, m=3.0)
     with pytest.raises(ParameterError, match="gravity direction"):
         World(nx=0.0, ny=0.0)
+
+
+def test_fixed_rotation_turns_frame_b():
+    """A body hung from a pin through a FixedRotation (frame_b turned by
+    angle a, offset r): the same motion as the body at the rotated offset,
+    with its own angle shifted by a (the pendulum's closed form)."""
+    from acausal.mechanics.planar import FixedRotation
+    a, L = 0.7, 0.4
+    m = Model()
+    m.world = World()
+    m.pin = Revolute(phi=0.0, w=0.0)
+    m.turn = FixedRotation(rx=0.1, ry=0.0, angle=a)
+    m.body = BodyShape(m=2.0, I=0.01, r_CM_x=L, rx=2 * L)
+    m.connect(m.world.frame_b, m.pin.frame_a)
+    m.connect(m.pin.frame_b, m.turn.frame_a)
+    m.connect(m.turn.frame_b, m.body.frame_a)
+    ts = np.linspace(0.0, 1.0, 101)
+    res = compile_model(m).simulate(t_end=1.0, output_times=ts, **SWING)
+    # the centre of mass from the pin: (0.1, 0) + L (cos a, sin a) in the pin's axes
+    cx, cy = 0.1 + L * math.cos(a), L * math.sin(a)
+    ref = _pendulum_reference(2.0, 0.01 + 2.0 * (cx**2 + cy**2), math.hypot(cx, cy),
+                              math.atan2(cy, cx), 0.0, ts)
+    assert np.max(np.abs(res["pin.phi"] - ref)) < 1e-8
+    assert np.max(np.abs(res["body.phi"] - (res["pin.phi"] + a))) < 1e-12
