@@ -544,8 +544,13 @@ def linearize(cm, at=None, inputs=(), outputs=(), *, params=None, t=None, backen
     states, ``C = I``). ``params``: other parameter and fixed-start
     overrides. ``rtol``, ``atol``, ``backend``: of the simulation to ``at``.
     Discrete modes are the point's (held fixed)."""
+    from ..runtime.result import Result
     ins, in_values = _inputs(cm, inputs)
     out_names = _output_names(cm, outputs)
+    if isinstance(at, (Result, Equilibrium)) and (params or in_values):
+        raise AnalysisError("linearize: the point's parameters and inputs are those of the "
+                            f"{type(at).__name__.lower()} given as at; name the inputs "
+                            "without values and give no params")
     params = _input_params(cm, ins, in_values, params or {})
     pt = _point(cm, at, params, t, backend, rtol, atol)
     return _linearize_at(cm, pt, ins, out_names)

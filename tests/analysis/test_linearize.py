@@ -339,3 +339,11 @@ def test_double_pendulum_of_boxes_about_its_hanging_equilibrium():
     ev = linearize(cm, at=eq).eigenvalues
     key = (lambda e: (round(e.imag, 6), e.real))
     assert np.allclose(sorted(ev, key=key), sorted(ref, key=key), rtol=1e-9, atol=1e-12)
+
+
+def test_a_point_with_its_own_parameters_refuses_other_values():
+    cm = compile_model(pendulum())
+    eq = trim(cm)
+    with pytest.raises(AnalysisError, match="name the inputs without values"):
+        linearize(cm, at=eq, inputs={"u": 1.0})
+    assert linearize(cm, at=eq, inputs=["u"]).u0[0] == 0.0
