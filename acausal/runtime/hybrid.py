@@ -784,7 +784,8 @@ def _failure(run, cm, sol, cb):
         extra += ("; " + ", ".join(f"parameter {nm} = {v:g} [{u}] is far from its default "
                                    f"{dv:g}" for nm, v, dv, u in suspect)
                   + ": check its value and unit")
-    message = f"IDA failed at t = {t:.9g} s{where}: {r.message}{extra}"
+    who = "IDA failed" if cm.dae.n_states else "solving the equations (no states) failed"
+    message = f"{who} at t = {t:.9g} s{where}: {r.message}{extra}"
     result = run.result("failed", r.message)
     hint = ask_components(cm.model, "solver_failure", [comp] if comp else [], message, t,
                           result)
