@@ -22,7 +22,7 @@ from . import Root, Segment, SegmentSolver
 
 SUBDIVISIONS = 100   # root checks per segment at least (without max_step)
 XTOL = 1e-14         # Brent's tolerance on t, relative to the time scale
-RES_TOL = 1e-8       # largest residual accepted at a point, relative to 1 + max|y|
+RES_TOL = 1e-8       # largest residual accepted at a point, relative to 1 + |J_i| |y|
 
 
 class AlgebraicSolver(SegmentSolver):
@@ -51,10 +51,16 @@ class AlgebraicSolver(SegmentSolver):
         if len(y1):
             r = np.zeros(len(y1))
             cb[0](t, y1, yp1, r)
-            scale = 1.0 + float(np.max(np.abs(y1))) if np.all(np.isfinite(y1)) else 1.0
-            if not np.all(np.isfinite(r)) or float(np.max(np.abs(r))) > RES_TOL * scale:
-                raise _NoSolution(t, y1, yp1, int(np.argmax(np.abs(np.nan_to_num(
-                    r, nan=np.inf)))))
+            bad = ~np.isfinite(r)
+            if not bad.any() and np.any(np.abs(r) > RES_TOL):
+                # each equation against the size of its terms, |J_i| |y| (the
+                # initialisation's consistency test)
+                n = len(y1)
+                Jy, Jyp = np.zeros((n, n)), np.zeros((n, n))
+                cb[3](t, y1, yp1, Jy, Jyp)
+                bad = np.abs(r) > RES_TOL * (1.0 + np.abs(Jy) @ np.abs(y1))
+            if bad.any():
+                raise _NoSolution(t, y1, yp1, int(np.argmax(bad)))
         return y1, yp1
 
     def _roots(self, cb, t, y, yp):
