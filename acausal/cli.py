@@ -340,7 +340,7 @@ def check(file, as_json):
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object")
 def linearize(file, at, inputs, outputs, sets, out, as_json):
     """Linearise a model file: A, B, C, D and the eigenvalues of A."""
-    from .analysis import linearize as lin_
+    from .analysis import RunSettings, linearize as lin_
     from .modelfile import compile_file
     try:
         params = _parse_sets(sets)
@@ -348,7 +348,7 @@ def linearize(file, at, inputs, outputs, sets, out, as_json):
         point = _parse_at(at)
         lin = lin_(cm, at=point, inputs=inputs, outputs=outputs, params=params,
                    t=mf.experiment.t0 if not isinstance(point, float) else None,
-                   rtol=mf.experiment.rtol, atol=mf.experiment.atol)
+                   run=RunSettings(rtol=mf.experiment.rtol, atol=mf.experiment.atol))
         if out:
             lin.save(out)
     except (AcausalError, click.BadParameter) as exc:
