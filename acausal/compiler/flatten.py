@@ -37,6 +37,7 @@ class VarInfo:
     owner: str
     port: bool = False     # a connector variable
     internal: bool = False  # made by the compiler (a time switch), not declared
+    unit_declared: bool = True   # False: no unit was given (not checked)
 
 
 @dataclass
@@ -101,15 +102,17 @@ def _declare(flat, comp):
         if isinstance(d, Parameter):
             flat.params[sym.name] = ParamInfo(sym, comp.value(name), d, path)
         elif isinstance(d, Variable):
-            flat.variables[sym.name] = VarInfo(sym, comp.start(name), d.unit, d.desc, path)
+            flat.variables[sym.name] = VarInfo(sym, comp.start(name), d.unit, d.desc, path,
+                                               unit_declared=d.unit_declared)
         elif isinstance(d, Discrete):
-            flat.discretes[sym.name] = VarInfo(sym, Start(d.start, True), d.unit, d.desc, path)
+            flat.discretes[sym.name] = VarInfo(sym, Start(d.start, True), d.unit, d.desc, path,
+                                               unit_declared=d.unit_declared)
     for name, ctype in comp.connectors().items():
         port = comp.port(name)
         if isinstance(port, SignalPort):
             sym = port.symbol
             flat.variables[sym.name] = VarInfo(sym, Start(0.0, False), ctype.unit, ctype.desc,
-                                               path, True)
+                                               path, True, unit_declared=ctype.unit_declared)
             continue
         for decls, syms in zip(ctype.pairs(), port.pairs()):
             for (vname, unit, desc), sym in zip(decls, syms):
@@ -207,7 +210,7 @@ def _initial_equation(flat, comp, known, k, eq):
     sym = sp.Symbol(f"{path}._initial{k}" if path else f"_initial{k}")
     flat.variables[sym.name] = VarInfo(sym, Start(0.0, True), "1",
                                        f"initial equation {k + 1}: {expr} = 0 at the start",
-                                       path, internal=True)
+                                       path, internal=True, unit_declared=False)
     known.add(sym.name)
     flat.equations.append(Equation(sym - expr, path,
                                    f"initial equation {k + 1} ({type(comp).__name__})"))
