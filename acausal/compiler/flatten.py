@@ -38,6 +38,7 @@ class VarInfo:
     port: bool = False     # a connector variable
     internal: bool = False  # made by the compiler (a time switch), not declared
     unit_declared: bool = True   # False: no unit was given (not checked)
+    nominal: float = None   # Modelica's nominal value (scales the absolute tolerance)
 
 
 @dataclass
@@ -103,7 +104,8 @@ def _declare(flat, comp):
             flat.params[sym.name] = ParamInfo(sym, comp.value(name), d, path)
         elif isinstance(d, Variable):
             flat.variables[sym.name] = VarInfo(sym, comp.start(name), d.unit, d.desc, path,
-                                               unit_declared=d.unit_declared)
+                                               unit_declared=d.unit_declared,
+                                               nominal=comp.nominal(name))
         elif isinstance(d, Discrete):
             flat.discretes[sym.name] = VarInfo(sym, Start(d.start, True), d.unit, d.desc, path,
                                                unit_declared=d.unit_declared)

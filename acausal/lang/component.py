@@ -13,7 +13,7 @@ import numbers
 import sympy as sp
 
 from .connectors import Connector, Port
-from .declare import Declaration, Discrete, Parameter, Start, Variable
+from .declare import Declaration, Discrete, Parameter, Start, Variable, check_nominal
 from ..errors import ModelError, ParameterError
 
 
@@ -68,6 +68,7 @@ class Component:
         object.__setattr__(self, "_values", {})
         object.__setattr__(self, "_starts", {})
         object.__setattr__(self, "_bindings", {})
+        object.__setattr__(self, "_nominals", {})
         for name, d in self.declarations().items():
             if isinstance(d, Parameter):
                 self._values[name] = d.default
@@ -114,6 +115,26 @@ class Component:
                 raise ParameterError(f"{key!r} of {self.path} is discrete; it cannot be set",
                                      component=self.path, variable=key)
         return self
+
+    def with_nominal(self, **values):
+        """Set the nominal values of variables of this instance (Modelica's
+        ``inertia(w(nominal=1e-3))``): ``Inertia(J=2).with_nominal(w=1e-3)``.
+        Returns the component."""
+        decls = self.declarations()
+        for key, value in values.items():
+            if not isinstance(decls.get(key), Variable):
+                raise ParameterError(f"with_nominal: {type(self).__name__} "
+                                     f"{self.path or '(top)'} has no variable {key!r}",
+                                     component=self.path, variable=key)
+            self._nominals[key] = check_nominal(value, f"{self.path or type(self).__name__}."
+                                                f"{key}")
+        return self
+
+    def nominal(self, name):
+        """The nominal value of variable ``name`` (None when not given)."""
+        if name in self._nominals:
+            return self._nominals[name]
+        return getattr(self.declarations().get(name), "nominal", None)
 
     def value(self, name):
         """The value given to a parameter (number, expression or choice)."""
@@ -280,11 +301,11 @@ class Model(Component):
         self._values[name] = p.check(default, self.path)
         return self.symbol(name)
 
-    def variable(self, name, start=0.0, unit=None, desc="", fixed=False):
+    def variable(self, name, start=0.0, unit=None, desc="", fixed=False, nominal=None):
         """Declare a variable of this model; returns its symbol."""
         if isinstance(start, Start):
             start, fixed = start.value, start.fixed
-        v = Variable(start, unit, desc, fixed=fixed)
+        v = Variable(start, unit, desc, fixed=fixed, nominal=nominal)
         v.name = name
         self._extra[name] = v
         self._starts[name] = v.start

@@ -20,6 +20,7 @@ from ..errors import ChatteringError, LimitError, SolverError, UsageError
 from .events import EventState
 from .initialize import ask_components, initial_point, reinitialize, suspect_parameters
 from .result import Result
+from .nominal import nominal_atol
 from .timeevents import TimeSchedule
 
 CHATTER_COUNT = 100     # this many firings of one event (root) ...
@@ -237,7 +238,7 @@ def _start(cm, t0, t_end, params, rtol, atol, atol_algebraic, max_step, max_step
     params, starts = cm.split_overrides(params)
     p = cm.param_vector(params)
     d = cm.discrete_start()
-    atol = _atol_vector(cm, atol, atol_algebraic)
+    atol = nominal_atol(cm, _atol_vector(cm, atol, atol_algebraic), rtol, atol)
     model = cm
     if sensitivities:
         from .sensitivity import SensRun, sensitivity_model
