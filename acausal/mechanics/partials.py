@@ -3,11 +3,12 @@ component is only its parameters and its law (Modelica's PartialCompliant /
 PartialRigid). Sign convention: see :mod:`acausal.connectors`."""
 import inspect
 import numbers
+import sys
 
 import sympy as sp
 
 from acausal.lang import Component, Eq, Flange, Parameter, RotFlange, Variable, der
-from acausal.lang.connectors import RealInput, RealOutput
+from acausal.lang.connectors import RealInput
 
 from acausal.errors import ModelError, ParameterError
 
@@ -228,7 +229,7 @@ def _nominal_parameter(comp, name):
     if isinstance(value, sp.Basic) and not value.is_number:
         return None
     value = float(value)
-    return value if value >= 2.220446049250313e-16 else 1.0
+    return value if value >= sys.float_info.epsilon else 1.0
 
 
 # -- support flanges (MSL's useSupport) ------------------------------------------
@@ -257,10 +258,6 @@ class PartialConditionalConnectors(Component):
             if self._values.get(flag):
                 out[name] = decl
         return out
-
-    def enabled(self, name):
-        """True when the conditional connector ``name`` exists."""
-        return bool(self._values.get(self._conditional[name][0]))
 
     def port(self, name):
         cond = self._conditional.get(name)
