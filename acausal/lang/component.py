@@ -91,7 +91,7 @@ class Component:
 
     def set(self, **kw):
         """Set parameter values and start values; checks bounds. A value
-        given for an input connector (``Position(s_ref=sin(time))``) binds
+        given for an input connector (``Position(s_ref=0.1*sin(2*pi*time))``) binds
         that input to the expression, as a Modelica modifier does: it is
         then set by it instead of by a connection."""
         decls = self.declarations()

@@ -55,7 +55,7 @@ def test_filtered_position_is_msl_s_bessel_filter():
     assert np.max(np.abs(res["src.v"] - v_ref)) < 1e-8
     # it starts at the input (MSL's initial equation s = s_ref), here with an offset
     m = Model()
-    m.src = Position(f_crit=5.0, s_ref=0.3 + 0.1 * sp.sin(time))
+    m.src = Position(f_crit=5.0, s_ref=0.3 + 0.1 * sp.sin(1.0 * time))
     m.mass = Mass(m=1.0)
     m.connect(m.src.flange, m.mass.flange)
     res = compile_model(m, cache=False).simulate(t_end=0.1)
@@ -77,7 +77,7 @@ def test_speed_exact_and_filtered():
     assert res.at("src.flange.f", 0.45) == pytest.approx(-2.0 * 4.0, rel=1e-9)
     # filtered: first order, v starts at v_ref (= 1 here), s at 0
     m = Model()
-    m.src = Speed(f_crit=2.0, v_ref=1.0 + time)
+    m.src = Speed(f_crit=2.0, v_ref=1.0 + 1.0 * time)
     m.mass = Mass(m=1.0)
     m.connect(m.src.flange, m.mass.flange)
     res = compile_model(m, cache=False).simulate(t_end=1.0, rtol=1e-10, atol=1e-12)
@@ -109,7 +109,7 @@ def test_accelerate_integrates_its_input(backend):
 
 def test_move_takes_its_velocity_and_acceleration_from_its_inputs():
     m = Model()
-    m.src = Move(u1=sp.sin(time), u2=sp.cos(time), u3=-sp.sin(time))
+    m.src = Move(u1=1.0 * sp.sin(1.0 * time), u2=1.0 * sp.cos(1.0 * time), u3=-1.0 * sp.sin(1.0 * time))
     m.mass = Mass(m=2.0)
     m.connect(m.src.flange, m.mass.flange)
     cm = compile_model(m, cache=False)
@@ -118,7 +118,7 @@ def test_move_takes_its_velocity_and_acceleration_from_its_inputs():
     assert np.max(np.abs(res["mass.flange.f"] + 2 * np.sin(res.t))) < 1e-14
     # position only, velocity and acceleration zero on purpose (MSL's use): no force
     m = Model()
-    m.src = Move(u1=sp.sin(time), u2=0, u3=0)
+    m.src = Move(u1=1.0 * sp.sin(1.0 * time), u2=0, u3=0)
     m.mass = Mass(m=2.0)
     m.connect(m.src.flange, m.mass.flange)
     res = compile_model(m, cache=False).simulate(t_end=1.0)
@@ -149,7 +149,7 @@ def test_rotational_sources_and_a_support():
     res = compile_model(m, cache=False).simulate(t_end=1.0, rtol=1e-10, atol=1e-12)
     assert abs(res["j1.phi"][-1] - 2.0) < 1e-9 and abs(res["j2.phi"][-1] + 0.5) < 1e-9
     m = Model()
-    m.src = rot.Move(u1=time ** 3, u2=3 * time ** 2, u3=6 * time)
+    m.src = rot.Move(u1=1.0 * time ** 3, u2=3.0 * time ** 2, u3=6.0 * time)
     m.j = rot.Inertia(J=0.5)
     m.connect(m.src.flange, m.j.flange)
     res = compile_model(m, cache=False).simulate(t_end=1.0)

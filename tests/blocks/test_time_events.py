@@ -15,6 +15,7 @@ class _TimeForce(Component):
     """A force on the flange given by an expression of time (a test part)."""
     flange = Flange("flange")
     F = Parameter(2.0, "N", "force level")
+    K = Parameter(2.0, "N/s", "force rate")
     T = Parameter(0.5, "s", "switching time")
 
     def __init__(self, law, **kw):
@@ -70,12 +71,12 @@ def test_a_window_in_time_and_kinks_of_max_and_abs():
     assert [t for t, _ in res.events] == [0.2, 0.6]
     assert abs(res["mass.v"][-1] - 0.8) < 1e-9
     # Max(0, t - T): a ramp that starts at T (a kink, not a jump)
-    cm = pushed_mass(lambda c: c.F * sp.Max(0, time - c.T))
+    cm = pushed_mass(lambda c: c.K * sp.Max(0, time - c.T))
     res = cm.simulate(t_end=1.0, rtol=1e-10, atol=1e-12)
     assert [t for t, _ in res.events] == [0.5]
     assert abs(res["mass.s"][-1] - 2 * 0.5 ** 3 / 6) < 1e-10
     # |t - T|: v = F*(sign(t-T)(t-T)^2/2 + T^2/2)
-    cm = pushed_mass(lambda c: c.F * sp.Abs(time - c.T))
+    cm = pushed_mass(lambda c: c.K * sp.Abs(time - c.T))
     res = cm.simulate(t_end=1.0, rtol=1e-10, atol=1e-12)
     assert [t for t, _ in res.events] == [0.5]
     assert abs(res["mass.v"][-1] - 2 * (0.125 + 0.125)) < 1e-9

@@ -2,7 +2,7 @@
 ``Speed``, ``Accelerate``, ``Move``): the rotation of a flange relative to
 its support follows a signal (a :class:`~acausal.lang.connectors.RealInput`,
 connected to a block's output or bound to an expression of time:
-``Position(exact=True, phi_ref=sin(time))``). The flange takes whatever
+``Position(exact=True, phi_ref=0.5*sin(2*pi*time))``). The flange takes whatever
 torque the motion needs; with ``useSupport=True`` the support takes the
 reaction, otherwise the ground does. A model whose every motion is
 prescribed has no states and still runs.

@@ -2,7 +2,7 @@
 ``Speed``, ``Accelerate``, ``Move``): the motion of a flange relative to
 its support follows a signal (a :class:`~acausal.lang.connectors.RealInput`,
 connected to a block's output or bound to an expression of time:
-``Position(exact=True, s_ref=0.1*sin(time))``). The flange takes whatever
+``Position(exact=True, s_ref=0.1*sin(2*pi*time))``). The flange takes whatever
 force the motion needs; with ``useSupport=True`` the support takes the
 reaction, otherwise the ground does. A model whose every motion is
 prescribed has no states and still runs.
