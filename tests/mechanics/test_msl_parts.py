@@ -208,6 +208,29 @@ def test_elastogap_static_deflection_follows_the_exponent():
     assert 0.3 - res["mass.s"][-1] == pytest.approx((F / c) ** (1 / n), rel=1e-8)
 
 
+def test_phi_nominal_given_explicitly_is_the_nominal_of_phi_rel():
+    """MSL's phi_nominal / s_nominal: given, they are the nominal value of
+    phi_rel / s_rel (the solver's absolute tolerance rtol*nominal on that
+    unknown); left at the default they set none (earlier models keep their
+    tolerances); with_nominal wins."""
+    from acausal.runtime.nominal import nominal_slots
+    assert R.SpringDamper(c=1.0).nominal("phi_rel") is None
+    assert R.ElastoBacklash(phi_nominal=1.0).nominal("phi_rel") == 1.0
+    assert R.Damper(phi_nominal=0.0).nominal("phi_rel") == 1.0       # MSL: 1 below eps
+    assert R.Damper(phi_nominal=1e-3).with_nominal(phi_rel=5e-2).nominal("phi_rel") == 5e-2
+    assert T.SpringDamper(s_nominal=1e-3).nominal("s_rel") == 1e-3
+    assert T.Damper().nominal("s_rel") is None
+    model = Model()
+    model.a = R.Inertia(J=1.0, phi=0.0, w=0.0)
+    model.sd = R.SpringDamper(c=100.0, d=1.0, phi_nominal=1e-3, phi_rel=0.01, w_rel=0.0)
+    model.b = R.Inertia(J=1.0)
+    model.connect(model.a.flange, model.sd.flange_a)
+    model.connect(model.sd.flange_b, model.b.flange)
+    cm = compile_model(model)
+    slots = [k for k, names in enumerate(cm.slot_names()) if "sd.phi_rel" in names]
+    assert slots and nominal_slots(cm)[slots[0]] == 1e-3
+
+
 # -- backlash ----------------------------------------------------------------------
 @pytest.mark.parametrize("cls", [R.ElastoBacklash, R.ElastoBacklash2])
 def test_free_inertia_crosses_the_backlash_at_the_closed_form_times(cls):
@@ -278,6 +301,32 @@ def test_zero_backlash_is_a_spring_damper():
         res[name] = run(model)
         assert not [e for e in res[name].events if e[1].startswith(name)]
     assert rel(res["eb"]["body.phi"], res["sd"]["body.phi"]) < 1e-12
+
+
+def test_disc_turns_its_right_flange_by_delta_phi_and_relative_states_read_it():
+    """A Disc between a motor-driven inertia and a spring-loaded one: a
+    rigid offset deltaPhi, the torque passes unchanged; RelativeStates
+    across it reads phi_rel = deltaPhi, w_rel = 0 and takes no torque."""
+    J1, J2, c, dphi = 0.2, 0.3, 40.0, 0.25
+    model = Model()
+    model.a = R.Inertia(J=J1, phi=0.0, w=0.0)
+    model.disc = R.Disc(deltaPhi=dphi)
+    model.b = R.Inertia(J=J2)
+    model.spring = R.Spring(c=c, phi_rel0=dphi)
+    model.ground = R.Fixed()
+    model.motor = R.ConstantTorque(tau_constant=1.0)
+    model.rel = R.RelativeStates()
+    model.connect(model.motor.flange, model.a.flange_a)
+    model.connect(model.a.flange_b, model.disc.flange_a, model.rel.flange_a)
+    model.connect(model.disc.flange_b, model.b.flange_a, model.rel.flange_b)
+    model.connect(model.b.flange_b, model.spring.flange_b)
+    model.connect(model.spring.flange_a, model.ground.flange)
+    res = run(model)
+    w = np.sqrt(c / (J1 + J2))
+    assert rel(res["a.phi"], 1.0 / c * (1 - np.cos(w * res.t))) < 1e-8
+    assert rel(res["b.phi"] - res["a.phi"], dphi) < 1e-12
+    assert rel(res["rel.phi_rel"], dphi) < 1e-12
+    assert np.max(np.abs(res["rel.w_rel"])) < 1e-10
 
 
 # -- gears and wheels --------------------------------------------------------------

@@ -3,18 +3,17 @@ signals, laws or speed-dependent characteristics, and prescribed motion.
 Sign convention: :mod:`acausal.lang.connectors`."""
 
 import sympy as sp
-from sympy import Basic, Piecewise, SympifyError, sympify
+from sympy import Piecewise
 
-from acausal.lang import Component, Eq, Flange, Parameter, Variable, der, time
-
-from acausal.errors import ParameterError
+from acausal.lang import Eq, Flange, Parameter, time
 
 from .kinematic import Accelerate, Move, Position, Speed  # noqa: F401 (MSL's Sources)
 from ..partials import (PartialCompliant, PartialElementaryOneFlangeAndSupport2, PartialForce,
                         PartialSource, SourceValue)
 
 __all__ = ["Force", "Force2", "RelativeForce", "ConstantForce", "SignForce",
-           "QuadraticSpeedDependentForce", "LinearSpeedDependentForce", "ForceStep", "Position", "Speed", "Accelerate", "Move"]
+           "QuadraticSpeedDependentForce", "LinearSpeedDependentForce", "ForceStep", "Position",
+           "Speed", "Accelerate", "Move"]
 
 REGULARIZATIONS = ("Exp", "Sine", "Linear", "CoSine")
 
