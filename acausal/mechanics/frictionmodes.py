@@ -195,7 +195,8 @@ class FrictionModes(Component):
         sf, sb = self.startForward, self.startBackward
         e = self.engagement()
         active = sp.true if e is None else e > 0
-        locked = self._configuration()[0]
+        # locked after the start (Unknown is locked only until initial_mode)
+        locked = Rel(m, STUCK) & Rel(sf, 0) & Rel(sb, 0)
         sliding = Rel(m, FORWARD) | Rel(m, BACKWARD)
         starting = {1: Rel(m, STUCK) & Rel(sf, 1), -1: Rel(m, STUCK) & Rel(sb, 1)}
         pre = f"{self.path}." if self.path else ""
@@ -231,7 +232,7 @@ class FrictionModes(Component):
                              off(nonzero(d * (self.hold_level(d) - sa), -1), starting[d]), 1,
                              self._act_abort(d), recheck=True))
         evs.append(Event(pre + "slide_stop", off(nonzero(-m * w, nonzero(-m * a, -1)), sliding),
-                         1, self._act_stop, recheck=True))
+                         1, self._act_slide_stop, recheck=True))
         return evs
 
     # -- event actions (each writes absolute values: two of one element never
@@ -289,7 +290,7 @@ class FrictionModes(Component):
             self._set(state, STUCK)
         return act
 
-    def _act_stop(self, state):
+    def _act_slide_stop(self, state):
         w, _ = self.friction_motion()
         m = int(state[self.mode])
         jump = self.jump_level()
