@@ -78,6 +78,7 @@ __all__ = ["FrictionModes", "PartialFriction", "PartialRotFriction",
            "UNKNOWN", "FREE", "FORWARD", "STUCK", "BACKWARD"]
 
 UNKNOWN, FREE, FORWARD, STUCK, BACKWARD = 3, 2, 1, 0, -1
+TIE = 1e-12   # a level or acceleration within this of its threshold is at it (see _roots)
 
 
 def _value(state, expr):
@@ -173,6 +174,19 @@ class FrictionModes(Component):
         forward = Rel(m, FORWARD) | (stuck & Rel(sf, 1))
         return locked, free, forward
 
+    def _locked_condition(self):
+        """Locked after the start (Unknown is locked only until initial_mode)."""
+        return Rel(self.mode, STUCK) & Rel(self.startForward, 0) & Rel(self.startBackward, 0)
+
+    def _friction_elements(self):
+        """Every friction element of the model this one belongs to, in the
+        model's order."""
+        top = self
+        while getattr(top, "_parent", None) is not None:
+            top = top._parent
+        return [c for c in (top.walk() if hasattr(top, "walk") else [top])
+                if isinstance(c, FrictionModes)]
+
     def equations(self):
         w, a = self.friction_motion()
         F, sa = self.friction_force(), self.sa
@@ -195,8 +209,7 @@ class FrictionModes(Component):
         sf, sb = self.startForward, self.startBackward
         e = self.engagement()
         active = sp.true if e is None else e > 0
-        # locked after the start (Unknown is locked only until initial_mode)
-        locked = Rel(m, STUCK) & Rel(sf, 0) & Rel(sb, 0)
+        locked = self._locked_condition()
         sliding = Rel(m, FORWARD) | Rel(m, BACKWARD)
         starting = {1: Rel(m, STUCK) & Rel(sf, 1), -1: Rel(m, STUCK) & Rel(sb, 1)}
         pre = f"{self.path}." if self.path else ""
@@ -228,11 +241,18 @@ class FrictionModes(Component):
                              self._act_break(d), recheck=True))
             evs.append(Event(pre + "slide_" + name, off(nonzero(d * w, -1), starting[d]), 1,
                              self._act_go(d), recheck=True))
+            hold = self.hold_level(d)
             evs.append(Event(pre + "abort_" + name,
-                             off(nonzero(d * (self.hold_level(d) - sa), -1), starting[d]), 1,
+                             off(d * (hold - sa) - TIE * (1 + sp.Abs(hold)), starting[d]), 1,
                              self._act_abort(d), recheck=True))
-        evs.append(Event(pre + "slide_stop", off(nonzero(-m * w, nonzero(-m * a, -1)), sliding),
-                         1, self._act_slide_stop, recheck=True))
+        evs.append(Event(pre + "slide_stop",
+                         off(nonzero(-m * w, -m * a - TIE), sliding), 1,
+                         self._act_slide_stop, recheck=True))
+        others = [c for c in self._friction_elements() if c is not self]
+        if others:
+            anyone = sp.Or(*[c._locked_condition() for c in others])
+            evs.append(Event(pre + "coupled_lock", Piecewise((1, locked & anyone), (-1, True)), 1,
+                             self._act_coupled_lock, recheck=True, log=False))
         return evs
 
     # -- event actions (each writes absolute values: two of one element never
@@ -279,7 +299,8 @@ class FrictionModes(Component):
 
     def _act_go(self, d):
         def act(state):
-            if d * (_value(state, self.sa) - _value(state, self.hold_level(d))) < 0:
+            hold = _value(state, self.hold_level(d))
+            if d * (hold - _value(state, self.sa)) - TIE * (1 + abs(hold)) > 0:
                 self._set(state, STUCK)          # the start is over first (MSL order)
             else:
                 self._set(state, d)
@@ -289,6 +310,44 @@ class FrictionModes(Component):
         def act(state):
             self._set(state, STUCK)
         return act
+
+    def _act_coupled_lock(self, state):
+        """Two locked elements that hold the same motion (a bearing and a
+        brake on one shaft, a lossy gear and its bearing: their velocities
+        are proportional) leave their holding torques undetermined: MSL's
+        "RequirementsForSimulationTool". The re-initialisation has split the
+        load by least squares, closest to the values before the event (the
+        choice MSL's users guide suggests); to integrate, only the first of
+        them (in the model's order) stays locked, and this one starts to
+        slide in the direction of its share of the load (at once if the
+        velocity allows, else waiting, as after a break-away)."""
+        if not _true(state, self._locked_condition()):
+            return
+        for other in self._friction_elements():
+            if other is self:
+                return                            # none before this one holds the same motion
+            if _true(state, other._locked_condition()) and self._coupled(state, other):
+                share = _value(state, self.sa)
+                self._act_break(1 if share >= 0 else -1)(state)
+                return
+
+    def _coupled(self, state, other):
+        """True when this element's velocity is a constant multiple of the
+        other's in the compiled model (the same motion)."""
+        cm = state.cm
+        key = (id(cm), other.path)
+        memo = self.__dict__.setdefault("_coupling", {})
+        if key not in memo:
+            try:
+                mine = cm.resolve(self.friction_motion()[0])
+                theirs = cm.resolve(other.friction_motion()[0])
+                ratio = sp.simplify(mine / theirs) if theirs != 0 else sp.nan
+                values = dict(zip(cm.param_syms, state.p))
+                ratio = ratio.xreplace(values)
+                memo[key] = bool(ratio.is_number and ratio.is_finite and ratio != 0)
+            except Exception:       # an expression the compiled model cannot give
+                memo[key] = False
+        return memo[key]
 
     def _act_slide_stop(self, state):
         w, _ = self.friction_motion()

@@ -20,7 +20,7 @@ from ..partials import (NonZeroParameter, PartialRotCompliantWithRelativeStates,
                         PartialRotElementaryTwoFlangesAndSupport2)
 from ..tables import Table, interpolate
 
-__all__ = ["BearingFriction", "Brake", "Clutch", "OneWayClutch", "LossyGear"]
+__all__ = ["BearingFriction", "Brake", "Clutch", "OneWayClutch", "LossyGear", "IDEAL_LOSS_TABLE"]
 
 
 def _mu_pos():
@@ -269,3 +269,141 @@ class OneWayClutch(PartialRotCompliantWithRelativeStates, FrictionModes):
 
     def locked_jump_level(self):
         return self.w_small
+
+
+class _LossTable(Table):
+    """LossyGear's ``lossTable``: rows (|w_a| [rad/s], eta_mf1, eta_mf2 [1],
+    tau_bf1, tau_bf2 [N*m]), the speed increasing strictly, the mesh
+    efficiencies in (0, 1]."""
+
+    def check(self, value, where):
+        rows = super().check(value, where)
+        label = f"{where}.{self.name}" if where else self.name
+        for k, row in enumerate(rows):
+            for j in (1, 2):
+                if not 0 < row[j] <= 1:
+                    raise ParameterError(
+                        f"parameter {label}: row {k + 1}, column {j + 1} (eta_mf{j}) = "
+                        f"{row[j]:g}: a mesh efficiency must be in (0, 1]", variable=label)
+        return rows
+
+
+IDEAL_LOSS_TABLE = ((0.0, 1.0, 1.0, 0.0, 0.0),)
+
+
+class LossyGear(PartialRotElementaryTwoFlangesAndSupport2, FrictionModes):
+    """A gear with mesh efficiency and bearing friction, which may stick
+    (MSL ``LossyGear``; Pelchen, Schweiger & Otter 2002, with Bertsch's
+    2009 correction)::
+
+        phi_a = ratio*phi_b                       (relative to the support)
+        0 = flange_b.tau + ratio*(flange_a.tau - tauLoss)
+        w_a = der(phi_a),  a_a = der(w_a)
+
+    ``tauLoss`` is the torque lost in the teeth and the bearings, referred
+    to ``flange_a``. With the table's values at ``|w_a|`` (``eta_mf1``:
+    mesh efficiency when ``flange_a`` drives, ``eta_mf2`` when ``flange_b``
+    drives, ``tau_bf1``/``tau_bf2``: bearing friction referred to
+    ``flange_a`` in those cases)::
+
+        quadrant1 = (1 - eta_mf1)*flange_a.tau + tau_bf1      (w_a > 0, a drives)
+        quadrant2 = (1 - 1/eta_mf2)*flange_a.tau + tau_bf2    (w_a > 0, b drives)
+        quadrant3 = (1 - eta_mf1)*flange_a.tau - tau_bf1      (w_a < 0, b drives)
+        quadrant4 = (1 - 1/eta_mf2)*flange_a.tau - tau_bf2    (w_a < 0, a drives)
+        rolling forward:   tauLoss = quadrant1 if tau_eta >= 0 else quadrant2
+        rolling backward:  tauLoss = quadrant4 if tau_eta >= 0 else quadrant3
+        stuck:             a_a = 0, tauLoss = the torque that holds it
+
+    where ``tau_eta = flange_a.tau -+ tau_bf_a`` (the torque past flange_a's
+    own bearing, ``tau_bf_a`` the part of the bearing friction on the a
+    side) tells which side drives. The gear starts rolling forward when the
+    loss needed to stay stuck exceeds ``tauLossMax_p`` (the loss available
+    at ``w_a = 0+``: quadrant 1 or 2 at zero speed, chosen by ``flange_a.tau
+    - tau_bf_a(0)``), backward when it is below ``tauLossMin_m``. The mode
+    machine is :mod:`acausal.mechanics.frictionmodes`'s, with these levels
+    (and no hold above the break-away level, as MSL's LossyGear); a loss
+    table equal to ``[0, 1, 1, 0, 0]`` is an ideal gear (``mode`` Free,
+    no loss). The quadrant is chosen continuously (the loss is continuous
+    where ``tau_eta`` changes sign), not frozen between events as in MSL.
+
+    A negative ``ratio`` is a reversing stage: the losses refer to
+    ``flange_a`` whatever the sign. Zero is rejected.
+
+    Parameters: ``ratio`` [1] flange_a.phi/flange_b.phi (non-zero);
+    ``lossTable`` rows (|w_a| [rad/s], eta_mf1 [1], eta_mf2 [1], tau_bf1
+    [N*m], tau_bf2 [N*m]), efficiencies in (0, 1]; ``useSupport``
+    (structural). States: ``phi_a``, ``phi_b`` [rad], ``w_a`` [rad/s],
+    ``a_a`` [rad/s2], ``tauLoss``, ``tau_eta`` [N*m]; the machine's
+    (``mode``, ``startForward``, ``startBackward``, ``sa``, ``locked``,
+    ``free``). Connectors: ``flange_a``, ``flange_b``, ``support`` (with
+    useSupport).
+    """
+
+    ratio = NonZeroParameter(1.0, "1", "transmission ratio flange_a.phi/flange_b.phi")
+    lossTable = _LossTable(IDEAL_LOSS_TABLE, 5, ("rad/s", "1", "1", "N*m", "N*m"),
+                           "mesh efficiencies and bearing friction against |w_a|: rows (|w_a| "
+                           "[rad/s], eta_mf1, eta_mf2 [1], tau_bf1, tau_bf2 [N*m])")
+    w_a = Variable(0.0, "rad/s", "angular velocity of flange_a relative to the support")
+    a_a = Variable(0.0, "rad/s2", "angular acceleration of flange_a relative to the support")
+    tauLoss = Variable(0.0, "N*m", "torque lost in the teeth and bearings, referred to flange_a")
+    tau_eta = Variable(0.0, "N*m", "torque that tells the driving side (flange_a.tau past the "
+                       "bearing friction on side a)")
+
+    def _ideal(self):
+        return all(abs(x - y) <= 1e-15 for row in self.lossTable
+                   for x, y in zip(row, IDEAL_LOSS_TABLE[0])) and len(self.lossTable) == 1
+
+    def _at(self, speed):
+        """(eta_mf1, eta_mf2, tau_bf1, tau_bf2, tau_bf_a) at ``speed`` >= 0."""
+        eta1, eta2 = (interpolate(self.lossTable, j, speed) for j in (1, 2))
+        bf1, bf2 = (sp.Abs(interpolate(self.lossTable, j, speed)) for j in (3, 4))
+        split = (bf1 - bf2) / (eta1 - 1 / eta2)
+        if all(r[1] == 1.0 and r[2] == 1.0 for r in self.lossTable):
+            bf_a = bf1 / 2      # no mesh loss: the bearing friction is split evenly
+        else:
+            bf_a = Piecewise((bf1 / 2, (sp.Abs(eta1 - 1) <= 1e-15) & (sp.Abs(eta2 - 1) <= 1e-15)),
+                             (split, True))
+        return eta1, eta2, bf1, bf2, bf_a
+
+    def _quadrants(self, speed):
+        eta1, eta2, bf1, bf2, _ = self._at(speed)
+        t = self.flange_a.tau
+        return ((1 - eta1) * t + bf1, (1 - 1 / eta2) * t + bf2,
+                (1 - eta1) * t - bf1, (1 - 1 / eta2) * t - bf2)
+
+    def equations(self):
+        locked, _, forward = self._configuration()
+        bf_a = self._at(sp.Abs(self.w_a))[4]
+        t = self.flange_a.tau
+        return [Eq(self.phi_a, self.ratio * self.phi_b),
+                Eq(0, self.flange_b.tau + self.ratio * (t - self.tauLoss)),
+                Eq(self.w_a, der(self.phi_a)), Eq(self.a_a, der(self.w_a)),
+                Eq(self.tau_eta, Piecewise((t, locked), (t - bf_a, forward), (t + bf_a, True)))]
+
+    # -- the machine's law ------------------------------------------------------
+    def friction_motion(self):
+        return self.w_a, self.a_a
+
+    def friction_force(self):
+        return self.tauLoss
+
+    def engagement(self):
+        return sp.Integer(0) if self._ideal() else None
+
+    def sliding_force(self, direction):
+        q1, q2, q3, q4 = self._quadrants(sp.Abs(self.w_a))
+        pos = self.tau_eta >= 0
+        if direction > 0:
+            return Piecewise((q1, pos), (q2, True))
+        return Piecewise((q4, pos), (q3, True))
+
+    def break_level(self, direction):
+        q1, q2, q3, q4 = self._quadrants(0)
+        bf_a0 = self._at(0)[4]
+        t = self.flange_a.tau
+        if direction > 0:
+            return Piecewise((q1, t - bf_a0 > 0), (q2, True))
+        return Piecewise((q4, t + bf_a0 > 0), (q3, True))
+
+    def slide_offset(self, direction):
+        return self.sliding_force(direction)
