@@ -35,6 +35,7 @@ class VarInfo:
     desc: str
     owner: str
     port: bool = False     # a connector variable
+    unit_declared: bool = True   # False: no unit was given (not checked)
 
 
 @dataclass
@@ -95,9 +96,11 @@ def _declare(flat, comp):
         if isinstance(d, Parameter):
             flat.params[sym.name] = ParamInfo(sym, comp.value(name), d, path)
         elif isinstance(d, Variable):
-            flat.variables[sym.name] = VarInfo(sym, comp.start(name), d.unit, d.desc, path)
+            flat.variables[sym.name] = VarInfo(sym, comp.start(name), d.unit, d.desc, path,
+                                               unit_declared=d.unit_declared)
         elif isinstance(d, Discrete):
-            flat.discretes[sym.name] = VarInfo(sym, Start(d.start, True), d.unit, d.desc, path)
+            flat.discretes[sym.name] = VarInfo(sym, Start(d.start, True), d.unit, d.desc, path,
+                                               unit_declared=d.unit_declared)
     for name, ctype in comp.connectors().items():
         port = comp.port(name)
         if isinstance(port, SignalPort):

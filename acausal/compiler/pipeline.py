@@ -18,6 +18,7 @@ from ..lang.declare import Start
 from ..errors import ModelError, ParameterError, UsageError
 from ..lang.fastdiff import diff
 from .flatten import flatten
+from .units import check_units
 from .structure import Graph, check_structure, dummy_derivatives, pantelides
 from ..lang.symbols import base_and_order, der, time
 
@@ -99,6 +100,8 @@ class CompiledModel:
         """The compile stages after flattening: an :class:`acausal.cache.Entry`
         and the compiled ``make`` and ``fixjac``."""
         clock = _Stages(self.stage_s)
+        check_units(flat)
+        clock.lap("units")
         red = self.reduced = eliminate_aliases(flat)
         clock.lap("aliases")
         check_structure(red.equations, red.unknowns, flat)

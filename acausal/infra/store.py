@@ -36,7 +36,8 @@ FORMAT = 3
 _OFF = {"off", "0", "none", "false", "no"}
 _COMPILER_MODULES = ("compiler/flatten", "compiler/aliases", "compiler/structure",
                      "compiler/causalize", "compiler/codegen", "compiler/pipeline",
-                     "lang/fastdiff", "lang/symbols", "infra/store", "lang/declare")
+                     "lang/fastdiff", "lang/symbols", "infra/store", "lang/declare",
+                     "compiler/units")
 _source_hash = []
 
 

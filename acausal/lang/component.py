@@ -247,7 +247,7 @@ class Model(Component):
             raise ModelError(f"expose({name!r}): {port!r} is not a connector")
         self._exposed[name] = port
 
-    def parameter(self, name, default, unit="1", desc="", **bounds):
+    def parameter(self, name, default, unit=None, desc="", **bounds):
         """Declare a parameter of this model; returns its symbol."""
         p = Parameter(default, unit, desc, **bounds)
         p.name = name
@@ -255,7 +255,7 @@ class Model(Component):
         self._values[name] = p.check(default, self.path)
         return self.symbol(name)
 
-    def variable(self, name, start=0.0, unit="1", desc="", fixed=False):
+    def variable(self, name, start=0.0, unit=None, desc="", fixed=False):
         """Declare a variable of this model; returns its symbol."""
         if isinstance(start, Start):
             start, fixed = start.value, start.fixed

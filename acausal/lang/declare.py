@@ -17,8 +17,11 @@ class Declaration:
 
     kind = "declaration"
 
-    def __init__(self, unit="1", desc=""):
-        self.unit = unit
+    def __init__(self, unit=None, desc=""):
+        # a unit not given is dimensionless for display and data ("1"), but
+        # unchecked (Modelica's unit = ""): acausal.compiler.units skips it
+        self.unit_declared = unit is not None
+        self.unit = "1" if unit is None else unit
         self.desc = desc
         self.name = None
 
@@ -42,7 +45,7 @@ class Parameter(Declaration):
 
     kind = "parameter"
 
-    def __init__(self, default, unit="1", desc="", *, min=None, max=None,
+    def __init__(self, default, unit=None, desc="", *, min=None, max=None,
                  min_open=False, max_open=False, structural=False, choices=None):
         super().__init__(unit, desc)
         self.default = default
@@ -118,7 +121,7 @@ class Variable(Declaration):
 
     kind = "variable"
 
-    def __init__(self, start=0.0, unit="1", desc="", *, fixed=False):
+    def __init__(self, start=0.0, unit=None, desc="", *, fixed=False):
         super().__init__(unit, desc)
         self.start = Start(start, fixed)
 
@@ -129,7 +132,7 @@ class Discrete(Declaration):
 
     kind = "discrete"
 
-    def __init__(self, start=0.0, unit="1", desc=""):
+    def __init__(self, start=0.0, unit=None, desc=""):
         super().__init__(unit, desc)
         self.start = start
 

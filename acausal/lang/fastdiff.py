@@ -5,9 +5,15 @@ an expression, and each new node queries sympy's assumption system; on the
 polynomial-like residuals of mechanisms that is most of the cost of a
 Jacobian. :func:`diff` applies the sum, product and power rules directly to
 ``Add``, ``Mul``, ``Pow``, ``Piecewise`` (piece by piece) and functions
-(chain rule with the function's own ``fdiff``), skips sub-trees
-free of the variable, and hands every other node (``Abs``, ``Max``...) to
-``sympy.diff``, so the result is the same derivative.
+(chain rule with the function's own ``fdiff``, ``Max`` and ``Min``
+included), skips sub-trees free of the variable, and hands every other node
+to ``sympy.diff``, so the result is the same derivative.
+
+Every variable of a model is real. ``Abs`` is therefore differentiated as
+``sign(u) * du/dx``: sympy's own rule, for a symbol it does not know to be
+real, writes ``re()`` and ``im()`` terms that no printer can generate (a
+quadratic drag ``-c*v*Abs(v)`` at a planar loop's joint, whose velocity is an
+expression of the loop's states, failed to compile that way).
 """
 import sympy as sp
 
@@ -36,8 +42,12 @@ def diff(expr, x):
         if all(d == 0 for d, _ in pieces):
             return sp.S.Zero
         return sp.Piecewise(*pieces, evaluate=False)
-    if (isinstance(expr, sp.Function)
-            and type(expr)._eval_derivative is sp.Function._eval_derivative):
+    if isinstance(expr, sp.Abs):
+        u = expr.args[0]
+        return sp.sign(u) * diff(u, x)
+    if (isinstance(expr, (sp.Max, sp.Min))
+            or (isinstance(expr, sp.Function)
+                and type(expr)._eval_derivative is sp.Function._eval_derivative)):
         # chain rule, as Function._eval_derivative (not for Abs & co., which
         # define their own derivative)
         try:

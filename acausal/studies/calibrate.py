@@ -21,7 +21,7 @@ from ..data import load_dataset
 from .differences import ForwardDifferences  # noqa: F401  (re-exported: acausal.diagnose uses it)
 from ..errors import AcausalError, CalibrationError, ModelError, ModelFileError
 from ..modelfile import compile_file, evaluate_measures
-from .profile import profiles
+from .profile import Confidence, Coordinates, Tracing, profiles
 
 
 # Finite-difference step of the least squares, absolute in the optimiser's
@@ -420,10 +420,11 @@ def _profile_intervals(path, dataset, names, signals, n_res, n_sim, sol, sc, xs,
     profiles' Wald intervals are those of :func:`_linear_intervals`."""
     return profiles(
         _no_evidence_on_failure(path, dataset, names, signals, n_res, n_sim), xs, names,
-        every=every, bounds=(sc.lo, sc.hi), log=sc.logp, scale=sc.scale,
-        dispersion=max(2 * sol.cost / dof, 1.0) if dof > 0 else 1.0,
-        dof=dof or None, jacobian=sol.jac, fd_step=FD_STEP, inner_max_nfev=20,
-        inner_tol=1e-6, crossing_tol=1e-2)
+        every=every, coords=Coordinates((sc.lo, sc.hi), sc.logp, sc.scale),
+        confidence=Confidence(dispersion=max(2 * sol.cost / dof, 1.0) if dof > 0 else 1.0,
+                              dof=dof or None),
+        tracing=Tracing(fd_step=FD_STEP, inner_max_nfev=20, inner_tol=1e-6, crossing_tol=1e-2),
+        jacobian=sol.jac)
 
 
 def _fit_bounds(mf, entries, bounds):

@@ -181,36 +181,47 @@ class _Evaluator:
         return -math.log1p(s.d2) if np.isfinite(s.d2) else 1e3
 
 
+@dataclass(frozen=True)
+class Search:
+    """How the conditions' ranges are searched: a Latin hypercube of
+    ``n_initial`` points (default 8 per condition, at least 12), then a
+    bounded Powell search from the ``n_refine`` best, each of at most
+    ``max_refine_evals`` evaluations; ``seed`` of the hypercube."""
+
+    n_initial: int | None = None
+    n_refine: int = 3
+    max_refine_evals: int = 60
+    seed: int = 0
+
+
 def design_experiment(rivals: Mapping[str, Rival], conditions: Sequence[Condition],
                       signals: Sequence[Signal], *, fixed: Mapping[str, float] | None = None,
-                      reference: Mapping[str, float] | None = None, n_initial: int | None = None,
-                      n_refine: int = 3, max_refine_evals: int = 60, seed: int = 0,
+                      reference: Mapping[str, float] | None = None, search: Search = Search(),
                       min_separation: float = 3.0, times=None) -> NextExperiment:
     """The experiment within the conditions' ranges whose predicted outcomes
     differ most between ``rivals`` (name -> callable conditions -> {signal:
     samples}, or None when it cannot predict), in noise floors of the best of
     ``signals``. ``fixed``: further parameter settings passed to every rival
     unchanged. ``reference``: the conditions of the data so far (its
-    separation is reported as ``baseline``). Latin hypercube of
-    ``n_initial`` points (default 8 per condition, at least 12), then a
-    bounded Powell search from the ``n_refine`` best. ``min_separation``
-    [floors]: below it the result is not ``decisive`` (3 floors: the wrong
-    rival's chi^2 rises by 9, p = 0.003 for one degree of freedom).
-    ``times``: the rivals' sample times, kept in the result for its plot."""
+    separation is reported as ``baseline``). ``search``: :class:`Search`.
+    ``min_separation`` [floors]: below it the result is not ``decisive``
+    (3 floors: the wrong rival's chi^2 rises by 9, p = 0.003 for one degree
+    of freedom). ``times``: the rivals' sample times, kept in the result for
+    its plot."""
     conds = list(conditions)
     if not conds:
         raise UsageError("no experiment conditions to search (declare `conditions` "
                          "with their ranges in the model file)")
     ev = _Evaluator(rivals, conds, signals, fixed)
-    n0 = n_initial or max(12, 8 * len(conds))
-    pts = qmc.LatinHypercube(d=len(conds), seed=seed).random(n0)
+    n0 = search.n_initial or max(12, 8 * len(conds))
+    pts = qmc.LatinHypercube(d=len(conds), seed=search.seed).random(n0)
     pts = np.vstack([np.full(len(conds), 0.5), pts])
     scored = sorted(pts, key=ev.loss)
-    for start in scored[:n_refine]:
+    for start in scored[:search.n_refine]:
         if not np.isfinite(ev(start).d2):
             continue
         optimize.minimize(ev.loss, start, method="Powell", bounds=[(0.0, 1.0)] * len(conds),
-                          options=dict(maxfev=max_refine_evals, xtol=1e-3, ftol=1e-4))
+                          options=dict(maxfev=search.max_refine_evals, xtol=1e-3, ftol=1e-4))
     best_key = max(ev.cache, key=lambda k: ev.cache[k].d2)
     best = ev.cache[best_key]
     if best.signal is None:

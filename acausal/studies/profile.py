@@ -43,6 +43,49 @@ Residuals = Callable[[np.ndarray], np.ndarray]
 
 
 @dataclass(frozen=True)
+class Coordinates:
+    """How the parameters are seen by a profile: ``bounds`` (low, high)
+    arrays in natural units (may hold +-inf; None: unbounded), ``log`` per
+    parameter (or one bool for all: fit and profile on log(x)), ``scale``
+    the typical magnitudes of the others (default |x_opt|)."""
+
+    bounds: tuple | None = None
+    log: bool | Sequence[bool] = False
+    scale: Sequence[float] | None = None
+
+
+@dataclass(frozen=True)
+class Confidence:
+    """The interval's level and how the noise is known: ``dispersion`` and
+    ``dof`` as in :func:`threshold` (known noise: 1.0 and None)."""
+
+    level: float = 0.95
+    dispersion: float = 1.0
+    dof: int | None = None
+
+    def threshold(self) -> float:
+        return threshold(self.level, self.dispersion, self.dof)
+
+
+@dataclass(frozen=True)
+class Tracing:
+    """How hard a profile is traced. ``fd_step``: absolute finite-difference
+    step in the profile's variables (1e-3 for simulated objectives, see
+    ``acausal.studies.calibrate.FD_STEP``); ``rel_tol``: the Wald interval is
+    trusted within this fraction; ``max_points`` per side;
+    ``inner_max_nfev``, ``inner_tol``: limits of each re-optimisation of the
+    others; ``crossing_tol``: the threshold crossing is located to this
+    fraction of the last step (looser values for costly objectives)."""
+
+    fd_step: float = 1e-6
+    rel_tol: float = 0.1
+    max_points: int = 40
+    inner_max_nfev: int | None = None
+    inner_tol: float = 1e-10
+    crossing_tol: float = 1e-5
+
+
+@dataclass(frozen=True)
 class Profile:
     """The profile of one parameter (natural units throughout).
 
@@ -247,38 +290,29 @@ def _refine(obj, below, above, thresh, chi0):
 
 
 def profile_likelihood(residuals: Residuals, x_opt: Sequence[float], index: int, *,
-                       bounds: tuple | None = None, log: bool | Sequence[bool] = False,
-                       scale: Sequence[float] | None = None, level: float = 0.95,
-                       dispersion: float = 1.0, dof: int | None = None,
-                       name: str | None = None, fd_step: float = 1e-6,
-                       rel_tol: float = 0.1, max_points: int = 40,
-                       inner_max_nfev: int | None = None, inner_tol: float = 1e-10,
-                       crossing_tol: float = 1e-5, jacobian=None) -> Profile:
+                       coords: Coordinates = Coordinates(),
+                       confidence: Confidence = Confidence(), tracing: Tracing = Tracing(),
+                       name: str | None = None, jacobian=None) -> Profile:
     """Profile likelihood interval of parameter ``index``.
 
     ``residuals(x)``: weighted residuals (chi^2 = sum r^2) at the parameter
     vector ``x`` (natural units); ``x_opt``: the least-squares optimum;
-    ``bounds``: (low, high) arrays (may hold +-inf); ``log``: per parameter
-    (or one bool for all), fit and profile on log(x); ``scale``: typical
-    magnitudes of the others (default |x_opt|); ``level``, ``dispersion``,
-    ``dof``: the threshold (:func:`threshold`); ``fd_step``: absolute
-    finite-difference step in the profile's variables (1e-3 for simulated
-    objectives, see ``acausal.calibrate.FD_STEP``); ``jacobian``: d r / d u
-    at the optimum, if known (else forward differences). ``inner_max_nfev``,
-    ``inner_tol``: limits of each re-optimisation of the others;
-    ``crossing_tol``: the threshold crossing is located to this fraction of
-    the last step (looser values for costly simulated objectives)."""
-    c = _Coords(x_opt, log, scale, bounds)
-    thr = threshold(level, dispersion, dof)
-    obj = _Objective(residuals, c, int(index), fd_step, inner_max_nfev, inner_tol,
-                     crossing_tol)
+    ``coords``: bounds, log scaling and scales (:class:`Coordinates`);
+    ``confidence``: the threshold (:class:`Confidence`); ``tracing``: steps
+    and limits (:class:`Tracing`); ``jacobian``: d r / d u at the optimum, if
+    known (else forward differences)."""
+    c = _Coords(x_opt, coords.log, coords.scale, coords.bounds)
+    thr = confidence.threshold()
+    t = tracing
+    obj = _Objective(residuals, c, int(index), t.fd_step, t.inner_max_nfev, t.inner_tol,
+                     t.crossing_tol)
     chi0 = obj.chi2(np.zeros(c.x0.size))
-    hw = float(wald_halfwidths(residuals, x_opt, log=log, scale=scale, thresh=thr,
-                               fd_step=fd_step, jacobian=jacobian)[index])
+    hw = float(wald_halfwidths(residuals, x_opt, log=coords.log, scale=coords.scale, thresh=thr,
+                               fd_step=t.fd_step, jacobian=jacobian)[index])
     obj.n += c.x0.size + 1 if jacobian is None else 0
     h0 = 0.1 * hw if np.isfinite(hw) and hw > 0 else 0.1
-    sides = [_trace(obj, d, h0, thr, chi0, max_points) for d in (-1, 1)]
-    return _assemble(obj, sides, hw, thr, level, chi0, name, rel_tol)
+    sides = [_trace(obj, d, h0, thr, chi0, t.max_points) for d in (-1, 1)]
+    return _assemble(obj, sides, hw, thr, confidence.level, chi0, name, t.rel_tol)
 
 
 def _assemble(obj, sides, hw, thr, level, chi0, name, rel_tol) -> Profile:
@@ -310,8 +344,7 @@ def _assemble(obj, sides, hw, thr, level, chi0, name, rel_tol) -> Profile:
 
 
 def linear_check(residuals: Residuals, x_opt: Sequence[float], index: int, *,
-                 log: bool | Sequence[bool] = False, scale: Sequence[float] | None = None,
-                 bounds: tuple | None = None, thresh: float = 3.84, jacobian=None,
+                 coords: Coordinates = Coordinates(), thresh: float = 3.84, jacobian=None,
                  fd_step: float = 1e-6, rel_tol: float = 0.1) -> tuple:
     """A cheap screen for a Wald interval (two evaluations): (ok, ratios).
 
@@ -324,8 +357,9 @@ def linear_check(residuals: Residuals, x_opt: Sequence[float], index: int, *,
     near each end, a side longer or shorter than the Wald half-width by more
     than ``rel_tol``: the test of :func:`profile_likelihood`), when an end
     lies beyond a bound, or when the Jacobian cannot determine the
-    parameter: then trace the profile."""
-    c = _Coords(x_opt, log, scale, bounds)
+    parameter: then trace the profile. ``coords``: :class:`Coordinates`."""
+    log, scale = coords.log, coords.scale
+    c = _Coords(x_opt, log, scale, coords.bounds)
     k = c.x0.size
     if jacobian is None:
         fd = ForwardDifferences(lambda u: residuals(c.to_x(u)), fd_step, np.full(k, np.inf))
@@ -361,30 +395,27 @@ def jacobian_in_profile_variables(jac_x, x_opt, *, log=False, scale=None) -> np.
 
 
 def profiles(residuals: Residuals, x_opt: Sequence[float], names: Sequence[str], *,
-             every: bool = False, bounds: tuple | None = None,
-             log: bool | Sequence[bool] = False, scale: Sequence[float] | None = None,
-             dispersion: float = 1.0, dof: int | None = None, jacobian=None,
-             fd_step: float = 1e-6, **options) -> dict:
+             every: bool = False, coords: Coordinates = Coordinates(),
+             confidence: Confidence = Confidence(), tracing: Tracing = Tracing(),
+             jacobian=None) -> dict:
     """name -> :class:`Profile` for the parameters ``names`` (in the order of
     ``x_opt``): every one when ``every``, else those whose linearised
     interval fails :func:`linear_check` (two evaluations each). ``jacobian``:
     d r / d u at the optimum (see :func:`jacobian_in_profile_variables`),
-    else forward differences; ``options``: further keyword arguments of
-    :func:`profile_likelihood` (``inner_max_nfev``, ``inner_tol``,
-    ``crossing_tol``, ``level``, ``max_points``, ``rel_tol``)."""
-    common = dict(log=log, scale=scale, bounds=bounds, fd_step=fd_step)
-    rel_tol = options.get("rel_tol", 0.1)
+    else forward differences with ``tracing.fd_step``."""
     if jacobian is None:
-        c = _Coords(x_opt, log, scale, None)
-        fd = ForwardDifferences(lambda u: residuals(c.to_x(u)), fd_step,
+        c = _Coords(x_opt, coords.log, coords.scale, None)
+        fd = ForwardDifferences(lambda u: residuals(c.to_x(u)), tracing.fd_step,
                                 np.full(c.x0.size, np.inf))
         jacobian = fd.jac(np.zeros(c.x0.size))
-    thr = threshold(options.get("level", 0.95), dispersion, dof)
+    thr = confidence.threshold()
     out = {}
     for k, name in enumerate(names):
-        if not every and linear_check(residuals, x_opt, k, thresh=thr, jacobian=jacobian,
-                                      rel_tol=rel_tol, **common)[0]:
+        if not every and linear_check(residuals, x_opt, k, coords=coords, thresh=thr,
+                                      jacobian=jacobian, fd_step=tracing.fd_step,
+                                      rel_tol=tracing.rel_tol)[0]:
             continue
-        out[name] = profile_likelihood(residuals, x_opt, k, dispersion=dispersion, dof=dof,
-                                       name=name, jacobian=jacobian, **common, **options)
+        out[name] = profile_likelihood(residuals, x_opt, k, coords=coords,
+                                       confidence=confidence, tracing=tracing, name=name,
+                                       jacobian=jacobian)
     return out

@@ -182,9 +182,10 @@ class Toggle(Component):
 
     flange = Flange("flange")
     mode = Discrete(1, "1", "a mode that is never right")
+    F0 = Parameter(1.0, "N", "force per unit of mode")
 
     def equations(self):
-        return [Eq(self.flange.f, self.mode)]
+        return [Eq(self.flange.f, self.F0 * self.mode)]
 
     def events(self):
         def flip(state):

@@ -81,7 +81,7 @@ class ParamInterval:
 
 
 def _setup(task: ProfileTask):
-    from ...studies.profile import jacobian_in_profile_variables
+    from ...studies.profile import Coordinates, jacobian_in_profile_variables
     ps = task.params
     x = np.array([p.start for p in ps])
     log = [p.low > 0 and p.start > 0 for p in ps]
@@ -92,7 +92,7 @@ def _setup(task: ProfileTask):
     obj = Objective(model_of(task.problem, task.candidate), ds, [p.name for p in ps],
                     max_evals=budget_evals(len(ds.experiments)), penalty=task.penalty,
                     backend=task.problem.settings.integrator)
-    return x, dict(log=log, scale=scale, bounds=bounds, jacobian=J, fd_step=FD_STEP), obj
+    return x, dict(coords=Coordinates(bounds, log, scale), jacobian=J), obj
 
 
 def budget_evals(n_experiments: int) -> int:
@@ -102,15 +102,18 @@ def budget_evals(n_experiments: int) -> int:
 
 def profile_parameter(task: ProfileTask) -> ParamInterval:
     """The cheap check, then the profile if the check fails (module doc)."""
-    from ...studies.profile import linear_check, profile_likelihood, threshold, wald_halfwidths
+    from ...studies.profile import (Confidence, Tracing, linear_check, profile_likelihood,
+                                    wald_halfwidths)
     x, common, obj = _setup(task)
+    coords = common["coords"]
     i, name = task.index, task.params[task.index].name
-    thr = threshold(0.95, task.dispersion, task.dof)
-    hw = float(wald_halfwidths(obj, x, log=common["log"], scale=common["scale"], thresh=thr,
+    confidence = Confidence(0.95, task.dispersion, task.dof)
+    thr = confidence.threshold()
+    hw = float(wald_halfwidths(obj, x, log=coords.log, scale=coords.scale, thresh=thr,
                                jacobian=common["jacobian"])[i])
-    wald = _wald(x[i], hw, common["log"][i], common["scale"][i])
+    wald = _wald(x[i], hw, coords.log[i], coords.scale[i])
     try:
-        ok, ratios = linear_check(obj, x, i, thresh=thr, **common)
+        ok, ratios = linear_check(obj, x, i, thresh=thr, fd_step=FD_STEP, **common)
     except Exception as exc:  # noqa: BLE001 - the budget or a failed simulation
         return ParamInterval(name, x[i], wald, (), "linear (check failed)", *wald,
                              n_eval=obj.n_eval, message=f"{type(exc).__name__}: {exc}")
@@ -118,9 +121,10 @@ def profile_parameter(task: ProfileTask) -> ParamInterval:
         return ParamInterval(name, x[i], wald, ratios, "linear (checked)", *wald,
                              n_eval=obj.n_eval)
     try:
-        pr = profile_likelihood(obj, x, i, dispersion=task.dispersion, dof=task.dof, name=name,
-                                max_points=MAX_POINTS, crossing_tol=CROSSING_TOL,
-                                inner_max_nfev=10 * len(x), inner_tol=1e-6, **common)
+        tracing = Tracing(fd_step=FD_STEP, max_points=MAX_POINTS, crossing_tol=CROSSING_TOL,
+                          inner_max_nfev=10 * len(x), inner_tol=1e-6)
+        pr = profile_likelihood(obj, x, i, confidence=confidence, tracing=tracing, name=name,
+                                **common)
     except Exception as exc:  # noqa: BLE001 - out of budget: keep the linear interval
         return ParamInterval(name, x[i], wald, ratios, "linear (profile not finished)",
                              *wald, n_eval=obj.n_eval, message=f"{type(exc).__name__}: {exc}")

@@ -112,7 +112,7 @@ def _fixed_only(rv, signals, ref, times):
 def next_experiment(problem, ds, dec, rk, index=None) -> NextStep:
     """Stage: the experiment that splits the best candidate's class (module doc)."""
     import time
-    from ...studies.design import conditions_of, design_experiment
+    from ...studies.design import Search, conditions_of, design_experiment
     from ...modelfile import compile_file
     t0 = time.perf_counter()
     rows = class_rows(dec, rk, index)
@@ -130,10 +130,10 @@ def next_experiment(problem, ds, dec, rk, index=None) -> NextStep:
         if not conds:
             res = _fixed_only(rv, signals, ref, times)
         else:
+            search = Search(n_initial=max(8, 4 * len(conds)), n_refine=N_REFINE,
+                            max_refine_evals=MAX_REFINE_EVALS)
             res = design_experiment(rv, conds, signals, fixed=dict(ref.conditions),
-                                    reference=dict(ref.conditions),
-                                    n_initial=max(8, 4 * len(conds)), n_refine=N_REFINE,
-                                    max_refine_evals=MAX_REFINE_EVALS, times=times)
+                                    reference=dict(ref.conditions), search=search, times=times)
     except AcausalError as exc:
         return NextStep(labels, None, f"not computed: {exc}", time.perf_counter() - t0,
                         ref.name)
