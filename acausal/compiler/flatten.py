@@ -10,9 +10,10 @@ import sympy as sp
 
 from ..lang.component import Model
 from ..lang.connectors import SignalPort
-from ..lang.declare import Discrete, Parameter, Start, Variable
+from ..lang.declare import Discrete, Parameter, Start, TimeEvent, Variable
 from ..errors import ConnectionError_, ModelError
 from ..lang.symbols import base_and_order, time
+from .timeevents import find_time_switches
 
 
 @dataclass
@@ -36,6 +37,7 @@ class VarInfo:
     owner: str
     port: bool = False     # a connector variable
     unit_declared: bool = True   # False: no unit was given (not checked)
+    internal: bool = False  # made by the compiler (a time switch), not declared
 
 
 @dataclass
@@ -58,6 +60,8 @@ class Flat:
     assertions: list = field(default_factory=list)
     unconnected: list = field(default_factory=list)  # port paths
     owners: dict = field(default_factory=dict)      # component path -> class name
+    time_switches: list = field(default_factory=list)  # compiler/timeevents.TimeSwitch
+    time_events: list = field(default_factory=list)    # lang.declare.TimeEvent
 
     def owner_of(self, sym):
         """Component path owning a variable/parameter symbol."""
@@ -85,6 +89,7 @@ def flatten(model):
     for comp in comps:
         _equations(flat, comp, known)
     _connections(flat, model, comps)
+    flat.time_switches = find_time_switches(flat)
     return flat
 
 
@@ -181,6 +186,9 @@ def _equations(flat, comp, known):
         flat.equations.append(Equation(expr, path, f"equation {i + 1} ({type(comp).__name__})"))
     for ev in comp.gather("events"):
         ev.owner = path
+        if isinstance(ev, TimeEvent):
+            flat.time_events.append(ev)
+            continue
         ev.expr = relocate(ev.expr, comp, known)
         flat.events.append(ev)
     for a in comp.gather("assertions"):

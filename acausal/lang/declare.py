@@ -169,6 +169,32 @@ class Event:
         self.owner = None  # set by flattening: the component path
 
 
+class TimeEvent:
+    r"""Events at instants known without integrating (a table's breakpoints,
+    a clock), which a component returns from ``events()`` beside its
+    :class:`Event`\ s. The integrator stops exactly at each one (IDA's stop
+    time, not a root search) and the hybrid loop runs ``action``.
+
+    ``next_time(state)``: the first instant of this event strictly after
+    ``state.t`` [s] (``math.inf`` for none); it may read parameters and
+    discrete values (``state[symbol]``), not variables.
+    ``action(state)``: sets the discrete values (``state[d] = v``) for the
+    interval that begins at ``state.t``; it runs at the start of a run (to
+    set them for the first interval; variables cannot be read there) and
+    at each of this event's instants (recorded in ``res.events`` under
+    ``name`` unless ``log=False``).
+    """
+
+    def __init__(self, name, next_time, action, *, log=True):
+        if not callable(next_time) or not callable(action):
+            raise ModelError(f"time event {name}: next_time and action must be functions")
+        self.name = name
+        self.next_time = next_time
+        self.action = action
+        self.log = log
+        self.owner = None  # set by flattening: the component path
+
+
 class Assertion:
     """A condition ``expr > 0`` that must hold while simulating; when it is
     crossed the run stops with ``message`` naming the component."""

@@ -7,6 +7,7 @@ import numbers
 import sympy as sp
 
 from acausal.lang import Component, Eq, Flange, Parameter, RotFlange, Variable, der
+from acausal.lang.connectors import RealInput, RealOutput
 
 from acausal.errors import ModelError, ParameterError
 
@@ -274,6 +275,26 @@ class PartialElementaryOneFlangeAndSupport2(_WithSupport):
                 + self.support_reaction(-self.flange.f))
 
 
+class PartialForce(PartialElementaryOneFlangeAndSupport2):
+    """A force law on one flange relative to its support (MSL
+    ``PartialForce``): ``f = flange.f`` is the force the component takes
+    from the flange (the body there receives ``-f``), ``v = der(s)`` the
+    flange's velocity relative to the support. A leaf gives ``f``.
+
+    Parameters: ``useSupport`` (structural). States: ``s`` [m], ``v``
+    [m/s], ``f`` [N]. Connectors: ``flange``, ``support`` (with useSupport).
+    """
+
+    diagnosis_site = "source"   # what acausal.diagnose may extend here
+
+    f = Variable(0.0, "N", "force the component takes from the flange (= flange.f; the "
+                 "body receives -f)")
+    v = Variable(0.0, "m/s", "velocity of flange with respect to support (= der(s))")
+
+    def equations(self):
+        return [Eq(self.f, self.flange.f), Eq(self.v, der(self.s))]
+
+
 class PartialElementaryTwoFlangesAndSupport2(_WithSupport):
     """Two translational flanges and an optional ``support`` (MSL's partial
     of the same name): ``s_a = flange_a.s - support.s``, ``s_b = flange_b.s
@@ -313,6 +334,28 @@ class PartialRotElementaryOneFlangeAndSupport2(_WithSupport):
     def equations(self):
         return ([Eq(self.phi, self.flange.phi - self.support_across())]
                 + self.support_reaction(-self.flange.tau))
+
+
+class PartialTorque(PartialRotElementaryOneFlangeAndSupport2):
+    """A torque law on one flange relative to its support (MSL
+    ``PartialTorque`` with the leaves' ``w`` and ``tau``): ``tau =
+    -flange.tau`` is the torque that accelerates the flange (the body there
+    receives ``+tau``), ``w = der(phi)`` the flange's angular velocity
+    relative to the support. A leaf gives ``tau``.
+
+    Parameters: ``useSupport`` (structural). States: ``phi`` [rad], ``w``
+    [rad/s], ``tau`` [N*m]. Connectors: ``flange``, ``support`` (with
+    useSupport).
+    """
+
+    diagnosis_site = "source"   # what acausal.diagnose may extend here
+
+    tau = Variable(0.0, "N*m", "accelerating torque acting at the flange (= -flange.tau)")
+    w = Variable(0.0, "rad/s", "angular velocity of flange with respect to support "
+                 "(= der(phi))")
+
+    def equations(self):
+        return [Eq(self.tau, -self.flange.tau), Eq(self.w, der(self.phi))]
 
 
 class PartialRotElementaryTwoFlangesAndSupport2(_WithSupport):
@@ -407,6 +450,23 @@ class PartialRelativeSensor(Component):
         return [Eq(self.flange_a.f, 0), Eq(self.flange_b.f, 0)]
 
 
+class PartialFlowSensor(Component):
+    """Two translational flanges joined rigidly, through which the force
+    passes unchanged (the partial of MSL's ForceSensor, PowerSensor and
+    MultiSensor): ``flange_a.s = flange_b.s``, ``flange_a.f + flange_b.f =
+    0``. Connectors: ``flange_a``, ``flange_b``.
+    """
+
+    diagnosis_site = "sensor"   # what acausal.diagnose may extend here
+
+    flange_a = Flange("left flange")
+    flange_b = Flange("right flange")
+
+    def equations(self):
+        return [Eq(self.flange_a.s, self.flange_b.s),
+                Eq(self.flange_a.f + self.flange_b.f, 0)]
+
+
 class PartialRotAbsoluteSensor(Component):
     """One rotational flange that takes no torque. Connectors: ``flange``."""
 
@@ -431,6 +491,23 @@ class PartialRotRelativeSensor(Component):
         return [Eq(self.flange_a.tau, 0), Eq(self.flange_b.tau, 0)]
 
 
+class PartialRotFlowSensor(Component):
+    """Two rotational flanges joined rigidly, through which the torque
+    passes unchanged (the partial of MSL's TorqueSensor, PowerSensor and
+    MultiSensor): ``flange_a.phi = flange_b.phi``, ``flange_a.tau +
+    flange_b.tau = 0``. Connectors: ``flange_a``, ``flange_b``.
+    """
+
+    diagnosis_site = "sensor"   # what acausal.diagnose may extend here
+
+    flange_a = RotFlange("left flange")
+    flange_b = RotFlange("right flange")
+
+    def equations(self):
+        return [Eq(self.flange_a.phi, self.flange_b.phi),
+                Eq(self.flange_a.tau + self.flange_b.tau, 0)]
+
+
 # -- sources: a law given as a number, an expression or a function -------------
 def _n_positional(fn):
     """How many positional arguments ``fn`` takes (1 when unknown)."""
@@ -449,10 +526,30 @@ def _n_positional(fn):
     return 2 if var else n
 
 
-class PartialSource(Component):
-    """A source whose value (force or torque) follows a law given at
-    construction as
+class SourceValue(Variable):
+    """The value of a :class:`PartialSource` (a force or torque): a variable
+    set by the source's law, or, on a source built without a law, MSL's
+    ``RealInput`` connector of the same name (``connect(sine.y,
+    force.f)``). Read on an instance it is the connector in the second case,
+    the variable's symbol in the first; both stand for the same variable
+    (``force.f``) in equations."""
 
+    def __get__(self, obj, objtype=None):
+        if obj is None:
+            return self
+        if self.name in obj.__dict__.get("_inputs", {}):
+            return obj.port(self.name)
+        return obj.symbol(self.name)
+
+
+class PartialSource(Component):
+    """A source whose value (force or torque) is MSL's ``RealInput`` signal,
+    or follows a law given at construction as
+
+    * nothing (``None``, the default of :class:`~acausal.mechanics.translational.Force`
+      and :class:`~acausal.mechanics.rotational.Torque`): the value is an
+      input connector of the value's name, to be connected to a signal
+      (``connect(sine.y, force.f)``), as MSL's sources;
     * a number: a constant, kept as the run-time parameter ``<name>_const``
       (changeable with ``simulate(params=...)`` without recompiling);
     * a sympy expression: of :data:`acausal.time` and of model parameters
@@ -463,8 +560,9 @@ class PartialSource(Component):
       returns a sympy expression (it may also use ``acausal.time``).
 
     A leaf sets ``quantity`` = (name, unit, description) and
-    ``across_name``, declares the Variable of that name and writes its
-    connector equation with :meth:`law`.
+    ``across_name``, declares the :class:`SourceValue` of that name and
+    writes ``Eq(value, self.law(x))`` (which is empty for an input) and its
+    connector equation.
     """
 
     diagnosis_site = "source"   # what acausal.diagnose may extend here
@@ -473,9 +571,18 @@ class PartialSource(Component):
     across_name = "across variable"   # how the law's argument is called in messages
 
     def __init__(self, value=0.0, **kw):
+        object.__setattr__(self, "_inputs", {})
+        if value is None:
+            name, unit, desc = self.quantity
+            decl = RealInput(f"{desc} (input signal)", unit)
+            decl.name = name
+            self._inputs[name] = decl
         super().__init__(**kw)
         name, unit, desc = self.quantity
         where = f"{type(self).__name__}.{name}"
+        if value is None:
+            object.__setattr__(self, "_law", None)
+            return
         if isinstance(value, bool):
             raise ParameterError(f"{where} must be a number, a sympy expression or a "
                                  f"function, got {value!r}")
@@ -494,6 +601,22 @@ class PartialSource(Component):
             raise ParameterError(f"{where} must be a number, a sympy expression or a "
                                  f"function of the flange {self.across_name}, "
                                  f"got {value!r}")
+
+    @property
+    def is_input(self):
+        """True when the value is an input signal (no law given)."""
+        return bool(self._inputs)
+
+    def declarations(self):
+        decl = super().declarations()
+        for name in self.__dict__.get("_inputs", {}):
+            decl.pop(name, None)       # the input connector is that variable
+        return decl
+
+    def connectors(self):
+        out = super().connectors()
+        out.update(self.__dict__.get("_inputs", {}))
+        return out
 
     def _call(self, fn, x, v):
         name = self.quantity[0]
@@ -516,7 +639,9 @@ class PartialSource(Component):
 
     def law(self, x):
         """The source value as a sympy expression; ``x`` is the flange's
-        across variable symbol."""
+        across variable symbol. For an input, the input's variable."""
+        if self._inputs:
+            return self.symbol(self.quantity[0])
         if self._law is None:
             return self.symbol(f"{self.quantity[0]}_const")
         if isinstance(self._law, sp.Basic) and not isinstance(self._law, sp.Lambda):

@@ -20,6 +20,7 @@ from ..errors import ChatteringError, LimitError, SolverError, UsageError
 from .events import EventState
 from .initialize import ask_components, initial_point, reinitialize, suspect_parameters
 from .result import Result
+from .timeevents import TimeSchedule
 
 CHATTER_COUNT = 100     # this many firings of one event (root) ...
 CHATTER_SPAN = 1e-9     # ... within this fraction of the time span is chattering
@@ -242,6 +243,8 @@ def _start(cm, t0, t_end, params, rtol, atol, atol_algebraic, max_step, max_step
         model = sensitivity_model(cm, sensitivities)
         atol = model.atol(atol, p)
     run = _Run(model, p, t0, t_end, rtol, atol, max_step, max_steps, backend, linsolver)
+    run.schedule = TimeSchedule(cm, p, t0, t_end)
+    d, _ = run.schedule.update(t0, d, start=True)   # the time switches' values at t0
     cb = run.serve(cm, d) if sensitivities else run.callbacks(d)
     run.cb_d = list(d)
     y, yp = initial_point(cm, p, d, cb, t0, starts)
@@ -259,7 +262,11 @@ def _integrate(run, watch, cb, t, y, yp, d, stop, tout, output_step):
     with re-initialisation and event iteration; output is recorded in ``run``."""
     t_end = run.t_end
     while not stop and t < t_end:
-        tspan = _tspan(t, tout, t_end, watch.horizon(t))
+        if not run.schedule.empty():
+            y, yp, d, cb, stop = _time_events(run, cb, t, y, yp, d)
+            if stop:
+                break
+        tspan = _tspan(t, tout, t_end, watch.horizon(t), run.schedule.next(t, d))
         seg = watch.solve(run.solver(), watch.wrap(cb, tspan), d, tspan, y, yp,
                           every_step=output_step == 0)
         run.nfev += seg.nfev
@@ -316,10 +323,14 @@ def _check_output_size(cm, t0, t_end, output_step, output_times, max_rows):
             "t_end, or raise max_rows (--max-rows)", t=t0)
 
 
-def _tspan(t, tout, t_end, horizon):
+def _tspan(t, tout, t_end, horizon, t_event=np.inf):
     """Times of the next solver call: ``t``, then the output times after it,
     up to ``t_end`` (which ends the span), or up to ``horizon`` when a watch
-    cuts the run into windows (at least one output time)."""
+    cuts the run into windows (at least one output time), or up to the
+    next time event ``t_event`` (which then ends the span: the solver
+    stops exactly there)."""
+    if t_event < t_end and (horizon is None or t_event <= horizon):
+        return np.concatenate([[t], tout[(tout > t) & (tout < t_event)], [t_event]])
     later = tout[tout > t]
     if horizon is not None and horizon < t_end:
         cut = later[later <= horizon]
@@ -556,6 +567,27 @@ def _handle(run, cb, t, y, yp, d, fired):
         stop = stop or stop2
     if run.sens is not None:
         run.sens.dtau[:] = 0.0   # the instant is over
+    return y, yp, d, cb, stop
+
+
+def _time_events(run, cb, t, y, yp, d):
+    """The time events due at ``t`` (:mod:`acausal.runtime.timeevents`):
+    the switches set to their values after ``t``, the due time events'
+    actions run and logged; a changed mode is re-initialised and iterated
+    like any event's, and recorded after the row before it."""
+    obs = cb[4](t, y, yp)
+    d_new, fired = run.schedule.update(t, d, obs)
+    if run.sens is not None and fired:
+        run.sens.dtau[:] = run.schedule.time_sensitivity(t, d, run.sens.sm.pidx)
+    for ev in {ev.name: ev for ev in fired}.values():   # one entry per name and instant
+        _log_event(run, t, ev, run.sens.dtau.copy() if run.sens is not None else None)
+    stop = False
+    if list(d_new) != list(d):
+        d, cb, y, yp = _new_mode(run, [], t, y, yp, list(d), d_new, obs)
+        y, yp, d, cb, stop = _event_iteration(run, cb, t, y, yp, d)
+        run.record(t, y, yp, d)
+    if run.sens is not None:
+        run.sens.dtau[:] = 0.0
     return y, yp, d, cb, stop
 
 

@@ -13,10 +13,14 @@ everything connected to it add up there).
 from .components import (Fixed, Inertia, TorsionSpring, RotationalDamper, SpringDamper, Spring,
                          Damper, ElastoBacklash, ElastoBacklash2, IdealGear, IdealGearR2T,
                          IdealRollingWheel)
-from .sources import Torque, RelativeTorque, Angle
-from .sensors import AngleSensor, SpeedSensor, AccSensor, TorqueSensor, RelAngleSensor, RelSpeedSensor
+from .sources import (Torque, Torque2, RelativeTorque, ConstantTorque, SignTorque,
+                      QuadraticSpeedDependentTorque, LinearSpeedDependentTorque, TorqueStep, Angle)
+from .sensors import (AngleSensor, SpeedSensor, AccSensor, TorqueSensor, PowerSensor, MultiSensor,
+                      RelAngleSensor, RelSpeedSensor, RelAccSensor)
 
 __all__ = ["Fixed", "Inertia", "TorsionSpring", "RotationalDamper", "SpringDamper", "Spring",
            "Damper", "ElastoBacklash", "ElastoBacklash2", "IdealGear", "IdealGearR2T",
-           "IdealRollingWheel", "Torque", "RelativeTorque", "Angle", "AngleSensor", "SpeedSensor",
-           "AccSensor", "TorqueSensor", "RelAngleSensor", "RelSpeedSensor"]
+           "IdealRollingWheel", "Torque", "Torque2", "RelativeTorque", "ConstantTorque",
+           "SignTorque", "QuadraticSpeedDependentTorque", "LinearSpeedDependentTorque",
+           "TorqueStep", "Angle", "AngleSensor", "SpeedSensor", "AccSensor", "TorqueSensor",
+           "PowerSensor", "MultiSensor", "RelAngleSensor", "RelSpeedSensor", "RelAccSensor"]

@@ -11,10 +11,14 @@ connected to it add up there).
 """
 from .components import Fixed, Mass, Rod, Spring, Damper, SpringDamper, ElastoGap
 from ..rotational.components import IdealGearR2T, IdealRollingWheel
-from .sources import Force, RelativeForce, Position
-from .sensors import PositionSensor, SpeedSensor, AccSensor, ForceSensor, RelPositionSensor, RelSpeedSensor
+from .sources import (Force, Force2, RelativeForce, ConstantForce, SignForce,
+                      QuadraticSpeedDependentForce, LinearSpeedDependentForce, ForceStep, Position)
+from .sensors import (PositionSensor, SpeedSensor, AccSensor, ForceSensor, PowerSensor,
+                      MultiSensor, RelPositionSensor, RelSpeedSensor, RelAccSensor)
 
 __all__ = ["Fixed", "Mass", "Rod", "Spring", "Damper", "SpringDamper", "ElastoGap",
-           "IdealGearR2T", "IdealRollingWheel", "Force", "RelativeForce", "Position",
-           "PositionSensor", "SpeedSensor", "AccSensor", "ForceSensor", "RelPositionSensor",
-           "RelSpeedSensor"]
+           "IdealGearR2T", "IdealRollingWheel", "Force", "Force2", "RelativeForce",
+           "ConstantForce", "SignForce", "QuadraticSpeedDependentForce",
+           "LinearSpeedDependentForce", "ForceStep", "Position", "PositionSensor", "SpeedSensor",
+           "AccSensor", "ForceSensor", "PowerSensor", "MultiSensor", "RelPositionSensor",
+           "RelSpeedSensor", "RelAccSensor"]
