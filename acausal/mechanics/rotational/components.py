@@ -5,6 +5,7 @@ from sympy import Piecewise
 
 from acausal.lang import Component, Discrete, Eq, Event, Parameter, RotFlange, Variable, der
 
+from ..contact import PosPow
 from ..partials import (NonZeroParameter, PartialElementaryRotationalToTranslational,
                         PartialRotCompliant, PartialRotCompliantWithRelativeStates,
                         PartialRotElementaryTwoFlangesAndSupport2, PartialRotRigid)
@@ -14,6 +15,7 @@ __all__ = ["Fixed", "Inertia", "TorsionSpring", "RotationalDamper", "SpringDampe
            "IdealRollingWheel"]
 
 B_EPS = 1e-10   # MSL's minimum backlash [rad]: below it the backlash elements are linear
+TOUCH_TOL = 1e-12   # [rad] the contact regions switch this far before the gap's edge
 
 
 class Fixed(Component):
@@ -125,7 +127,11 @@ class _PartialBacklash(PartialRotCompliantWithRelativeStates):
     ``+-b/2`` (MSL's events on ``phi_diff > bMax``, ``< bMin``). A backlash
     ``b <= 1e-10`` rad (MSL's ``bEps``) makes the element a plain spring
     and damper, ``tau = tau_c + tau_d`` with ``tau_c = c * phi_diff``, and
-    switches no regions.
+    switches no regions. The events switch ``region`` 1e-12 rad
+    (:data:`TOUCH_TOL`) inside the gap's edge, where the spring torque is
+    still exactly 0 (``tau_c`` is ``c`` times the penetration beyond the
+    edge), so that a run starting exactly at the edge starts in contact
+    (IDA cannot see a root function that starts at zero).
 
     MSL changes the characteristic during initialisation (a monotone line
     inside ``1.5 * b/2``) so that an initialisation that must invert it is
@@ -156,8 +162,9 @@ class _PartialBacklash(PartialRotCompliantWithRelativeStates):
         tau_up, loss_up = self._contact_torque(+1)
         tau_low, loss_low = self._contact_torque(-1)
         return [
-            Eq(self.tau_c, Piecewise((self.c * diff, linear), (self.c * (diff - half), up),
-                                     (self.c * (diff + half), low), (0, True))),
+            Eq(self.tau_c, Piecewise((self.c * diff, linear),
+                                     (self.c * PosPow(diff - half, 1), up),
+                                     (-self.c * PosPow(-half - diff, 1), low), (0, True))),
             Eq(self.tau_d, self.d * self.w_rel),
             Eq(self.tau, Piecewise((self.tau_c + self.tau_d, linear), (tau_up, up),
                                    (tau_low, low), (0, True))),
@@ -168,7 +175,7 @@ class _PartialBacklash(PartialRotCompliantWithRelativeStates):
     def events(self):
         p, region = self.path, self.region
         diff = self.phi_rel - self.phi_rel0
-        half = self.b / 2
+        half = self.b / 2 - TOUCH_TOL
         gated = self.b > B_EPS
         free, up, low = Eq(region, 0), Eq(region, 1), Eq(region, -1)
 

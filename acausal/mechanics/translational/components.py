@@ -11,6 +11,8 @@ from ..partials import (PartialCompliant, PartialCompliantWithRelativeStates, Pa
 
 __all__ = ["Fixed", "Mass", "Rod", "Spring", "Damper", "SpringDamper", "ElastoGap"]
 
+TOUCH_TOL = 1e-12   # [m] the contact flag switches this far before the touching point
+
 
 class Fixed(Component):
     """A flange fixed at position ``s0``: ``flange.s = s0`` (it takes any force).
@@ -147,6 +149,12 @@ class ElastoGap(PartialCompliantWithRelativeStates):
     ``s_rel0`` (MSL's event on ``s_rel < s_rel0``); the clamping has no
     events (MSL's ``noEvent``). ``lossPower = f_d * v_rel``.
 
+    The events switch ``contact`` at ``s_rel = s_rel0 + 1e-12`` m
+    (:data:`TOUCH_TOL`), where the force is still exactly 0, so that a run
+    starting with the flanges exactly touching starts in contact (IDA
+    cannot see a root function that starts at zero); the force is MSL's
+    law at every position.
+
     Parameters: ``c`` [N/m^n] spring constant (>= 0), ``d`` [N*s/m] damping
     (>= 0), ``s_rel0`` [m] relative position at first touch (MSL's
     unstretched length), ``n`` [1] exponent of the spring force (>= 1).
@@ -178,7 +186,7 @@ class ElastoGap(PartialCompliantWithRelativeStates):
 
     def events(self):
         p, contact = self.path, self.contact
-        gap = self.s_rel0 - self.s_rel          # > 0: in contact
+        gap = self.s_rel0 - self.s_rel + TOUCH_TOL     # > 0: in contact
 
         def close(s):
             s[contact] = 1

@@ -29,10 +29,11 @@ def regularized_sign(x, x0, reg):
     """
     if reg == "Exp":
         return 2 / (1 + sp.exp(-x / (sp.Rational(1, 100) * x0))) - 1
+    sgn = Piecewise((1, x >= 0), (-1, True))     # sign(x) without a DiracDelta derivative
     inside = {"Sine": sp.sin(sp.pi / 2 * x / x0),
               "Linear": x / x0,
-              "CoSine": sp.sign(x) * (1 - sp.cos(sp.pi / 2 * x / x0))}[reg]
-    return Piecewise((sp.sign(x), sp.Abs(x) >= x0), (inside, True))
+              "CoSine": sgn * (1 - sp.cos(sp.pi / 2 * x / x0))}[reg]
+    return Piecewise((1, x >= x0), (-1, x <= -x0), (inside, True))
 
 
 class Force(PartialSource, PartialElementaryOneFlangeAndSupport2):
