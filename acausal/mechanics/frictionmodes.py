@@ -120,16 +120,20 @@ class FrictionModes(Component):
 
     Discrete states: ``mode`` (3 Unknown, 2 Free, 1 Forward, 0 Stuck, -1
     Backward), ``startForward``, ``startBackward`` (0/1). States: ``sa``
-    [1] path parameter (the holding force while locked), ``locked``,
-    ``free`` [1] (0/1, as MSL's booleans).
+    (no unit) path parameter (the holding force while locked),
+    ``sa_offset`` (no unit) its offset while sliding, ``locked``, ``free``
+    [1] (0/1, as MSL's booleans).
     """
 
     mode = Discrete(UNKNOWN, "1", "3 unknown (before the start), 2 free, 1 sliding forward, "
                     "0 stuck, -1 sliding backward")
     startForward = Discrete(0, "1", "1 while stuck and starting to slide forward")
     startBackward = Discrete(0, "1", "1 while stuck and starting to slide backward")
-    sa = Variable(0.0, "1", "path parameter of the friction characteristic (the holding "
-                  "force/torque while locked)")
+    sa = Variable(0.0, None, "path parameter of the friction characteristic (the holding "
+                  "force/torque while locked; the acceleration shifted by sa_offset while "
+                  "sliding): no unit, as MSL's")
+    sa_offset = Variable(0.0, None, "the level subtracted from sa while sliding (MSL's "
+                         "tau0_max/unitTorque): no unit")
     locked = Variable(0.0, "1", "1 while stuck and not starting to slide")
     free = Variable(0.0, "1", "1 while the element transmits nothing (normal force <= 0)")
 
@@ -196,9 +200,13 @@ class FrictionModes(Component):
         if free is not sp.false:
             acc.append((a - sa, free))
             force.append((F, free))
-        acc += [(a - sa + self.slide_offset(1), forward), (a - sa + self.slide_offset(-1), True)]
+        # sa carries no unit and sa_offset stands for the force level in sa's
+        # terms (MSL divides by unitTorque, unitAngularAcceleration)
+        acc.append((a - sa + self.sa_offset, True))
         force += [(F - self.sliding_force(1), forward), (F - self.sliding_force(-1), True)]
         return [Eq(0, Piecewise(*acc)), Eq(0, Piecewise(*force)),
+                Eq(self.sa_offset, Piecewise((self.slide_offset(1), forward),
+                                             (self.slide_offset(-1), True))),
                 Eq(self.locked, Piecewise((1, locked), (0, True))),
                 Eq(self.free, Piecewise((1, free), (0, True)))]
 
