@@ -110,8 +110,9 @@ def _declare(flat, comp):
         port = comp.port(name)
         if isinstance(port, SignalPort):
             sym = port.symbol
-            flat.variables[sym.name] = VarInfo(sym, Start(0.0, False), ctype.unit, ctype.desc,
-                                               path, True)
+            flat.variables[sym.name] = VarInfo(sym, Start(0.0, False), ctype.unit or "1",
+                                               ctype.desc, path, True,
+                                               unit_declared=ctype.unit is not None)
             continue
         for decls, syms in zip(ctype.pairs(), port.pairs()):
             for (vname, unit, desc), sym in zip(decls, syms):

@@ -167,9 +167,9 @@ class RealSignal(Connector):
     domain = "signal"
     causality = None     # "input" or "output"
 
-    def __init__(self, desc="", unit="1"):
+    def __init__(self, desc="", unit=None):
         super().__init__(desc)
-        self.unit = unit
+        self.unit = unit      # None: no unit (MSL's blocks), not checked
 
     @classmethod
     def pairs(cls):

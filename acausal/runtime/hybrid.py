@@ -329,9 +329,12 @@ def _tspan(t, tout, t_end, horizon, t_event=np.inf):
     cuts the run into windows (at least one output time), or up to the
     next time event ``t_event`` (which then ends the span: the solver
     stops exactly there)."""
+    # an output time a few ulps after t (an event that stopped at 0.95 and
+    # the grid's 0.9500000000000001) is t: IDA cannot start towards it
+    ahead = tout > t + 8 * np.finfo(float).eps * max(1.0, abs(t))
     if t_event < t_end and (horizon is None or t_event <= horizon):
-        return np.concatenate([[t], tout[(tout > t) & (tout < t_event)], [t_event]])
-    later = tout[tout > t]
+        return np.concatenate([[t], tout[ahead & (tout < t_event)], [t_event]])
+    later = tout[ahead]
     if horizon is not None and horizon < t_end:
         cut = later[later <= horizon]
         if len(cut) == 0:

@@ -24,3 +24,9 @@ __all__ = ["Fixed", "Inertia", "TorsionSpring", "RotationalDamper", "SpringDampe
            "SignTorque", "QuadraticSpeedDependentTorque", "LinearSpeedDependentTorque",
            "TorqueStep", "Angle", "AngleSensor", "SpeedSensor", "AccSensor", "TorqueSensor",
            "PowerSensor", "MultiSensor", "RelAngleSensor", "RelSpeedSensor", "RelAccSensor"]
+
+# friction elements on the shared mode machine (acausal.mechanics.frictionmodes)
+from .friction import BearingFriction, Brake, Clutch, OneWayClutch, LossyGear  # noqa: E402
+from .planetary import IdealPlanetary  # noqa: E402
+
+__all__ += ["BearingFriction", "Brake", "Clutch", "OneWayClutch", "LossyGear", "IdealPlanetary"]

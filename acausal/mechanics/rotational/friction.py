@@ -236,7 +236,7 @@ class OneWayClutch(PartialRotCompliantWithRelativeStates, FrictionModes):
     tau0_max = Variable(0.0, "N*m", "largest torque for w_rel = 0 while locked (break-away)")
 
     def equations(self):
-        u = self.f_normalized
+        u = sp.sympify(self.f_normalized)    # the input signal as a symbol
         mu0 = interpolate(self.mu_pos, 1, 0)
         peak2 = sp.Max(self.peak, 1 + EPS0)
         return [Eq(self.a_rel, der(self.w_rel)),
