@@ -287,12 +287,37 @@ def variables(file):
     states = {s.name for s in cm.dae.y[:cm.dae.n_states]}
     for name in cm.var_names:
         info = cm.flat.variables[name]
+        if info.internal:
+            continue
         st = info.start
         kind = "state" if name in states else ""
         start = f"start {st.value}{' (fixed)' if st.fixed else ''}"
         click.echo(f"  {name:32s} [{info.unit}] {info.desc}; {start} {kind}")
     for d in cm.discretes:
+        if d.internal:
+            continue
         click.echo(f"  {d.symbol.name:32s} [{d.unit}] {d.desc}; discrete, start {d.start.value}")
+
+
+@main.command()
+@click.argument("file", type=click.Path(dir_okay=False))
+@click.option("--json", "as_json", is_flag=True, help="print one JSON object")
+def check(file, as_json):
+    """Check a model file: compile it and list its states, time events and
+    unconnected connectors (no error: their force/torque is zero)."""
+    from .compiler.check import check_model
+    from .modelfile import compile_file
+    try:
+        mf, cm = compile_file(file)
+        report = check_model(None, compiled=cm)
+    except AcausalError as exc:
+        _fail(exc)
+    if as_json:
+        click.echo(json.dumps(dict(file=str(file), **report.as_dict())))
+        return
+    click.echo(f"checked {file}:")
+    for line in report.lines():
+        click.echo(f"  {line}")
 
 
 @main.command()

@@ -20,12 +20,14 @@ from ..errors import ChatteringError, LimitError, SolverError, UsageError
 from .events import EventState
 from .initialize import ask_components, initial_point, reinitialize, suspect_parameters
 from .result import Result
+from .nominal import nominal_atol
 from .timeevents import TimeSchedule
 
 CHATTER_COUNT = 100     # this many firings of one event (root) ...
 CHATTER_SPAN = 1e-9     # ... within this fraction of the time span is chattering
 MAX_ITER = 20           # event iterations at one instant
 DEFAULT_BACKEND = "sundae"
+SAME_INSTANT = 256 * np.finfo(float).eps   # (relative) times closer than this are one
 MAX_ROWS = 1_000_000    # stored output rows, by default (each 8 bytes per unknown, twice)
 WINDOW_S = 0.25         # wall time per integration window when watched [s]
 PROGRESS_DELAY_S = 2.0  # a progress bar shows once a run has lasted this long [s]
@@ -236,7 +238,7 @@ def _start(cm, t0, t_end, params, rtol, atol, atol_algebraic, max_step, max_step
     params, starts = cm.split_overrides(params)
     p = cm.param_vector(params)
     d = cm.discrete_start()
-    atol = _atol_vector(cm, atol, atol_algebraic)
+    atol = nominal_atol(cm, _atol_vector(cm, atol, atol_algebraic), rtol, atol)
     model = cm
     if sensitivities:
         from .sensitivity import SensRun, sensitivity_model
@@ -261,7 +263,7 @@ def _integrate(run, watch, cb, t, y, yp, d, stop, tout, output_step):
     root, the end or a window of the watch), observer roots, event actions
     with re-initialisation and event iteration; output is recorded in ``run``."""
     t_end = run.t_end
-    while not stop and t < t_end:
+    while not stop and t < t_end - SAME_INSTANT * max(abs(t), abs(t_end)):
         if not run.schedule.empty():
             y, yp, d, cb, stop = _time_events(run, cb, t, y, yp, d)
             if stop:
@@ -329,12 +331,12 @@ def _tspan(t, tout, t_end, horizon, t_event=np.inf):
     cuts the run into windows (at least one output time), or up to the
     next time event ``t_event`` (which then ends the span: the solver
     stops exactly there)."""
-    # an output time a few ulps after t (an event that stopped at 0.95 and
-    # the grid's 0.9500000000000001) is t: IDA cannot start towards it
-    ahead = tout > t + 8 * np.finfo(float).eps * max(1.0, abs(t))
+    # an output time closer to t than IDA can step (it refuses a tout within
+    # 100 unit round-offs of t: an output 1 ulp after a time event) is t
+    after = t + SAME_INSTANT * max(abs(t), abs(t_end))
     if t_event < t_end and (horizon is None or t_event <= horizon):
-        return np.concatenate([[t], tout[ahead & (tout < t_event)], [t_event]])
-    later = tout[ahead]
+        return np.concatenate([[t], tout[(tout > after) & (tout < t_event)], [t_event]])
+    later = tout[tout > after]
     if horizon is not None and horizon < t_end:
         cut = later[later <= horizon]
         if len(cut) == 0:

@@ -24,7 +24,7 @@ import sympy as sp
 from ..lang.symbols import time
 from .events import EventState
 
-MERGE = 64 * np.finfo(float).eps   # instants closer than this (x time scale) are one
+MERGE = 256 * np.finfo(float).eps   # instants closer than this (x time scale) are one
 
 
 class _Due:

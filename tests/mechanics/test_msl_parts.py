@@ -208,6 +208,29 @@ def test_elastogap_static_deflection_follows_the_exponent():
     assert 0.3 - res["mass.s"][-1] == pytest.approx((F / c) ** (1 / n), rel=1e-8)
 
 
+def test_phi_nominal_given_explicitly_is_the_nominal_of_phi_rel():
+    """MSL's phi_nominal / s_nominal: given, they are the nominal value of
+    phi_rel / s_rel (the solver's absolute tolerance rtol*nominal on that
+    unknown); left at the default they set none (earlier models keep their
+    tolerances); with_nominal wins."""
+    from acausal.runtime.nominal import nominal_slots
+    assert R.SpringDamper(c=1.0).nominal("phi_rel") is None
+    assert R.ElastoBacklash(phi_nominal=1.0).nominal("phi_rel") == 1.0
+    assert R.Damper(phi_nominal=0.0).nominal("phi_rel") == 1.0       # MSL: 1 below eps
+    assert R.Damper(phi_nominal=1e-3).with_nominal(phi_rel=5e-2).nominal("phi_rel") == 5e-2
+    assert T.SpringDamper(s_nominal=1e-3).nominal("s_rel") == 1e-3
+    assert T.Damper().nominal("s_rel") is None
+    model = Model()
+    model.a = R.Inertia(J=1.0, phi=0.0, w=0.0)
+    model.sd = R.SpringDamper(c=100.0, d=1.0, phi_nominal=1e-3, phi_rel=0.01, w_rel=0.0)
+    model.b = R.Inertia(J=1.0)
+    model.connect(model.a.flange, model.sd.flange_a)
+    model.connect(model.sd.flange_b, model.b.flange)
+    cm = compile_model(model)
+    slots = [k for k, names in enumerate(cm.slot_names()) if "sd.phi_rel" in names]
+    assert slots and nominal_slots(cm)[slots[0]] == 1e-3
+
+
 # -- backlash ----------------------------------------------------------------------
 @pytest.mark.parametrize("cls", [R.ElastoBacklash, R.ElastoBacklash2])
 def test_free_inertia_crosses_the_backlash_at_the_closed_form_times(cls):
@@ -459,6 +482,56 @@ def test_sign_torque_regularisations_are_continuous_and_odd():
     res = run(model, t_end=1.0)
     early = res.t < (1.0 - 0.05) / tau
     assert rel(res["body.w"][early], 1.0 - tau / J * res.t[early]) < 1e-8
+
+
+def test_linear_speed_dependent_force_is_a_viscous_load():
+    m, b, vi = 2.0, 3.0, 1.5
+    for direction in (False, True):
+        model = Model()
+        model.mass = T.Mass(m=m, s=0.0, v=vi)
+        model.visc = T.LinearSpeedDependentForce(f_nominal=-b, v_nominal=1.0,
+                                                 ForceDirection=direction)
+        model.connect(model.mass.flange, model.visc.flange)
+        res = run(model)
+        # v > 0 throughout: |v| = v, both directions give m dv/dt = -b v
+        assert rel(res["mass.v"], vi * np.exp(-b * res.t / m)) < 1e-8
+
+
+def test_rolling_resistance_decelerates_a_coasting_mass():
+    """m dv/dt = -Cr W cos(atan(i)) while v > v0 (linear regularisation);
+    the coefficient and the inclination may be inputs."""
+    m, W, Cr, i, vi = 10.0, 98.0, 0.02, 0.1, 2.0
+    model = Model()
+    model.mass = T.Mass(m=m, s=0.0, v=vi)
+    model.roll = T.RollingResistance(fWeight=W, useCrInput=True, useInclinationInput=True,
+                                     reg="Linear", v0=1e-3)
+    model.cr, model.incl = Constant(k=Cr), Constant(k=i)
+    model.connect(model.cr.y, model.roll.cr)
+    model.connect(model.incl.y, model.roll.inclination)
+    model.connect(model.mass.flange, model.roll.flange)
+    res = run(model, t_end=5.0)
+    dec = Cr * W * np.cos(np.arctan(i)) / m
+    assert rel(res["mass.v"], vi - dec * res.t) < 1e-9
+    assert rel(res["roll.f_nominal"], -Cr * W * np.cos(np.arctan(i))) < 1e-12
+
+
+def test_vehicle_reaches_the_speed_where_the_resistances_balance_the_torque():
+    """A Vehicle with a drive-train inertia and a wind input, driven by a
+    constant torque, settles where tau/R = Cd A rho/2 (v - v_wind)^2 +
+    Cr m g; its s, v are its mass's."""
+    m, J, R_, tau, Cd, A, rho, Cr, vw = 10.0, 0.1, 0.3, 6.0, 0.6, 1.0, 1.0, 0.01, 2.0
+    model = Model()
+    model.car = T.Vehicle(m=m, J=J, R=R_, A=A, Cd=Cd, rho=rho, CrConstant=Cr,
+                          useWindInput=True, s=0.0, v=0.0)
+    model.wind = Constant(k=vw)
+    model.motor = R.ConstantTorque(tau_constant=tau)
+    model.connect(model.wind.y, model.car.vWind)
+    model.connect(model.motor.flange, model.car.flangeR)
+    res = run(model, t_end=40.0, step=0.1)
+    v_end = vw + np.sqrt((tau / R_ - Cr * m * 9.80665) / (Cd * A * rho / 2))
+    assert res["car.v"][-1] == pytest.approx(v_end, rel=1e-6)
+    assert rel(res["car.s"], res["car.mass.s"]) < 1e-12
+    assert rel(res["car.inertia.w"] * R_, res["car.v"]) < 1e-10
 
 
 def test_force_step_and_torque_step_are_time_events():

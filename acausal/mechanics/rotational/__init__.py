@@ -14,7 +14,8 @@ from .components import (Fixed, Inertia, TorsionSpring, RotationalDamper, Spring
                          Damper, ElastoBacklash, ElastoBacklash2, IdealGear, IdealGearR2T,
                          IdealRollingWheel)
 from .sources import (Torque, Torque2, RelativeTorque, ConstantTorque, SignTorque,
-                      QuadraticSpeedDependentTorque, LinearSpeedDependentTorque, TorqueStep, Angle)
+                      QuadraticSpeedDependentTorque, LinearSpeedDependentTorque, TorqueStep, Angle,
+                      Position, Speed, Accelerate, Move)
 from .sensors import (AngleSensor, SpeedSensor, AccSensor, TorqueSensor, PowerSensor, MultiSensor,
                       RelAngleSensor, RelSpeedSensor, RelAccSensor)
 
@@ -22,7 +23,7 @@ __all__ = ["Fixed", "Inertia", "TorsionSpring", "RotationalDamper", "SpringDampe
            "Damper", "ElastoBacklash", "ElastoBacklash2", "IdealGear", "IdealGearR2T",
            "IdealRollingWheel", "Torque", "Torque2", "RelativeTorque", "ConstantTorque",
            "SignTorque", "QuadraticSpeedDependentTorque", "LinearSpeedDependentTorque",
-           "TorqueStep", "Angle", "AngleSensor", "SpeedSensor", "AccSensor", "TorqueSensor",
+           "TorqueStep", "Angle", "Position", "Speed", "Accelerate", "Move", "AngleSensor", "SpeedSensor", "AccSensor", "TorqueSensor",
            "PowerSensor", "MultiSensor", "RelAngleSensor", "RelSpeedSensor", "RelAccSensor"]
 
 # friction elements on the shared mode machine (acausal.mechanics.frictionmodes)
