@@ -36,8 +36,8 @@ class VarInfo:
     desc: str
     owner: str
     port: bool = False     # a connector variable
-    internal: bool = False  # made by the compiler (a time switch), not declared
     unit_declared: bool = True   # False: no unit was given (not checked)
+    internal: bool = False  # made by the compiler (a time switch), not declared
     nominal: float = None   # Modelica's nominal value (scales the absolute tolerance)
 
 
@@ -212,7 +212,7 @@ def _initial_equation(flat, comp, known, k, eq):
     sym = sp.Symbol(f"{path}._initial{k}" if path else f"_initial{k}")
     flat.variables[sym.name] = VarInfo(sym, Start(0.0, True), "1",
                                        f"initial equation {k + 1}: {expr} = 0 at the start",
-                                       path, internal=True, unit_declared=False)
+                                       path, unit_declared=False, internal=True)
     known.add(sym.name)
     flat.equations.append(Equation(sym - expr, path,
                                    f"initial equation {k + 1} ({type(comp).__name__})"))

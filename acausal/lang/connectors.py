@@ -161,17 +161,16 @@ class Frame(Connector):
 
 
 class RealSignal(Connector):
-    """A causal signal connector: one real variable (unit ``unit``), no
-    through part. Use :class:`RealInput` or :class:`RealOutput`. A signal
-    declared without a unit (MSL's ``RealOutput y`` of a block) is
-    dimensionless for display but not checked (Modelica's ``unit = ""``),
-    so a sine block may drive a force input in N."""
+    """A causal signal connector: one real variable (unit ``unit``; none, as
+    MSL's plain ``Real`` signals, is not checked), no through part. Use
+    :class:`RealInput` or :class:`RealOutput`."""
 
     domain = "signal"
     causality = None     # "input" or "output"
 
     def __init__(self, desc="", unit=None):
         super().__init__(desc)
+        # no unit (MSL's plain Real signal): shown as "1", not checked
         self.unit_declared = unit is not None
         self.unit = "1" if unit is None else unit
 

@@ -108,7 +108,7 @@ class AlgebraicSolver(SegmentSolver):
             if g_at(t1, i) == 0.0:
                 ti = t1
             else:
-                ti = brentq(lambda tt: g_at(tt, i), t0, t1, xtol=tol, rtol=4e-16)
+                ti = brentq(lambda tt: g_at(tt, i), t0, t1, xtol=tol, rtol=1e-15)
                 # the side of the crossing: the end of the bracket past the root
                 if (g_at(ti, i) < 0) == (g0[i] < 0) and g_at(ti, i) != 0.0:
                     ti = min(ti + tol, t1)
