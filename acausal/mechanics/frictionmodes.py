@@ -81,6 +81,12 @@ UNKNOWN, FREE, FORWARD, STUCK, BACKWARD = 3, 2, 1, 0, -1
 TIE = 1e-12   # a level or acceleration within this of its threshold is at it (see _roots)
 
 
+def magnitude(x):
+    """|x| as a Piecewise: its derivative is the branch's (sympy's Abs
+    differentiates through re/im, which the code generators do not print)."""
+    return Piecewise((x, x >= 0), (-x, True))
+
+
 def _value(state, expr):
     """The value of a sympy expression of model symbols in an event action."""
     expr = sp.sympify(expr)
@@ -251,7 +257,7 @@ class FrictionModes(Component):
                              self._act_go(d), recheck=True))
             hold = self.hold_level(d)
             evs.append(Event(pre + "abort_" + name,
-                             off(d * (hold - sa) - TIE * (1 + sp.Abs(hold)), starting[d]), 1,
+                             off(d * (hold - sa) - TIE * (1 + magnitude(hold)), starting[d]), 1,
                              self._act_abort(d), recheck=True))
         evs.append(Event(pre + "slide_stop",
                          off(nonzero(-m * w, -m * a - TIE), sliding), 1,

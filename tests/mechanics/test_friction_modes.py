@@ -142,6 +142,22 @@ def test_clutch_engages_and_locks_at_the_momentum_time():
     assert abs(fin["a.phi"] - phi_a) < 1e-8
 
 
+@pytest.mark.parametrize("backend", ["sundae", "compiled"])
+def test_lock_time_sensitivity_to_the_normal_force(backend):
+    """The event-time sensitivity of the lock through the mode machine's
+    roots: t_lock = t_on + (w1 - w2)/(cgeo*mu*fn_max*(1/J1 + 1/J2)), so
+    d t_lock/d fn_max = -(t_lock - t_on)/fn_max."""
+    J1, J2, w1, w2, t_on, fn = 0.4, 1.2, 20.0, -5.0, 0.2, 200.0
+    model = _two_inertias(rot.Clutch(fn_max=fn, cgeo=0.1, mu_pos=[[0, 0.4]], peak=1.2),
+                          J1, J2, w1, w2, t_on)
+    res = compile_model(model).simulate(t_end=1.5, output_step=0.01, backend=backend,
+                                        sensitivities=["clutch.fn_max"], **TIGHT)
+    t_lock = t_on + (w1 - w2) / (0.1 * 0.4 * fn * (1 / J1 + 1 / J2))
+    k = [n for _, n in res.events].index("clutch.slide_stop")
+    dt = res.event_sensitivity("clutch.fn_max")[k]
+    assert abs(dt - (-(t_lock - t_on) / fn)) < 1e-9
+
+
 def test_clutch_released_slips_then_goes_free():
     """Locked and carrying 1 N*m (b accelerates with a at 1 rad/s^2), the
     normal force ramps down to 0 between 0.5 and 0.75 s: the clutch slips

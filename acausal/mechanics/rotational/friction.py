@@ -15,7 +15,7 @@ from sympy import Piecewise
 from acausal.errors import ParameterError
 from acausal.lang import Eq, Parameter, RealInput, Variable, der
 
-from ..frictionmodes import FrictionModes, PartialRotFriction
+from ..frictionmodes import FrictionModes, PartialRotFriction, magnitude
 from ..partials import (NonZeroParameter, PartialRotCompliantWithRelativeStates,
                         PartialRotElementaryTwoFlangesAndSupport2)
 from ..tables import Table, interpolate
@@ -356,12 +356,12 @@ class LossyGear(PartialRotElementaryTwoFlangesAndSupport2, FrictionModes):
     def _at(self, speed):
         """(eta_mf1, eta_mf2, tau_bf1, tau_bf2, tau_bf_a) at ``speed`` >= 0."""
         eta1, eta2 = (interpolate(self.lossTable, j, speed) for j in (1, 2))
-        bf1, bf2 = (sp.Abs(interpolate(self.lossTable, j, speed)) for j in (3, 4))
+        bf1, bf2 = (magnitude(interpolate(self.lossTable, j, speed)) for j in (3, 4))
         split = (bf1 - bf2) / (eta1 - 1 / eta2)
         if all(r[1] == 1.0 and r[2] == 1.0 for r in self.lossTable):
             bf_a = bf1 / 2      # no mesh loss: the bearing friction is split evenly
         else:
-            bf_a = Piecewise((bf1 / 2, (sp.Abs(eta1 - 1) <= 1e-15) & (sp.Abs(eta2 - 1) <= 1e-15)),
+            bf_a = Piecewise((bf1 / 2, (magnitude(eta1 - 1) <= 1e-15) & (magnitude(eta2 - 1) <= 1e-15)),
                              (split, True))
         return eta1, eta2, bf1, bf2, bf_a
 
@@ -373,7 +373,7 @@ class LossyGear(PartialRotElementaryTwoFlangesAndSupport2, FrictionModes):
 
     def equations(self):
         locked, _, forward = self._configuration()
-        bf_a = self._at(sp.Abs(self.w_a))[4]
+        bf_a = self._at(magnitude(self.w_a))[4]
         t = self.flange_a.tau
         return [Eq(self.phi_a, self.ratio * self.phi_b),
                 Eq(0, self.flange_b.tau + self.ratio * (t - self.tauLoss)),
@@ -391,7 +391,7 @@ class LossyGear(PartialRotElementaryTwoFlangesAndSupport2, FrictionModes):
         return sp.Integer(0) if self._ideal() else None
 
     def sliding_force(self, direction):
-        q1, q2, q3, q4 = self._quadrants(sp.Abs(self.w_a))
+        q1, q2, q3, q4 = self._quadrants(magnitude(self.w_a))
         pos = self.tau_eta >= 0
         if direction > 0:
             return Piecewise((q1, pos), (q2, True))
