@@ -34,9 +34,10 @@ flag. Transitions, each an event of the element (name = path + suffix):
   ``mode`` is Forward at once if ``w >= 0`` (MSL: if ``w > 0``; see below).
 * ``slide_forward`` / ``slide_backward``: starting and ``w`` leaves zero in
   that direction: Forward (Backward), the start flag is cleared.
-* ``abort_forward`` / ``abort_backward``: starting forward and ``sa`` falls below the level that
-  keeps it (``hold_fwd``; ``F0`` for PartialFriction) before ``w`` left
-  zero: back to locked (backward likewise).
+* ``abort_forward`` / ``abort_backward``: starting forward and ``sa``
+  falls below the level that keeps it (``hold_fwd``; ``F0`` for
+  PartialFriction) before ``w`` left zero: back to locked (backward
+  likewise).
 * ``slide_stop``: sliding and ``w`` reaches zero (MSL's relation ``w > 0``
   switches): Stuck, locked; the break-away tests then run again at the same
   instant and may start it in either direction at once. When ``w`` has
@@ -49,6 +50,19 @@ Every transition is also re-checked after any event of the model (an event
 iteration, as Modelica's), so a mode that is not valid at the new point is
 left at once.
 
+Two elements that lock the same motion (their velocities proportional in
+the compiled model: a bearing and a brake on one shaft, MSL's LossyGear
+with a BearingFriction) leave their holding torques undetermined (MSL's
+UsersGuide "RequirementsForSimulationTool": "there does not exist a unique
+solution"), and the integrator cannot step a singular system. The
+re-initialisation splits the load by least squares, closest to the values
+before the event (what that guide suggests); then (bookkeeping event
+``coupled_lock``, not logged) only the first of them in the model's order
+stays locked, and each other one starts to slide in the direction of its
+share, at its sliding level. The motion starts when their total break-away
+is exceeded. This reproduces the reference results of MSL's LossyGearDemo2,
+mode by mode.
+
 Where this differs from MSL 4.0.0 (each only at an exact tie, where MSL's
 own outcome depends on the tool's event epsilon):
 
@@ -60,10 +74,14 @@ own outcome depends on the tool's event epsilon):
   where a segment starts is ignored). With ``w`` of the other sign (a stuck
   element whose drift velocity is -1e-16), the start flag stays until ``w``
   crosses zero, as in MSL.
-* ``startForward`` is kept while ``sa >= hold_fwd`` (MSL: ``sa > F0``): with
-  ``peak = 1`` and the motion held by another element (the "starting"
-  element then has ``a = 0`` exactly, ``sa = F0``), MSL's strict test would
-  drop the flag and raise it again at once, for ever.
+* ``startForward`` is kept while ``sa >= hold_fwd`` (MSL: ``sa > F0``),
+  and a start is dropped, or a sliding element at ``w = 0`` stopped, only
+  when the margin exceeds ``TIE`` = 1e-12 (relative to the level): with
+  ``peak = 1`` and the motion held by another element, the "starting"
+  element has ``a = 0`` up to round-off (+-1e-31) and ``sa = F0``; MSL's
+  strict test would drop the flag and raise it again at once, for ever.
+* the root functions are never exactly zero where a segment starts (a
+  tie gives -1 or +1 instead), so that IDA sees every later crossing.
 
 The element needs inertia on the sliding side, or another element that
 fixes the motion, as in Modelica.
