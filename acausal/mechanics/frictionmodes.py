@@ -96,7 +96,7 @@ __all__ = ["FrictionModes", "PartialFriction", "PartialRotFriction",
            "UNKNOWN", "FREE", "FORWARD", "STUCK", "BACKWARD"]
 
 UNKNOWN, FREE, FORWARD, STUCK, BACKWARD = 3, 2, 1, 0, -1
-TIE = 1e-12   # a level or acceleration within this of its threshold is at it (see _roots)
+TIE = 1e-12   # a level (relative) or an acceleration (absolute) within this of its threshold is at it
 
 
 def magnitude(x):
