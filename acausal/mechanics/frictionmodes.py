@@ -229,7 +229,9 @@ class FrictionModes(Component):
         acc.append((a - sa + self.sa_offset, True))
         force += [(F - self.sliding_force(1), forward), (F - self.sliding_force(-1), True)]
         return [Eq(0, Piecewise(*acc)), Eq(0, Piecewise(*force)),
-                Eq(self.sa_offset, Piecewise((self.slide_offset(1), forward),
+                # (0 where it is not used: a sliding law need not make sense
+                # while locked, and LossyGear's is discontinuous there)
+                Eq(self.sa_offset, Piecewise((0, locked | free), (self.slide_offset(1), forward),
                                              (self.slide_offset(-1), True))),
                 Eq(self.locked, Piecewise((1, locked), (0, True))),
                 Eq(self.free, Piecewise((1, free), (0, True)))]
