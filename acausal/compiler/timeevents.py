@@ -153,8 +153,7 @@ class _Finder:
         sym = sp.Symbol(f"{base}_time_switch{k}")
         self.allowed.add(sym)
         self.flat.discretes[sym.name] = VarInfo(sym, Start(0.0, True), "1",
-                                                f"time switch: {text}", owner, internal=True,
-                                                unit_declared=False)
+                                                f"time switch: {text}", owner, internal=True)
         return TimeSwitch(sym, kind, g, a, b, owner, text)
 
 

@@ -303,6 +303,32 @@ def test_zero_backlash_is_a_spring_damper():
     assert rel(res["eb"]["body.phi"], res["sd"]["body.phi"]) < 1e-12
 
 
+def test_disc_turns_its_right_flange_by_delta_phi_and_relative_states_read_it():
+    """A Disc between a motor-driven inertia and a spring-loaded one: a
+    rigid offset deltaPhi, the torque passes unchanged; RelativeStates
+    across it reads phi_rel = deltaPhi, w_rel = 0 and takes no torque."""
+    J1, J2, c, dphi = 0.2, 0.3, 40.0, 0.25
+    model = Model()
+    model.a = R.Inertia(J=J1, phi=0.0, w=0.0)
+    model.disc = R.Disc(deltaPhi=dphi)
+    model.b = R.Inertia(J=J2)
+    model.spring = R.Spring(c=c, phi_rel0=dphi)
+    model.ground = R.Fixed()
+    model.motor = R.ConstantTorque(tau_constant=1.0)
+    model.rel = R.RelativeStates()
+    model.connect(model.motor.flange, model.a.flange_a)
+    model.connect(model.a.flange_b, model.disc.flange_a, model.rel.flange_a)
+    model.connect(model.disc.flange_b, model.b.flange_a, model.rel.flange_b)
+    model.connect(model.b.flange_b, model.spring.flange_b)
+    model.connect(model.spring.flange_a, model.ground.flange)
+    res = run(model)
+    w = np.sqrt(c / (J1 + J2))
+    assert rel(res["a.phi"], 1.0 / c * (1 - np.cos(w * res.t))) < 1e-8
+    assert rel(res["b.phi"] - res["a.phi"], dphi) < 1e-12
+    assert rel(res["rel.phi_rel"], dphi) < 1e-12
+    assert np.max(np.abs(res["rel.w_rel"])) < 1e-10
+
+
 # -- gears and wheels --------------------------------------------------------------
 def test_ideal_gear_support_conserves_angular_momentum():
     """A motor between a free housing and the input shaft of a gear whose

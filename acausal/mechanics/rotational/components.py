@@ -8,11 +8,12 @@ from acausal.lang import Component, Discrete, Eq, Event, Parameter, RotFlange, V
 from ..contact import PosPow
 from ..partials import (NonZeroParameter, PartialElementaryRotationalToTranslational,
                         PartialRotCompliant, PartialRotCompliantWithRelativeStates,
-                        PartialRotElementaryTwoFlangesAndSupport2, PartialRotRigid)
+                        PartialRotElementaryTwoFlangesAndSupport2, PartialRotRelativeSensor,
+                        PartialRotRigid)
 
-__all__ = ["Fixed", "Inertia", "TorsionSpring", "RotationalDamper", "SpringDamper", "Spring",
-           "Damper", "ElastoBacklash", "ElastoBacklash2", "IdealGear", "IdealGearR2T",
-           "IdealRollingWheel"]
+__all__ = ["Fixed", "Inertia", "Disc", "TorsionSpring", "RotationalDamper", "SpringDamper",
+           "Spring", "Damper", "ElastoBacklash", "ElastoBacklash2", "IdealGear", "IdealGearR2T",
+           "IdealRollingWheel", "RelativeStates"]
 
 B_EPS = 1e-10   # MSL's minimum backlash [rad]: below it the backlash elements are linear
 TOUCH_TOL = 1e-12   # [rad] the contact regions switch this far before the gap's edge
@@ -48,6 +49,26 @@ class Inertia(PartialRotRigid):
 
     def equations(self):
         return [Eq(self.J * der(self.w), self.net_torque())]
+
+
+class Disc(Component):
+    """A massless rigid disc whose right flange is turned by a fixed angle
+    from its left one (MSL ``Disc``): ``flange_a.phi = phi - deltaPhi/2``,
+    ``flange_b.phi = phi + deltaPhi/2``, ``flange_a.tau + flange_b.tau = 0``.
+
+    Parameters: ``deltaPhi`` [rad] flange_b.phi - flange_a.phi. States:
+    ``phi`` [rad] the disc's angle. Connectors: ``flange_a``, ``flange_b``.
+    """
+
+    flange_a = RotFlange("left flange (phi - deltaPhi/2)")
+    flange_b = RotFlange("right flange (phi + deltaPhi/2)")
+    deltaPhi = Parameter(0.0, "rad", "fixed rotation of flange_b relative to flange_a")
+    phi = Variable(0.0, "rad", "absolute rotation angle of the disc")
+
+    def equations(self):
+        return [Eq(self.flange_a.phi, self.phi - self.deltaPhi / 2),
+                Eq(self.flange_b.phi, self.phi + self.deltaPhi / 2),
+                Eq(self.flange_a.tau + self.flange_b.tau, 0)]
 
 
 class TorsionSpring(PartialRotCompliant):
@@ -311,6 +332,27 @@ class IdealRollingWheel(PartialElementaryRotationalToTranslational):
     def equations(self):
         return [Eq(self.radius * self.phi_rel(), self.s_rel()),
                 Eq(self.radius * self.flangeT.f + self.flangeR.tau, 0)]
+
+
+class RelativeStates(PartialRotRelativeSensor):
+    """Relative angle, speed and acceleration between two flanges, taking
+    no torque (MSL ``RelativeStates``): ``phi_rel = flange_b.phi -
+    flange_a.phi``, ``w_rel = der(phi_rel)``, ``a_rel = der(w_rel)``. MSL
+    uses it to make ``phi_rel``, ``w_rel`` the states; here fixed start
+    values on them (``RelativeStates(phi_rel=0.1, w_rel=0)``) make the
+    solver keep them as states where it can.
+
+    States: ``phi_rel`` [rad], ``w_rel`` [rad/s], ``a_rel`` [rad/s2].
+    Connectors: ``flange_a``, ``flange_b``.
+    """
+
+    phi_rel = Variable(0.0, "rad", "relative angle flange_b.phi - flange_a.phi")
+    w_rel = Variable(0.0, "rad/s", "relative angular velocity der(phi_rel)")
+    a_rel = Variable(0.0, "rad/s2", "relative angular acceleration der(w_rel)")
+
+    def equations(self):
+        return [Eq(self.phi_rel, self.flange_b.phi - self.flange_a.phi),
+                Eq(self.w_rel, der(self.phi_rel)), Eq(self.a_rel, der(self.w_rel))]
 
 
 # Modelica / ModelingToolkitStandardLibrary names

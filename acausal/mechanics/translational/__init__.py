@@ -10,7 +10,7 @@ Several components may be connected to one flange (the forces of everything
 connected to it add up there).
 """
 from .components import (Fixed, Mass, Rod, Spring, Damper, SpringDamper, ElastoGap,
-                         RollingResistance, Vehicle)
+                         RollingResistance, Vehicle, RelativeStates)
 from ..rotational.components import IdealGearR2T, IdealRollingWheel
 from .sources import (Force, Force2, RelativeForce, ConstantForce, SignForce,
                       QuadraticSpeedDependentForce, LinearSpeedDependentForce, ForceStep,
@@ -19,7 +19,7 @@ from .sensors import (PositionSensor, SpeedSensor, AccSensor, ForceSensor, Power
                       MultiSensor, RelPositionSensor, RelSpeedSensor, RelAccSensor)
 
 __all__ = ["Fixed", "Mass", "Rod", "Spring", "Damper", "SpringDamper", "ElastoGap",
-           "RollingResistance", "Vehicle", "IdealGearR2T", "IdealRollingWheel", "Force",
+           "RollingResistance", "Vehicle", "RelativeStates", "IdealGearR2T", "IdealRollingWheel", "Force",
            "Force2", "RelativeForce", "ConstantForce", "SignForce",
            "QuadraticSpeedDependentForce", "LinearSpeedDependentForce", "ForceStep", "Position",
            "Speed", "Accelerate", "Move", "PositionSensor", "SpeedSensor", "AccSensor",

@@ -8,12 +8,12 @@ from acausal.lang.connectors import RealInput
 
 from ..contact import PosPow
 from ..partials import (PartialCompliant, PartialCompliantWithRelativeStates,
-                        PartialForce, PartialRigid,
+                        PartialForce, PartialRelativeSensor, PartialRigid,
                         PartialRigidBody, declared_connector)
 from .sources import REGULARIZATIONS, regularized_sign
 
 __all__ = ["Fixed", "Mass", "Rod", "Spring", "Damper", "SpringDamper", "ElastoGap",
-           "RollingResistance", "Vehicle"]
+           "RollingResistance", "Vehicle", "RelativeStates"]
 
 TOUCH_TOL = 1e-12   # [m] the contact flag switches this far before the touching point
 
@@ -202,6 +202,27 @@ class ElastoGap(PartialCompliantWithRelativeStates):
                       recheck=True),
                 Event(f"{p}.lift", Piecewise((gap, Eq(contact, 1)), (1, True)), -1, open_,
                       recheck=True)]
+
+
+class RelativeStates(PartialRelativeSensor):
+    """Relative position, speed and acceleration between two flanges,
+    taking no force (MSL ``RelativeStates``): ``s_rel = flange_b.s -
+    flange_a.s``, ``v_rel = der(s_rel)``, ``a_rel = der(v_rel)``. MSL uses it
+    to make ``s_rel``, ``v_rel`` the states; here fixed start values on them
+    (``RelativeStates(s_rel=0.1, v_rel=0)``) make the solver keep them as
+    states where it can.
+
+    States: ``s_rel`` [m], ``v_rel`` [m/s], ``a_rel`` [m/s2]. Connectors:
+    ``flange_a``, ``flange_b``.
+    """
+
+    s_rel = Variable(0.0, "m", "relative position flange_b.s - flange_a.s")
+    v_rel = Variable(0.0, "m/s", "relative velocity der(s_rel)")
+    a_rel = Variable(0.0, "m/s2", "relative acceleration der(v_rel)")
+
+    def equations(self):
+        return [Eq(self.s_rel, self.flange_b.s - self.flange_a.s),
+                Eq(self.v_rel, der(self.s_rel)), Eq(self.a_rel, der(self.v_rel))]
 
 
 class RollingResistance(PartialForce):
