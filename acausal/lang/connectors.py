@@ -161,16 +161,17 @@ class Frame(Connector):
 
 
 class RealSignal(Connector):
-    """A causal signal connector: one real variable (unit ``unit``; none, as
-    MSL's plain ``Real`` signals, is not checked), no through part. Use
-    :class:`RealInput` or :class:`RealOutput`."""
+    """A causal signal connector: one real variable (unit ``unit``), no
+    through part. Use :class:`RealInput` or :class:`RealOutput`. A signal
+    given no unit is dimensionless for display but not checked (Modelica's
+    ``unit = ""``, as a declaration without one: :mod:`acausal.compiler.units`),
+    so a block's plain output may feed a force's input in N."""
 
     domain = "signal"
     causality = None     # "input" or "output"
 
     def __init__(self, desc="", unit=None):
         super().__init__(desc)
-        # no unit (MSL's plain Real signal): shown as "1", not checked
         self.unit_declared = unit is not None
         self.unit = "1" if unit is None else unit
 

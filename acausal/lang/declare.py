@@ -41,13 +41,23 @@ class Parameter(Declaration):
     ``max_open`` make a bound strict). A ``structural`` parameter (a choice of
     law, a flag) is baked into the generated code: changing it recompiles.
     Its value is read as a plain Python value, not a symbol.
+
+    ``default`` may be a function of the component, evaluated when the
+    model is flattened (:meth:`acausal.lang.Component.value`): a derived
+    parameter (a body's mass from its dimensions and density) or one taken
+    from an enclosing component (a body's gravity from the world's,
+    :meth:`acausal.lang.Component.outer`). Its value is then an expression
+    of other parameters, which a run cannot set on its own. ``final``: a
+    derived parameter that cannot be given a value (Modelica's ``final``).
     """
 
     kind = "parameter"
 
     def __init__(self, default, unit=None, desc="", *, min=None, max=None,
-                 min_open=False, max_open=False, structural=False, choices=None):
+                 min_open=False, max_open=False, structural=False, choices=None,
+                 final=False):
         super().__init__(unit, desc)
+        self.final = final
         self.default = default
         self.min, self.max = min, max
         self.min_open, self.max_open = min_open, max_open
