@@ -1,25 +1,190 @@
 """The ``acausal`` command: simulate, animate, variables, calibrate, sweep, diagnose.
 
-Exit codes: 0 success, 2 a model or input error (an AcausalError: one
-readable line on stderr), 3 a solver failure (time and component named).
-Any other exception is a bug: it is not caught, so Python shows its
-traceback and exits with 1.
+Exit codes: 0 success, 2 a model or input error (an AcausalError, a bad
+option value, a budget that refuses the work before it starts: one readable
+line on stderr), 3 a solver failure or a run stopped by a limit (time and
+component named; the partial result is written), 130 an interruption
+(Ctrl-C, SIGTERM: the partial result is written). Any other exception is a
+bug: it is not caught, so Python shows its traceback and exits with 1.
+
+Every option value is checked before anything runs (:class:`_Number`,
+:func:`_check_output`); library warnings (numpy, scipy) do not reach the
+terminal: a command that succeeds ends with one line counting them
+(:func:`_quiet_warnings`), and values far from the model's defaults or
+declared ranges get one warning line each.
 """
 import contextlib
 import json
+import math
 import os
+import signal
 import sys
+import warnings
 
 import click
 import numpy as np
 
-from .errors import AcausalError, SolverError, UsageError
+from .errors import AcausalError, Interrupted, SolverError, UsageError
 
 
 def _fail(exc):
-    code = 3 if isinstance(exc, SolverError) else 2
-    click.echo(f"acausal: error: {exc}", err=True)
+    if isinstance(exc, Interrupted):
+        code = 130
+    elif isinstance(exc, (UsageError, click.BadParameter)):
+        code = 2
+    else:
+        code = 3 if isinstance(exc, SolverError) else 2
+    click.echo(f"acausal: error: {_one_line(str(exc))}", err=True)
     sys.exit(code)
+
+
+def _one_line(text):
+    return " ".join(str(text).split())
+
+
+def _warn(text):
+    click.echo(f"acausal: warning: {_one_line(text)}", err=True)
+
+
+class _Group(click.Group):
+    """The command group, whose usage errors (an unknown option, a value of
+    the wrong type) are one line, like every other error: ``acausal
+    simulate: error: Invalid value for '--t-end': ...`` (exit 2)."""
+
+    def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True,
+             **extra):
+        if not standalone_mode:
+            return super().main(args, prog_name, complete_var, standalone_mode, **extra)
+        try:
+            return super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
+        except click.exceptions.Abort:
+            click.echo("acausal: interrupted", err=True)
+            sys.exit(130)
+        except click.ClickException as exc:
+            ctx = getattr(exc, "ctx", None)
+            where = ctx.command_path if ctx is not None else "acausal"
+            click.echo(f"{where}: error: {_one_line(exc.format_message())} "
+                       f"(see {where} --help)", err=True)
+            sys.exit(exc.exit_code)
+
+
+class _Number(click.ParamType):
+    """A number option checked when it is parsed: ``kind`` "finite", "positive"
+    (finite > 0), "fraction" (0 < x < 1) or "count" (a whole number >= 1,
+    written 1000000, 1e6 or 1_000_000: the messages print counts as 1e6)."""
+
+    def __init__(self, kind):
+        self.kind = kind
+        self.name = {"count": "count"}.get(kind, "number")
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            x = float(value)
+        else:
+            try:
+                x = float(str(value).strip().replace("_", ""))
+            except ValueError:
+                self.fail(f"{value!r} is not a number", param, ctx)
+        if not math.isfinite(x):
+            self.fail(f"{value!r} is not a finite number", param, ctx)
+        if self.kind == "positive" and not x > 0:
+            self.fail(f"{value!r} must be > 0", param, ctx)
+        if self.kind == "fraction" and not 0 < x < 1:
+            self.fail(f"{value!r} must be between 0 and 1", param, ctx)
+        if self.kind == "count":
+            if x != int(x) or x < 1:
+                self.fail(f"{value!r} must be a whole number >= 1", param, ctx)
+            if x > 1e15:
+                self.fail(f"{value!r} is beyond any budget (at most 1e15)", param, ctx)
+            return int(x)
+        return x
+
+
+FINITE, POSITIVE, FRACTION, COUNT = (_Number(k) for k in ("finite", "positive", "fraction",
+                                                           "count"))
+
+
+def _size(ctx, param, value):
+    """``--max-memory``: bytes (``4GB``, ``512MB``, ``2e9``), or None."""
+    if value is None:
+        return None
+    from .budget import parse_size
+    try:
+        return parse_size(value, f"--{param.name.replace('_', '-')}")
+    except UsageError as exc:
+        raise click.BadParameter(str(exc)) from None
+
+
+def _check_output(path, option, *, plot=False, create=False):
+    """Refuse, before anything runs, an output path that cannot be written:
+    its folder missing (unless ``create``: made now) or not writable, the
+    path a folder, or (``plot``) a format matplotlib cannot write. (A
+    missing folder was found after the simulation, with a traceback.)"""
+    if path is None:
+        return
+    path = os.fspath(path)
+    if plot:
+        from matplotlib.backend_bases import FigureCanvasBase
+        formats = FigureCanvasBase.get_supported_filetypes()
+        ext = os.path.splitext(path)[1].lstrip(".").lower()
+        if ext not in formats:
+            raise UsageError(f"{option} {path}: cannot write a figure as "
+                             f"{'.' + ext if ext else 'a file without an extension'}; "
+                             f"use one of {', '.join('.' + f for f in sorted(formats))}")
+    if os.path.isdir(path):
+        raise UsageError(f"{option} {path}: is a folder, not a file")
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        if os.path.exists(folder) or not create:
+            raise UsageError(f"{option} {path}: the folder {os.path.dirname(path) or '.'} "
+                             "does not exist")
+        try:
+            os.makedirs(folder, exist_ok=True)
+        except OSError as exc:
+            raise UsageError(f"{option} {path}: cannot make its folder: "
+                             f"{exc.strerror or exc}") from None
+    if not os.access(folder, os.W_OK) or (os.path.exists(path) and
+                                          not os.access(path, os.W_OK)):
+        raise UsageError(f"{option} {path}: not writable")
+
+
+@contextlib.contextmanager
+def _quiet_warnings():
+    """Library warnings (numpy's overflow, scipy's LinAlgWarning, ...) are
+    kept from the terminal while the block runs (24 lines of LinAlgWarning
+    for a 1e30 stiffness, six RuntimeWarnings before a clean error); a block
+    that ends normally prints one line counting them."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with np.errstate(all="ignore"):
+            yield
+    if caught:
+        kinds = {}
+        for w in caught:
+            kinds.setdefault(w.category.__name__, []).append(w)
+        parts = [f"{len(ws)} {name}" + (f" (first: {_one_line(ws[0].message)[:120]})"
+                                         if name != "DeprecationWarning" else "")
+                 for name, ws in kinds.items()]
+        _warn("the numerical libraries warned during the run, not shown: " + "; ".join(parts))
+
+
+def _far_settings(cm, params):
+    """One warning line per ``--set`` value far from its default (6 decades,
+    the initialisation's own test) or of the other sign: a value in the
+    wrong unit, typically."""
+    from .initialize import SUSPECT_DECADES
+    for name, value in params.items():
+        try:
+            e = cm.params[cm.param_index(name)]
+        except AcausalError:
+            continue
+        d = e.default
+        if d and value and math.isfinite(value) and (abs(math.log10(abs(value / d))) >= SUSPECT_DECADES or
+                            (value > 0) != (d > 0)):
+            _warn(f"--set {name}={value:g} [{e.unit}] is far from its default {d:g} "
+                  f"[{e.unit}] ({abs(math.log10(abs(value / d))):.1f} decades"
+                  f"{', other sign' if (value > 0) != (d > 0) else ''}): check its value "
+                  "and unit")
 
 
 def _parse_sets(sets):
@@ -38,7 +203,7 @@ def _parse_sets(sets):
     return out
 
 
-@click.group()
+@click.group(cls=_Group)
 @click.version_option(package_name="acausal")
 @click.option("--backend", "global_backend", type=click.Choice(["sundae", "compiled"]),
               help="integrator backend of every simulation of the command, local worker "
@@ -83,58 +248,123 @@ def _set_backend(ctx, name):
     ctx.call_on_close(restore)
 
 
+MAX_MEMORY_HELP = ("memory limit of the command (4GB, 512MB, ...; default $ACAUSAL_MAX_MEMORY, "
+                   "else 4GB or 80% of the machine's memory): estimated before the work "
+                   "starts, watched while it runs")
+
+
 @main.command()
 @click.argument("file", type=click.Path(dir_okay=False))
-@click.option("--t-end", type=float, help="stop time [s] (default: the model file's)")
+@click.option("--t-end", type=FINITE, help="stop time [s] (default: the model file's)")
 @click.option("--set", "sets", multiple=True, metavar="PATH=VALUE",
               help="override a parameter, e.g. --set contact.K=6.25e8")
 @click.option("--out", type=click.Path(dir_okay=False), help="write all variables to CSV")
 @click.option("--plot", type=click.Path(dir_okay=False), help="write a figure (PNG, PDF...)")
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object")
-@click.option("--rtol", type=float)
-@click.option("--atol", type=float)
-@click.option("--max-rows", type=int, default=None, metavar="N",
+@click.option("--rtol", type=FRACTION, help="relative tolerance (0 < rtol < 1)")
+@click.option("--atol", type=POSITIVE, help="absolute tolerance (> 0)")
+@click.option("--max-rows", type=COUNT, default=None, metavar="N",
               help="most output rows to store (default 1e6): a larger grid is refused")
-@click.option("--max-wall", type=float, metavar="SECONDS",
+@click.option("--max-wall", type=POSITIVE, metavar="SECONDS",
               help="stop after this wall time, keeping what was computed")
-@click.option("--max-steps", type=int, metavar="N",
+@click.option("--max-steps", type=COUNT, metavar="N",
               help="stop after this many solver steps, keeping what was computed")
+@click.option("--max-memory", callback=_size, metavar="SIZE", help=MAX_MEMORY_HELP)
 @click.option("--progress/--no-progress", default=None,
               help="progress bar on stderr for runs longer than 2 s "
                    "(default: when stderr is a terminal)")
 @click.option("--backend", type=click.Choice(["sundae", "compiled"]),
               help="integrator backend (default: acausal.simulate.DEFAULT_BACKEND)")
 def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, max_rows, max_wall, max_steps,
-             progress, backend):
-    """Simulate a model file."""
+             max_memory, progress, backend):
+    """Simulate a model file. Stopped by a limit, Ctrl-C or SIGTERM, it
+    writes what it computed (--out, --plot, --json) and says where it stopped."""
+    from .budget import max_memory as memory_limit
     from .modelfile import compile_file, measure_values
+    res = error = None
     try:
-        params = _parse_sets(sets)
-        mf, cm = compile_file(file)
-        opts = _simulate_options(mf, dict(t_end=t_end, rtol=rtol, atol=atol, max_rows=max_rows,
-                                          max_wall=max_wall, max_total_steps=max_steps,
-                                          backend=backend),
-                                 progress, dense=bool(out or plot))
-        with _c_stdout_to_stderr() if as_json else contextlib.nullcontext():
-            res, error = _run_keeping_partial(cm, params, opts)
-        measures, missing = measure_values(mf, res) if error is None else ({}, {})
-        if out:
-            res.to_csv(out)
-            if error is not None:
-                click.echo(f"acausal: partial results up to t = {res.t[-1]:.6g} s written to "
-                           f"{out}", err=True)
-        if plot:
-            _plot(mf, res, plot, partial=error is not None)
+        with _interruptible(), _quiet_warnings():
+            _check_output(out, "--out")
+            _check_output(plot, "--plot", plot=True)
+            params = _parse_sets(sets)
+            mf, cm = compile_file(file)
+            cm.param_vector(cm.split_overrides(params)[0])   # names, bounds: errors first
+            _far_settings(cm, params)
+            opts = _simulate_options(mf, dict(t_end=t_end, rtol=rtol, atol=atol,
+                                              max_rows=max_rows, max_wall=max_wall,
+                                              max_total_steps=max_steps, backend=backend),
+                                     progress, dense=bool(out or plot))
+            _check_run_options(opts)
+            opts["max_memory"] = memory_limit(max_memory)
+            with _c_stdout_to_stderr() if as_json else contextlib.nullcontext():
+                res, error = _run_keeping_partial(cm, params, opts)
+            measures, missing = measure_values(mf, res) if error is None else ({}, {})
+            if out:
+                res.to_csv(out)
+                if error is not None:
+                    click.echo(f"acausal: partial results up to t = {res.t[-1]:.6g} s written "
+                               f"to {out}", err=True)
+            if plot:
+                _plot(mf, res, plot, partial=error is not None)
     except (AcausalError, click.BadParameter) as exc:
         if as_json:
             click.echo(json.dumps({"error": _error_dict(exc)}, indent=1))
         _fail(exc)
+    except KeyboardInterrupt:
+        click.echo("acausal: interrupted before the simulation started: nothing computed",
+                   err=True)
+        sys.exit(130)
     if as_json:
         click.echo(json.dumps(_result_dict(mf, res, measures, missing, error), indent=1))
     else:
         _print_run(mf, cm, res, measures, missing)
     if error is not None:
         _fail(error)
+
+
+def _check_run_options(opts):
+    """The run's stop time after its start (the model file's t0), checked
+    before the run (--t-end -1 gave an IndexError, nan a ValueError)."""
+    t0, t_end = opts.get("t0", 0.0), opts.get("t_end")
+    if t_end is not None and not t_end > t0:
+        raise UsageError(f"--t-end {t_end:g}: must be after the start time t0 = {t0:g} s")
+
+
+@contextlib.contextmanager
+def _interruptible():
+    """Ctrl-C, SIGTERM and SIGHUP stop a running simulation with its partial
+    result (:func:`acausal.simulate.request_stop`: the run ends at its next
+    check, keeping its rows, and the command writes them); outside a run,
+    or at a second signal, they interrupt at once (KeyboardInterrupt; the
+    process ends within the grace period whatever it is doing)."""
+    from . import simulate as sim
+    from .executor import exit_soon
+
+    def handler(signum, frame):
+        name = signal.Signals(signum).name
+        if not sim.STOP.reason and sim.request_stop(f"an interruption ({name})"):
+            exit_soon(130, grace=120.0)     # time to write the partial result
+            return
+        exit_soon(130, grace=5.0)
+        raise KeyboardInterrupt(name)
+
+    if not _in_main_thread():
+        yield
+        return
+    names = [n for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n)]
+    old = {n: signal.signal(getattr(signal, n), handler) for n in names}
+    sim.STOP.armed = True
+    try:
+        yield
+    finally:
+        sim.STOP.armed = False
+        for n, h in old.items():
+            signal.signal(getattr(signal, n), h)
+
+
+def _in_main_thread():
+    import threading
+    return threading.current_thread() is threading.main_thread()
 
 
 def _simulate_options(mf, given, progress, dense=False):
