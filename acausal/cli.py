@@ -632,6 +632,11 @@ def _sweep_units(mf, cm, params, measures):
     return units
 
 
+SWEEP_POINT_BYTES = 600     # a sweep point in the main process, per column (+ 400 bytes):
+                            # 1.1 kB measured for 1 parameter and 1 measure, x 1.5
+MAX_POINTS = 1_000_000      # the sweep's default work budget
+
+
 @main.command()
 @click.argument("file", type=click.Path(dir_okay=False))
 @click.option("--param", "params", multiple=True, required=True, metavar="NAME=A:B:N",
@@ -644,48 +649,124 @@ def _sweep_units(mf, cm, params, measures):
                    "(even a kill) resumes")
 @click.option("--plot", type=click.Path(dir_okay=False), help="plot the first measure")
 @click.option("--scheduler", help="Dask scheduler address (default: local processes)")
-@click.option("--workers", type=int, help="local worker processes (default: all cores)")
+@click.option("--workers", type=COUNT, help="local worker processes (default: all cores)")
+@click.option("--max-points", type=COUNT, default=MAX_POINTS, show_default=True,
+              help="most grid points: a larger grid is refused before anything runs")
+@click.option("--max-wall", type=POSITIVE, metavar="SECONDS",
+              help="stop after this wall time, keeping the finished points")
+@click.option("--max-memory", callback=_size, metavar="SIZE", help=MAX_MEMORY_HELP)
 @click.option("--no-progress", is_flag=True)
-def sweep(file, params, measures, out, plot, scheduler, workers, no_progress):
-    """Run a grid of simulations in parallel."""
+def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max_wall,
+          max_memory, no_progress):
+    """Run a grid of simulations in parallel. Budgets, checked before anything
+    runs: the grid's point count (--max-points) and its memory (points x
+    bytes per point, plus each worker's output rows: --max-memory); while it
+    runs: memory and wall time (--max-wall), which stop it like Ctrl-C,
+    keeping the finished points."""
     import functools
-    import os
 
+    from .budget import PROCESS_BYTES, Watchdog, check_estimate
+    from .budget import max_memory as memory_limit
     from .checkpoint import source_files
-    from .executor import open_executor, terminate_on_sigterm
+    from .executor import default_workers, open_executor, terminate_on_sigterm
     from .modelfile import compile_file, sweep_task
     from .sweep import grid, parse_param, plot_sweep, run_sweep
     measures = _csv_list(",".join(measures))
     try:
-        mf, cm = compile_file(file)
-        specs = [parse_param(p) for p in params]
-        for name, _ in specs:   # a parameter, or a fixed start value (mass.v)
-            if name in cm.split_overrides({name: 0.0})[0]:
-                cm.param_index(name)
-        for m in measures:
-            if m not in mf.measures:
-                raise click.BadParameter(f"--measure {m!r}: the model file defines "
-                                         f"{sorted(mf.measures) or 'no measures'}")
-        task = functools.partial(sweep_task, os.path.abspath(file))
-        units = _sweep_units(mf, cm, [name for name, _ in specs], measures)
-        with terminate_on_sigterm(), _resumable(out), open_executor(scheduler, workers) as ex:
-            rows = run_sweep(task, grid(specs), out, executor=ex, measures=measures,
-                             progress=not no_progress, inputs=source_files(file), units=units)
-        if plot:
-            plot_sweep(rows, specs[0][0], measures[0], plot)
+        with _quiet_warnings():
+            if not measures:
+                raise UsageError("--measure: no measure named (give --measure M1,M2)")
+            _check_output(out, "--out", create=True)
+            _check_output(plot, "--plot", plot=True, create=True)
+            specs = [parse_param(p, max_points) for p in params]
+            n_points = math.prod(len(v) for _, v in specs)
+            if n_points > max_points:
+                raise _budget_error(f"the grid has {n_points:,} points, more than the limit "
+                                    f"of {max_points:,} (--max-points): fewer values per "
+                                    "parameter, or raise --max-points")
+            limit = memory_limit(max_memory)
+            n_workers = workers or (default_workers() if scheduler is None else 1)
+            per_point = 400 + SWEEP_POINT_BYTES * (len(specs) + len(measures) + 3)
+            main_need = PROCESS_BYTES + n_points * per_point
+            check_estimate(main_need + n_workers * PROCESS_BYTES, limit,
+                           f"a sweep of {n_points:,} points on {n_workers} workers",
+                           "sweep fewer points")
+            per_worker = (limit - main_need) / max(n_workers, 1) - PROCESS_BYTES
+            mf, cm = compile_file(file)
+            _check_sweep_params(cm, specs)
+            for m in measures:
+                if m not in mf.measures:
+                    raise click.BadParameter(f"--measure {m!r}: the model file defines "
+                                             f"{sorted(mf.measures) or 'no measures'}")
+            task = functools.partial(sweep_task, os.path.abspath(file),
+                                     max_memory=max(per_worker, 50e6))
+            units = _sweep_units(mf, cm, [name for name, _ in specs], measures)
+            points = grid(specs)
+            with terminate_on_sigterm(), _resumable(out), \
+                    Watchdog(limit, max_wall, "the sweep"), \
+                    open_executor(scheduler, workers) as ex:
+                rows = run_sweep(task, points, out, executor=ex, measures=measures,
+                                 progress=not no_progress, inputs=source_files(file),
+                                 units=units, on_resume=_say_resumed("points"))
+            if plot:
+                fn = mf.measures[measures[0]]
+                y_unit, y_factor = units.get(measures[0]), 1.0
+                if getattr(fn, "display", None) and y_unit:
+                    y_factor, y_unit = fn.shown(1.0)
+                plot_sweep(rows, specs[0][0], measures[0], plot,
+                           x_unit=units.get(specs[0][0]), y_unit=y_unit, y_factor=y_factor)
     except (AcausalError, click.BadParameter) as exc:
         _fail(exc)
     failed = sum(1 for r in rows if r.get("status") != "ok")
     click.echo(f"{len(rows)} points, {failed} failed; results in {out}")
 
 
+def _budget_error(message):
+    from .errors import BudgetError
+    return BudgetError(message)
+
+
+def _check_sweep_params(cm, specs):
+    """Every swept name is a parameter or a fixed start value, and every
+    value of its range is within the parameter's bounds: checked before
+    the sweep runs (-1:1:3 for a speed that must be > 0 ran and failed
+    point by point)."""
+    for name, values in specs:
+        params, _ = cm.split_overrides({name: 0.0})
+        if name not in params:
+            continue                      # a fixed start value: no bounds
+        e = cm.params[cm.param_index(name)]
+        lo, hi = float(np.min(values)), float(np.max(values))
+        for v in (lo, hi):
+            try:
+                e.decl.check_bounds(v, name)
+            except AcausalError as exc:
+                raise UsageError(f"--param {name}={lo:g}..{hi:g}: {exc}", variable=name
+                                 ) from None
+
+
+def _say_resumed(what):
+    """The line a resumed command prints: 'resumed: 4,141 of 10,000 points already done'."""
+    def say(done, total):
+        click.echo(f"acausal: resumed: {done:,} of {total:,} {what} already done", err=True)
+    return say
+
+
 @contextlib.contextmanager
 def _resumable(where):
     """An interruption (Ctrl-C, SIGTERM) ends with one line saying where the
     finished work is, and exit code 130."""
+    from .budget import tripped
+    from .executor import exit_soon
     try:
         yield
     except KeyboardInterrupt:
+        exit_soon(130)
+        why = tripped()
+        if why:
+            click.echo(f"acausal: error: stopped: {why}; finished work is saved in {where}: "
+                       "run the same command again to resume", err=True)
+            sys.exit(3)
         click.echo(f"acausal: interrupted; finished work is saved in {where}: run the same "
                    "command again to resume", err=True)
         sys.exit(130)

@@ -192,6 +192,24 @@ class Executor:
             return iter(distributed.as_completed(futures))
         return cf.as_completed(futures)
 
+    def wait_any(self, futures: Iterable) -> list:
+        """Block until at least one of ``futures`` is done; return the done
+        ones (serial: runs the first not yet run)."""
+        futures = list(futures)
+        if self.kind == "serial":
+            for fut in futures:
+                if isinstance(fut, _DeferredFuture) and not fut.done():
+                    fut.run()
+                    break
+            return [f for f in futures if f.done()]
+        if self.kind == "dask":
+            import distributed
+
+            done, _ = distributed.wait(futures, return_when="FIRST_COMPLETED")
+            return list(done)
+        done, _ = cf.wait(futures, return_when=cf.FIRST_COMPLETED)
+        return list(done)
+
     @staticmethod
     def _serial_as_completed(futures: list) -> Iterator:
         for fut in futures:
@@ -261,6 +279,8 @@ def _die_with_parent(parent: int) -> None:
     # fork, printed two worker tracebacks on a killed sweep)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    import warnings
+    warnings.simplefilter("ignore")   # numpy/scipy warnings: not a wall on the terminal
     if hasattr(signal, "SIGHUP"):
         signal.signal(signal.SIGHUP, signal.SIG_DFL)
     if sys.platform.startswith("linux"):

@@ -310,12 +310,16 @@ def run_file(path, params=None, **overrides):
     return res, evaluate_measures(mf, res)
 
 
-def sweep_task(path, point):
+def sweep_task(path, point, max_memory=None):
     """One sweep point: the model file compiled once per worker process
     (the compile cache is per process), simulated with ``point`` as
     parameter overrides; returns the measures (NaN for one that cannot be
-    computed, with its reason in ``"__missing__"``). Module-level, so picklable."""
+    computed, with its reason in ``"__missing__"``). ``max_memory``: the
+    bytes this worker's run may store (:func:`acausal.simulate.simulate`).
+    Module-level, so picklable."""
     mf, cm = compile_file(path)
     opts = mf.experiment.run_options()
+    if max_memory is not None:
+        opts["max_memory"] = max_memory
     values, missing = measure_values(mf, cm.simulate(params=point, **opts))
     return {**values, "__missing__": missing}
