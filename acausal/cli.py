@@ -541,35 +541,61 @@ def variables(file):
               help="profile-likelihood 95% intervals (lsq): for the parameters whose "
                    "linearised interval is not trustworthy (auto), every one, or none")
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object")
-def calibrate(file, data, fit, method, experiments, profile, as_json):
-    """Fit parameters of a model file to a measured dataset."""
+@click.option("--max-wall", type=POSITIVE, metavar="SECONDS", help="stop after this wall time")
+@click.option("--max-memory", callback=_size, metavar="SIZE", help=MAX_MEMORY_HELP)
+def calibrate(file, data, fit, method, experiments, profile, as_json, max_wall, max_memory):
+    """Fit parameters of a model file to a measured dataset. Warns (one line
+    each) when a condition of the data lies outside the range the model
+    declares, a measured value is far from what the fitted model gives (a
+    unit, a sign), or a fitted value ends at a bound of its range."""
     from . import calibrate as cal
+    from .budget import Watchdog
+    from .budget import max_memory as memory_limit
     from .modelfile import compile_file
     try:
-        mf, cm = compile_file(file)
-        ds = cal.model_dataset(file, data)
-        chosen = None
-        if experiments:
-            chosen = "all" if experiments.strip() == "all" else [
-                x.strip() for x in experiments.split(",") if x.strip()]
-        ds, held = cal.split(ds, chosen)
-        items = [x.strip() for x in fit.split(",") if x.strip()]
-        if method == "report":
-            pairs = []
-            for it in items:
-                if ":" not in it:
-                    raise click.BadParameter(f"--fit {it!r}: the report method needs PARAM:MEASURE")
-                p, m = it.split(":", 1)
-                pairs.append((p, m))
-            cal.check_names(cm, [p for p, _ in pairs])
-            out = cal.report_method(file, ds, pairs)
-        else:
-            names = [it.split(":", 1)[0] for it in items]
-            cal.check_names(cm, names)
-            out = cal.least_squares(file, ds, names, profile=profile)
-        out.validation = cal.validate(file, held, out.values)
+        with _quiet_warnings(), _resumable("nothing (a calibration keeps no partial result)"), \
+                Watchdog(memory_limit(max_memory), max_wall, "the calibration"):
+            out, ds, held, mf, cm = _calibrate(cal, compile_file, file, data, fit, method,
+                                               experiments, profile)
     except (AcausalError, click.BadParameter) as exc:
         _fail(exc)
+    _calibration_warnings(mf, cm, ds, held, out)
+    _print_calibration(out, ds, mf, file, data, as_json)
+
+
+def _calibrate(cal, compile_file, file, data, fit, method, experiments, profile):
+    """The calibration's work: (result, dataset fitted, ModelFile, CompiledModel)."""
+    mf, cm = compile_file(file)
+    ds = cal.model_dataset(file, data)
+    _condition_warnings(mf, ds)
+    chosen = None
+    if experiments is not None:
+        chosen = "all" if experiments.strip() == "all" else [
+            x.strip() for x in experiments.split(",") if x.strip()]
+        if chosen == []:
+            raise UsageError("--experiments: the list is empty (give names, or 'all')")
+    ds, held = cal.split(ds, chosen)
+    items = [x.strip() for x in fit.split(",") if x.strip()]
+    if not items:
+        raise UsageError("--fit: no parameter named (give --fit P1,P2)")
+    if method == "report":
+        pairs = []
+        for it in items:
+            if ":" not in it:
+                raise click.BadParameter(f"--fit {it!r}: the report method needs PARAM:MEASURE")
+            p, m = it.split(":", 1)
+            pairs.append((p, m))
+        cal.check_names(cm, [p for p, _ in pairs])
+        out = cal.report_method(file, ds, pairs)
+    else:
+        names = [it.split(":", 1)[0] for it in items]
+        cal.check_names(cm, names)
+        out = cal.least_squares(file, ds, names, profile=profile)
+    out.validation = cal.validate(file, held, out.values)
+    return out, ds, held, mf, cm
+
+
+def _print_calibration(out, ds, mf, file, data, as_json):
     if as_json:
         click.echo(json.dumps(out.to_dict(), indent=1, default=float))
         return
@@ -588,22 +614,103 @@ def calibrate(file, data, fit, method, experiments, profile, as_json):
             click.echo(f"    {name:20s} " + " ".join(f"{x:+.3f}" for x in row))
     click.echo("  residuals (simulated - measured):")
     for exp, sig in out.residuals.items():
-        click.echo(f"    {exp}: " + ", ".join(_residual(k, v) for k, v in sig.items()))
+        click.echo(f"    {exp}: " + ", ".join(_residual(k, v, mf) for k, v in sig.items()))
     if out.validation:
         click.echo("  held back, predicted with these values (simulated - measured):")
         for exp, sig in out.validation.items():
-            click.echo(f"    {exp}: " + ", ".join(_residual(k, v) for k, v in sig.items()))
+            click.echo(f"    {exp}: " + ", ".join(_residual(k, v, mf) for k, v in sig.items()))
 
 
-def _residual(name, value):
-    """'thrt +1.2e-05' for a measure, 'hook.phi rms 3.4e-04 over 40 samples'
-    for a trace, the message for a failed prediction."""
+def _shown_unit(mf, name):
+    """(factor, unit) showing a residual of measure or variable ``name``:
+    a measure's display unit (thrt: 1e3, 'ms'), else its SI unit, else (1, '')."""
+    from .experiment import Measure
+    fn = mf.measures.get(name) if mf is not None else None
+    if isinstance(fn, Measure):
+        factor, unit = fn.shown(1.0)
+        return factor, ("" if unit == "1" else unit)
+    unit = mf.measure_unit(name) if mf is not None else None
+    if unit is None and mf is not None:
+        try:
+            from .modelfile import compile_file
+            unit = compile_file(mf.path)[1].flat.variables[name].unit
+        except (KeyError, AcausalError, OSError):
+            unit = None
+    return 1.0, ("" if unit in (None, "1") else unit)
+
+
+def _residual(name, value, mf=None):
+    """'thrt +0.012 ms' for a measure (in its display unit), 'hook.phi rms
+    3.4e-04 rad over 40 samples' for a trace, the message for a failed prediction."""
     if name == "error":
         return f"{name} {value}"
     v = np.asarray(value, dtype=float)
+    factor, unit = _shown_unit(mf, name)
+    unit = f" {unit}" if unit else ""
     if v.ndim == 0:
-        return f"{name} {float(v):+.4g}"
-    return f"{name} rms {float(np.sqrt(np.mean(v ** 2))):.4g} over {v.size} samples"
+        return f"{name} {factor * float(v):+.4g}{unit}"
+    return (f"{name} rms {factor * float(np.sqrt(np.mean(v ** 2))):.4g}{unit} over "
+            f"{v.size} samples")
+
+
+def _condition_warnings(mf, ds):
+    """One line per experiment condition outside the range the model file
+    declares (``conditions``), with a hint when a unit would explain it."""
+    for name, (low, high, unit) in mf.conditions.items():
+        if low is None or high is None:
+            continue
+        margin = 0.1 * (high - low)
+        out = [(e.name, e.conditions[name]) for e in ds.experiments
+               if name in e.conditions and not low - margin <= e.conditions[name] <= high + margin]
+        if out:
+            vals = [v for _, v in out]
+            which = (f"{out[0][0]}: {name} = {vals[0]:.4g} {unit}" if len(out) == 1 else
+                     f"{len(out)} experiments ({out[0][0]} .. {out[-1][0]}): {name} = "
+                     f"{min(vals):.4g} .. {max(vals):.4g} {unit}")
+            _warn(f"{which} (in SI) outside the range {low:g}..{high:g} {unit} the model "
+                  "declares: check the values and the unit in the data's header")
+
+
+AT_BOUND = 1e-4     # of a range: a fitted value this close to a bound is at it
+
+
+def _calibration_warnings(mf, cm, ds, held, out):
+    """A fitted value at a bound of its range (the data push it beyond a
+    plausible value: a unit, a wrong measure), and a measured value far from
+    what the fitted model gives (other sign, or a factor 10 away)."""
+    for name, v in out.values.items():
+        lo, hi = mf.free.get(name, (None, None))
+        if lo is None:
+            try:
+                d = cm.params[cm.param_index(name)].decl
+                lo, hi = d.min, d.max
+            except (AcausalError, AttributeError):
+                continue
+        span = (hi - lo) if lo is not None and hi is not None else abs(v) or 1.0
+        for bound, which in ((lo, "lower"), (hi, "upper")):
+            if bound is not None and abs(v - bound) <= AT_BOUND * span:
+                ci = out.ci95.get(name)
+                _warn(f"{name} = {v:.6g} is at the {which} bound {bound:g} of its range"
+                      + (" (its 95 % interval is undefined)" if ci is not None and
+                         not all(math.isfinite(c) for c in ci) else "")
+                      + ": the data push it out of range; check the data's values and units")
+    residuals = {**(out.validation or {}), **out.residuals}
+    for e in list(ds.experiments) + list(getattr(held, "experiments", None) or []):
+        for k, r in residuals.get(e.name, {}).items():
+            measured = e.measures.get(k)
+            try:
+                r = np.asarray(r, dtype=float)
+            except (TypeError, ValueError):
+                continue
+            if measured is None or r.ndim != 0 or not math.isfinite(float(r)):
+                continue
+            sim = measured + float(r)
+            if measured and (not sim or (sim > 0) != (measured > 0) or
+                             not 0.1 <= abs(measured / sim) <= 10):
+                factor, unit = _shown_unit(mf, k)
+                _warn(f"{e.name}: measured {k} = {factor * measured:.4g} {unit} is far from "
+                      f"the fitted model's {factor * sim:.4g} {unit}: check its value, sign "
+                      "and unit")
 
 
 def _profile_line(prof):
@@ -787,11 +894,14 @@ def _csv_list(text):
                                       "they finish, so running the same command again after an "
                                       "interruption (even a kill) resumes")
 @click.option("--scheduler", help="Dask scheduler address (default: local processes)")
-@click.option("--workers", type=int, help="local worker processes (default: all cores)")
+@click.option("--workers", type=COUNT, help="local worker processes (default: all cores)")
+@click.option("--max-wall", type=POSITIVE, metavar="SECONDS",
+              help="stop after this wall time, keeping the finished fits")
+@click.option("--max-memory", callback=_size, metavar="SIZE", help=MAX_MEMORY_HELP)
 @click.option("--hypotheses", metavar="ID,ID,...", help="only these hypotheses")
 @click.option("--locations", metavar="PATH,PATH,...",
               help="only these locations (a path or a prefix of paths)")
-@click.option("--alpha", type=float, default=0.01, show_default=True,
+@click.option("--alpha", type=FRACTION, default=0.01, show_default=True,
               help="family significance level of the discrepancy decision")
 @click.option("--starts", type=click.IntRange(0, 64), default=4, show_default=True,
               help="Latin-hypercube starts per fit (besides the neutral and calibrated ones)")
@@ -799,27 +909,41 @@ def _csv_list(text):
               help="best starts refined per fit (their agreement is reported)")
 @click.option("--no-progress", is_flag=True)
 @click.option("--library", hidden=True, help="module standing in for the hypothesis library")
-def diagnose(file, data, json_path, report_dir, scheduler, workers, hypotheses, locations,
-             alpha, starts, refine, no_progress, library):
+def diagnose(file, data, json_path, report_dir, scheduler, workers, max_wall, max_memory,
+             hypotheses, locations, alpha, starts, refine, no_progress, library):
     """Show what a model gets wrong against measured data, name the cause,
-    extend the model and measure the gain."""
+    extend the model and measure the gain. A long trace is thinned to what
+    its instrument floor supports (said on stderr); past --max-memory or
+    --max-wall, or at Ctrl-C or SIGTERM, it stops keeping its finished fits."""
+    from .budget import PROCESS_BYTES, Watchdog, check_estimate
+    from .budget import max_memory as memory_limit
     from .diagnose.problem import FitSettings
     from .diagnose.run import diagnose as run_diagnosis
-    from .executor import terminate_on_sigterm
+    from .executor import default_workers, terminate_on_sigterm
     try:
-        if not 0 < alpha < 1:
-            raise click.BadParameter(f"--alpha {alpha}: must be between 0 and 1")
-        with terminate_on_sigterm(), _resumable(f"{report_dir}/checkpoint"):
-            out = run_diagnosis(file, data, out_dir=report_dir, scheduler=scheduler,
-                                workers=workers, progress=not no_progress,
-                                hypotheses=_csv_list(hypotheses),
-                                locations=_csv_list(locations), alpha=alpha, library=library,
-                                settings=FitSettings(lhs=starts, refine=refine))
+        with _quiet_warnings():
+            _check_output(json_path, "--json")
+            _check_output(os.path.join(report_dir, "report.md"), "--report", create=True)
+            limit = memory_limit(max_memory)
+            n_workers = workers or (default_workers() if scheduler is None else 1)
+            check_estimate((n_workers + 1) * PROCESS_BYTES, limit,
+                           f"a diagnosis on {n_workers} workers", "use fewer --workers")
+            with terminate_on_sigterm(), _resumable(f"{report_dir}/checkpoint"), \
+                    Watchdog(limit, max_wall, "the diagnosis"):
+                out = run_diagnosis(file, data, out_dir=report_dir, scheduler=scheduler,
+                                    workers=workers, progress=not no_progress,
+                                    hypotheses=_csv_list(hypotheses),
+                                    locations=_csv_list(locations), alpha=alpha,
+                                    library=library,
+                                    settings=FitSettings(lhs=starts, refine=refine),
+                                    on_resume=lambda n, path: click.echo(
+                                        f"acausal: resumed: {n:,} fits already done "
+                                        f"(from {path})", err=True))
+            if json_path:
+                with open(json_path, "w") as f:
+                    json.dump(out, f, indent=1)
     except (AcausalError, click.BadParameter) as exc:
         _fail(exc)
-    if json_path:
-        with open(json_path, "w") as f:
-            json.dump(out, f, indent=1)
     g = out["gain"]
     if not out["discrepancy"]:
         click.echo("no significant discrepancy between the calibrated model and the data")
