@@ -320,8 +320,8 @@ def _integrate(run, watch, cb, t, y, yp, d, stop, tout, output_step):
         run.njev += seg.njev
         run.steps += seg.steps
         if watch.stopping:     # a limit or a stop request inside the call: keep its rows
-            keep = np.asarray(seg.t, float) > float(run.T[-1][-1])
-            keep[0] = False
+            st = np.asarray(seg.t, float)
+            keep = (st > float(run.T[-1][-1])) & np.r_[False, np.diff(st) > 0]
             if watch.stopping == "rows" and watch.max_rows is not None:
                 keep[np.cumsum(keep) > max(int(watch.max_rows) - run.rows, 0)] = False
             if keep.any():

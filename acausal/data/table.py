@@ -266,10 +266,13 @@ def _decode(path: Path, raw: list, first: int) -> list:
         try:
             text = b.decode("utf-8")
         except UnicodeDecodeError as exc:
-            raise DataError(f"byte 0x{b[exc.start]:02x} (byte {exc.start + 1} of the line) is "
-                            "not UTF-8 (save the file as UTF-8)", path, first + k) from None
+            line = first + k + b.count(b"\n", 0, exc.start)
+            col = exc.start - (b.rfind(b"\n", 0, exc.start) + 1) + 1
+            raise DataError(f"byte 0x{b[exc.start]:02x} (byte {col} of the line) is "
+                            "not UTF-8 (save the file as UTF-8)", path, line) from None
         if "\0" in text:
-            raise DataError("NUL byte (not a text file?)", path, first + k)
+            raise DataError("NUL byte (not a text file?)", path,
+                            first + k + text.count("\n", 0, text.index("\0")))
         out.append(text)
     return out
 
