@@ -474,26 +474,44 @@ def _plot(mf, res, path, partial=False):
 @click.argument("file", type=click.Path(dir_okay=False))
 @click.option("--out", required=True, type=click.Path(dir_okay=False),
               help="animation file: .gif (Pillow) or .mp4 (needs ffmpeg)")
-@click.option("--t-end", type=float, help="stop time [s] (default: the model file's)")
+@click.option("--t-end", type=FINITE, help="stop time [s] (default: the model file's)")
 @click.option("--set", "sets", multiple=True, metavar="PATH=VALUE",
               help="override a parameter, e.g. --set crank_pin.w=10")
-@click.option("--fps", type=int, default=25, show_default=True)
-@click.option("--frames", type=int, default=150, show_default=True,
+@click.option("--fps", type=COUNT, default=25, show_default=True)
+@click.option("--frames", type=COUNT, default=150, show_default=True,
               help="largest number of frames (evenly spaced in time)")
-def animate(file, out, t_end, sets, fps, frames):
+@click.option("--max-wall", type=POSITIVE, metavar="SECONDS",
+              help="stop the simulation after this wall time (the frames up to there are drawn)")
+@click.option("--max-memory", callback=_size, metavar="SIZE", help=MAX_MEMORY_HELP)
+def animate(file, out, t_end, sets, fps, frames, max_wall, max_memory):
     """Simulate a planar model file and animate its mechanism."""
     from .animate import animate as write_animation
+    from .budget import max_memory as memory_limit
     from .modelfile import compile_file
     try:
-        mf, cm = compile_file(file)
-        opts = mf.experiment.run_options()
-        if t_end is not None:
-            opts["t_end"] = t_end
-        res = cm.simulate(params=_parse_sets(sets), **opts)
-        ks = write_animation(res, out, fps=fps, max_frames=frames,
-                             title=mf.path.rsplit("/", 1)[-1])
+        with _interruptible(), _quiet_warnings():
+            if os.path.splitext(out)[1].lower() not in (".gif", ".mp4"):
+                raise UsageError(f"--out {out}: an animation is written as .gif or .mp4")
+            _check_output(out, "--out")
+            mf, cm = compile_file(file)
+            opts = mf.experiment.run_options()
+            if t_end is not None:
+                opts["t_end"] = t_end
+            _check_run_options(opts)
+            opts.update(max_memory=memory_limit(max_memory),
+                        **({"max_wall": max_wall} if max_wall else {}))
+            res, error = _run_keeping_partial(cm, _parse_sets(sets), opts)
+            ks = write_animation(res, out, fps=fps, max_frames=frames,
+                                 title=mf.path.rsplit("/", 1)[-1])
     except (AcausalError, click.BadParameter) as exc:
         _fail(exc)
+    except KeyboardInterrupt:
+        click.echo("acausal: interrupted before the simulation started: nothing drawn", err=True)
+        sys.exit(130)
+    if error is not None:
+        click.echo(f"wrote {out}: {len(ks)} frames, t = {res.t[0]:g} .. {res.t[-1]:g} s "
+                   "(partial)")
+        _fail(error)
     click.echo(f"wrote {out}: {len(ks)} frames, t = {res.t[0]:g} .. {res.t[-1]:g} s")
 
 
