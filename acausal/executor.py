@@ -359,6 +359,7 @@ def terminate_on_sigterm():
 
 
 EXIT_GRACE_S = 20.0   # an interrupted command has this long to save its work and end
+EXIT_SOON = True      # False where commands run inside another program (the tests' CliRunner)
 
 
 def exit_soon(code: int = 130, grace: float = EXIT_GRACE_S) -> None:
@@ -368,6 +369,8 @@ def exit_soon(code: int = 130, grace: float = EXIT_GRACE_S) -> None:
     ``code``; its pool workers follow it (:func:`_die_with_parent`). A
     later call can only bring the deadline closer. (A diagnosis stopped by
     SIGTERM printed 'interrupted' and went on computing.)"""
+    if not EXIT_SOON:
+        return
     deadline = time.monotonic() + grace
     if _EXITING["deadline"] is not None:
         _EXITING["deadline"] = min(_EXITING["deadline"], deadline)

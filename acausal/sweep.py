@@ -89,11 +89,11 @@ def _range_values(text: str, spec: str, max_count: int | None = None) -> np.ndar
     stop = _number(parts[1], spec, "stop")
     try:
         count = float(parts[2].strip().replace("_", ""))
-        if not (math.isfinite(count) and count == int(count)):
-            raise ValueError
-        count = int(count)
     except ValueError:
-        raise UsageError(f"bad parameter spec {spec!r}: count {parts[2].strip()!r} must be an integer >= 1") from None
+        count = math.nan
+    if not (math.isfinite(count) and count == int(count)):
+        raise UsageError(f"bad parameter spec {spec!r}: count {parts[2].strip()!r} must be an integer >= 1")
+    count = int(count)
     if max_count is not None and count > max_count:
         from .errors import BudgetError
         raise BudgetError(f"bad parameter spec {spec!r}: {count:,} points, more than the "
