@@ -181,7 +181,7 @@ class Watchdog:
 
     def _trip(self, reason):
         self.reason = _LAST["reason"] = reason
-        from .executor import exit_soon
+        from .infra.executor import exit_soon
         exit_soon(3)
         _thread.interrupt_main(signal.SIGINT)
 

@@ -156,6 +156,8 @@ def _quiet_warnings():
     that ends normally prints one line counting them."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
+        warnings.simplefilter("ignore", DeprecationWarning)   # (old import paths: not numerical)
+        warnings.simplefilter("ignore", PendingDeprecationWarning)
         with np.errstate(all="ignore"):
             yield
     if caught:
@@ -172,7 +174,7 @@ def _far_settings(cm, params):
     """One warning line per ``--set`` value far from its default (6 decades,
     the initialisation's own test) or of the other sign: a value in the
     wrong unit, typically."""
-    from .initialize import SUSPECT_DECADES
+    from .runtime.initialize import SUSPECT_DECADES
     for name, value in params.items():
         try:
             e = cm.params[cm.param_index(name)]
@@ -333,12 +335,12 @@ def _check_run_options(opts):
 @contextlib.contextmanager
 def _interruptible():
     """Ctrl-C, SIGTERM and SIGHUP stop a running simulation with its partial
-    result (:func:`acausal.simulate.request_stop`: the run ends at its next
+    result (:func:`acausal.runtime.hybrid.request_stop`: the run ends at its next
     check, keeping its rows, and the command writes them); outside a run,
     or at a second signal, they interrupt at once (KeyboardInterrupt; the
     process ends within the grace period whatever it is doing)."""
-    from . import simulate as sim
-    from .executor import exit_soon
+    from .runtime import hybrid as sim
+    from .infra.executor import exit_soon
 
     def handler(signum, frame):
         name = signal.Signals(signum).name
@@ -485,7 +487,7 @@ def _plot(mf, res, path, partial=False):
 @click.option("--max-memory", callback=_size, metavar="SIZE", help=MAX_MEMORY_HELP)
 def animate(file, out, t_end, sets, fps, frames, max_wall, max_memory):
     """Simulate a planar model file and animate its mechanism."""
-    from .animate import animate as write_animation
+    from .viz.animate import animate as write_animation
     from .budget import max_memory as memory_limit
     from .modelfile import compile_file
     try:
@@ -566,7 +568,7 @@ def calibrate(file, data, fit, method, experiments, profile, as_json, max_wall, 
     each) when a condition of the data lies outside the range the model
     declares, a measured value is far from what the fitted model gives (a
     unit, a sign), or a fitted value ends at a bound of its range."""
-    from . import calibrate as cal
+    from .studies import calibrate as cal
     from .budget import Watchdog
     from .budget import max_memory as memory_limit
     from .modelfile import compile_file
@@ -642,7 +644,7 @@ def _print_calibration(out, ds, mf, file, data, as_json):
 def _shown_unit(mf, name):
     """(factor, unit) showing a residual of measure or variable ``name``:
     a measure's display unit (thrt: 1e3, 'ms'), else its SI unit, else (1, '')."""
-    from .experiment import Measure
+    from .lang.experiment import Measure
     fn = mf.measures.get(name) if mf is not None else None
     if isinstance(fn, Measure):
         factor, unit = fn.shown(1.0)
@@ -792,10 +794,10 @@ def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max
 
     from .budget import PROCESS_BYTES, Watchdog, check_estimate
     from .budget import max_memory as memory_limit
-    from .checkpoint import source_files
-    from .executor import default_workers, open_executor, terminate_on_sigterm
+    from .infra.checkpoint import source_files
+    from .infra.executor import default_workers, open_executor, terminate_on_sigterm
     from .modelfile import compile_file, sweep_task
-    from .sweep import grid, parse_param, plot_sweep, run_sweep
+    from .studies.sweep import grid, parse_param, plot_sweep, run_sweep
     measures = _csv_list(",".join(measures))
     try:
         with _quiet_warnings():
@@ -882,7 +884,7 @@ def _resumable(where):
     """An interruption (Ctrl-C, SIGTERM) ends with one line saying where the
     finished work is, and exit code 130."""
     from .budget import tripped
-    from .executor import exit_soon
+    from .infra.executor import exit_soon
     try:
         yield
     except KeyboardInterrupt:
@@ -937,7 +939,7 @@ def diagnose(file, data, json_path, report_dir, scheduler, workers, max_wall, ma
     from .budget import max_memory as memory_limit
     from .diagnose.problem import FitSettings
     from .diagnose.run import diagnose as run_diagnosis
-    from .executor import default_workers, terminate_on_sigterm
+    from .infra.executor import default_workers, terminate_on_sigterm
     try:
         with _quiet_warnings():
             _check_output(json_path, "--json")

@@ -24,10 +24,10 @@ import sys
 import traceback
 from dataclasses import dataclass, field
 
-from .compile import compile_model
-from .component import Model
+from .compiler.pipeline import compile_model
+from .lang.component import Model
 from .errors import AcausalError, ModelFileError
-from .experiment import Experiment, Measure
+from .lang.experiment import Experiment, Measure
 
 
 @dataclass
@@ -340,7 +340,7 @@ def sweep_task(path, point, max_memory=None):
     (the compile cache is per process), simulated with ``point`` as
     parameter overrides; returns the measures (NaN for one that cannot be
     computed, with its reason in ``"__missing__"``). ``max_memory``: the
-    bytes this worker's run may store (:func:`acausal.simulate.simulate`).
+    bytes this worker's run may store (:func:`acausal.runtime.hybrid.simulate`).
     Module-level, so picklable."""
     mf, cm = compile_file(path)
     opts = mf.experiment.run_options()

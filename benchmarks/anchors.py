@@ -75,11 +75,11 @@ sys.path.insert(0, os.path.join(ROOT, "benchmarks"))
 
 from timing import best_interleaved  # noqa: E402
 
-from acausal.backends import compiled_available  # noqa: E402
-from acausal.initialize import initial_point  # noqa: E402
+from acausal.runtime.backends import compiled_available  # noqa: E402
+from acausal.runtime.initialize import initial_point  # noqa: E402
 from acausal.modelfile import compile_file, evaluate_measures  # noqa: E402
-from acausal.simulate import EventState  # noqa: E402
-from acausal.symbols import time as t_sym  # noqa: E402
+from acausal.runtime.hybrid import EventState  # noqa: E402
+from acausal.lang.symbols import time as t_sym  # noqa: E402
 
 PARAMS = {"contact.K": 6.25e8, "hook.bh": 0.219}
 # the hand-written reference's absolute tolerances (benchmarks/breaker_speed.py)
@@ -643,7 +643,7 @@ class Case:
     parameters, discrete values, tolerances."""
 
     def __init__(self, cm, bench):
-        from acausal.simulate import _atol_vector
+        from acausal.runtime.hybrid import _atol_vector
         self.cm = cm
         self.p = cm.param_vector(PARAMS)
         self.d = cm.discrete_start()

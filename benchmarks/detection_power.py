@@ -136,7 +136,7 @@ def main(argv=None):
                     "the .json beside it)")
     args = ap.parse_args(argv)
 
-    from acausal.diagnose.library import load_library
+    from acausal.diagnose.library.loader import load_library
     lib = load_library(args.library)
     hyps = args.hypotheses.split(",") if args.hypotheses else list(lib.HYPOTHESES)
     hyps, unsited = _sited(args.model, hyps, args.library)

@@ -95,8 +95,9 @@ class StageCounter:
         self.current = "load/other"
 
     def install(self):
-        from acausal import compile as comp
-        from acausal.diagnose import run, stages
+        from acausal.compiler import pipeline as comp
+        from acausal.diagnose import run
+        from acausal.diagnose.stages import chain as stages
         inner = comp.CompiledModel.simulate
         me = self
 

@@ -46,7 +46,7 @@ sys.path.insert(0, os.path.join(ROOT, "benchmarks"))
 sys.path.insert(0, os.path.join(ROOT, "models", "examples"))
 
 from acausal import AcausalError, compile_model  # noqa: E402
-import acausal.simulate  # noqa: E402,F401  (its imports are not a cost of the first simulation)
+import acausal.runtime.hybrid  # noqa: E402,F401  (its imports are not a cost of the first simulation)
 from chains import chain  # noqa: E402
 import newtons_cradle  # noqa: E402
 

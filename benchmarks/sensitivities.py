@@ -24,7 +24,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from timing import best_interleaved  # noqa: E402
 
-from acausal.backends import compiled_available  # noqa: E402
+from acausal.runtime.backends import compiled_available  # noqa: E402
 from acausal.modelfile import compile_file  # noqa: E402
 
 CASES = [

@@ -46,7 +46,7 @@ def dask_pool(workers: int, profile: bool = True):
     import dask
     import distributed
 
-    from acausal.executor import open_executor
+    from acausal.infra.executor import open_executor
 
     with dask.config.set({"distributed.worker.profile.enabled": profile}):
         with distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
@@ -95,7 +95,7 @@ def main(argv=None) -> int:
     parser.add_argument("--scheduler", choices=("processes", "dask", "dask-noprofile"), default="processes")
     args = parser.parse_args(argv)
 
-    from acausal.sweep import grid, parse_param
+    from acausal.studies.sweep import grid, parse_param
     from sweep_scaling import report
 
     points = grid([parse_param(args.points)])

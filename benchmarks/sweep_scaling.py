@@ -75,7 +75,7 @@ def _warm_all(executor, warmup: Callable[[], object], workers: int) -> None:
 def _timed_sweep(task, points, measures, executor, csv_path: Path) -> tuple[float, float, float]:
     """(wall time of the sweep, summed per-point task time measured on the workers,
     summed ``cpu_s`` measure if the task reports one, else nan)."""
-    from acausal.sweep import run_sweep
+    from acausal.studies.sweep import run_sweep
 
     start = time.perf_counter()
     rows = run_sweep(task, points, csv_path, executor=executor, measures=measures, progress=False)
@@ -129,7 +129,7 @@ def measure_scaling(
     CPU time / (workers * parallel_s): the share of the ``workers`` cores the
     tasks got; < 1 when other processes use them); else these are nan.
     """
-    from acausal.executor import open_executor
+    from acausal.infra.executor import open_executor
 
     with tempfile.TemporaryDirectory() as tmp:
         warmup()
@@ -186,7 +186,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--repeat", type=int, default=1, help="time each sweep N times, keep the fastest")
     args = parser.parse_args(argv)
 
-    from acausal.sweep import grid
+    from acausal.studies.sweep import grid
 
     loops = calibrate_loops(args.seconds)
     points = grid([("x", [float(i) for i in range(args.points)])])

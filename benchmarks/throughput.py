@@ -34,8 +34,8 @@ import numpy as np  # noqa: E402
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from acausal import calibrate as cal  # noqa: E402
-from acausal.batch import default_workers  # noqa: E402
+from acausal.studies import calibrate as cal  # noqa: E402
+from acausal.runtime.batch import default_workers  # noqa: E402
 from acausal.modelfile import compile_file, evaluate_measures  # noqa: E402
 
 MODEL = os.path.join(ROOT, "models", "breaker_24kv.py")

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from acausal.sweep import read_rows
+from acausal.studies.sweep import read_rows
 
 DESIGNS = [  # (csv stem, label)
     ("breaker_24kv", "base (plunger armature, one hook)"),

@@ -214,7 +214,7 @@ def plot(res, path):
     velocities and the angle keep the report's signs, since they are signed
     coordinates, not magnitudes."""
     import numpy as np
-    from acausal.plot import plot_result
+    from acausal.viz.plot import plot_result
     t0 = t_first_contact(res)
     imp = ct.impacts(res, "contact")[0]
     t_rel = t_release(res)

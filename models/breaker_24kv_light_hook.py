@@ -53,7 +53,7 @@ def plot(res, path):
     """Impact force, hook angle, hook velocity at s3 and armature velocity,
     contact end and release marked (as the base file's Fig. 7/10)."""
     import numpy as np
-    from acausal.plot import plot_result
+    from acausal.viz.plot import plot_result
     t0 = t_first_contact(res)
     imp = ct.impacts(res, "contact")
     t_rel = t_release(res)

@@ -114,7 +114,7 @@ def plot(res, path):
     """Impact force, hook angle, hook velocity at s3, pin velocity and
     clapper angle; contact ends and release marked."""
     import numpy as np
-    from acausal.plot import plot_result
+    from acausal.viz.plot import plot_result
     t0 = t_first_contact(res)
     imp = ct.impacts(res, "contact")
     t_rel = t_release(res)

@@ -119,7 +119,7 @@ def plot(res, path):
     """Contact force, hook angle, the toggle's torque on the hook (positive:
     against the trip) and the hook speed; contact end and release marked."""
     import numpy as np
-    from acausal.plot import plot_result
+    from acausal.viz.plot import plot_result
     t0 = t_first_contact(res)
     imp = ct.impacts(res, "contact")[0]
     t_rel = t_release(res)

@@ -128,7 +128,7 @@ def plot(res, path):
     """Both impact forces, hook angle, and the velocities of hook (at s3),
     trip lever (at b1) and armature; release marked."""
     import numpy as np
-    from acausal.plot import plot_result
+    from acausal.viz.plot import plot_result
     t0 = t_first_contact(res)
     t_rel = t_release(res)
     s3 = float(res["hook.s3"][0])

@@ -67,6 +67,6 @@ def _commands_share_this_process():
     an interrupted one must not arm acausal.executor.exit_soon, which would
     end the whole test run (the tests that need it run the command in a
     subprocess)."""
-    import acausal.executor as ex
+    import acausal.infra.executor as ex
     ex.EXIT_SOON = False
     yield

@@ -1,4 +1,6 @@
-"""Measured data: experiments, instrument and traces read from a folder of CSV files.
+"""Measured data: experiments, instrument and traces read from a folder of CSV files;
+and :func:`tube_compare`, csv-compare's tube test of a signal against a reference
+(:mod:`acausal.data.tube`).
 
 Folder format (every file: UTF-8, a BOM allowed, comma-separated with a
 decimal point, one record per line, blank lines and lines
@@ -44,7 +46,8 @@ the model file's ``conditions``.
 
 from .load import load_dataset
 from .records import DataError, Dataset, Experiment, Instrument, Trace
+from .tube import TubeResult, tube_compare
 from .write import write_dataset
 
 __all__ = ["DataError", "Dataset", "Experiment", "Instrument", "Trace",
-           "load_dataset", "write_dataset"]
+           "TubeResult", "load_dataset", "tube_compare", "write_dataset"]

@@ -16,8 +16,8 @@ into a :class:`~.result.Diagnosis`, of which :mod:`.report` is a pure view.
 fits, :mod:`.synth` synthetic data for blind tests. Importing this package
 has no side effects.
 """
-from .graph import KINDS, ModelGraph, Site
-from .hypotheses import HYPOTHESES, Hypothesis, ParamSpec, build_extended, write_extended_model
+from .library.graph import KINDS, ModelGraph, Site
+from .library.hypotheses import HYPOTHESES, Hypothesis, ParamSpec, build_extended, write_extended_model
 
 __all__ = ["KINDS", "ModelGraph", "Site", "HYPOTHESES", "Hypothesis", "ParamSpec",
            "build_extended", "write_extended_model"]

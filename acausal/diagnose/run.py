@@ -18,19 +18,19 @@ import json
 import time
 from pathlib import Path
 
-from ..executor import open_executor
-from . import stages
-from . import stats as st
-from .families import Members, family_index, fit_members, prefer_simplest
-from .intervals import intervals
-from .kinematics import Kinematics, equivalents, kinematics, prefer_site
-from .locate import Location, locate
-from .nextexp import next_experiment
+from ..infra.executor import open_executor
+from .stages import chain as stages
+from .stages import stats as st
+from .stages.families import Members, family_index, fit_members, prefer_simplest
+from .stages.intervals import intervals
+from .stages.kinematics import Kinematics, equivalents, kinematics, prefer_site
+from .stages.locate import Location, locate
+from .stages.nextexp import next_experiment
 from .problem import FitSettings
-from .result import Diagnosis, details, summary
-from .resume import FitStore
-from .stages import DiagnosisError
-from .tasks import fit_candidate
+from .report.result import Diagnosis, details, summary
+from .stages.resume import FitStore
+from .stages.chain import DiagnosisError
+from .stages.tasks import fit_candidate
 
 __all__ = ["diagnose", "run_stages", "DiagnosisError"]
 
@@ -82,7 +82,7 @@ def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None
     t_cv = time.perf_counter() - t0 - t_fit
     shown = None
     if views:
-        from .views import views as make_views
+        from .stages.views import views as make_views
         shown = make_views(problem, cal, rk)
     n_sim = cal.fit.n_sim + sum(r.fit.n_sim for r in fits if r.fit is not None) + clock.get(
         "pair_screen_n_sim", 0)
@@ -164,7 +164,7 @@ def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
                    settings=settings, collect=collect, generic=generic, pairs=pairs,
                    families=families, profile=profile, design=design)
     out_dir = Path(out_dir)
-    from .report import write_report
+    from .report.markdown import write_report
     write_report(out_dir, d, plots=plots)
     out = summary(d)
     out["notes"] = list(getattr(d.dataset, "notes", []))
@@ -178,7 +178,7 @@ def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
 def candidates(model_path, library=None, hypotheses=None, locations=None):
     """(library, graph, [(hyp_id, location, [Param...])]) the model graph
     offers (for scripts such as benchmarks/detection_power.py)."""
-    from .library import load_library
+    from .library.loader import load_library
     from .problem import Problem
     lib = load_library(library)
     problem = Problem(str(model_path), "", lib.name, ())

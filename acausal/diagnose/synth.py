@@ -35,7 +35,7 @@ from scipy import optimize
 from ..errors import AcausalError, UsageError
 from ..data import Dataset, Experiment, Instrument, Trace, write_dataset
 from ..modelfile import compile_file, evaluate_measures
-from .library import load_library
+from .library.loader import load_library
 
 TOO_STRONG = 1e6   # the effect [floors] of a magnitude at which the run fails
 

@@ -71,7 +71,7 @@ import numpy as np
 import sympy as sp
 from sympy import Piecewise
 
-from acausal import Component, Discrete, Eq, Event, Flange, Model, Parameter, Variable, der
+from acausal.lang import Component, Discrete, Eq, Event, Flange, Model, Parameter, Variable, der
 from acausal.errors import MeasureError, ParameterError
 
 from .partials import PartialCompliant

@@ -35,7 +35,7 @@ import math
 import sympy as sp
 from sympy import Max, Min, cos, sin, sqrt
 
-from acausal import Assertion, Component, Eq, Parameter, RotFlange, Start, Variable
+from acausal.lang import Assertion, Component, Eq, Parameter, RotFlange, Start, Variable
 from acausal.errors import ParameterError
 
 

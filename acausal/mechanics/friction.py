@@ -54,7 +54,7 @@ starts at rest stays exactly at rest while stuck.
 import sympy as sp
 from sympy import Ne, Piecewise
 
-from acausal import Component, Discrete, Eq, Event, Flange, Parameter, RotFlange, Variable, der
+from acausal.lang import Component, Discrete, Eq, Event, Flange, Parameter, RotFlange, Variable, der
 from acausal.errors import ParameterError
 
 from .partials import PartialCompliant, PartialRotCompliant

@@ -8,7 +8,9 @@ Sign convention: :mod:`acausal.connectors`.
 """
 from sympy import cos, sin
 
-from acausal import Component, Eq, Flange, Parameter, ParameterError, RotFlange, Variable
+from acausal.lang import Component, Eq, Flange, Parameter, RotFlange, Variable
+
+from acausal.errors import ParameterError
 
 __all__ = ["IdealLever", "TwoArmLever", "IdealGear"]
 

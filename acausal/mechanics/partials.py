@@ -6,7 +6,9 @@ import numbers
 
 import sympy as sp
 
-from acausal import Component, Eq, Flange, Parameter, ParameterError, RotFlange, Variable, der
+from acausal.lang import Component, Eq, Flange, Parameter, RotFlange, Variable, der
+
+from acausal.errors import ParameterError
 
 
 class PartialCompliant(Component):
@@ -61,7 +63,7 @@ class PartialRigid(Component):
     v = Variable(0.0, "m/s", "absolute velocity")
 
     def equations(self):
-        from acausal import der
+        from acausal.lang import der
         return [Eq(self.flange.s, self.s), Eq(der(self.s), self.v)]
 
 
@@ -76,7 +78,7 @@ class PartialRotRigid(Component):
     w = Variable(0.0, "rad/s", "absolute angular velocity")
 
     def equations(self):
-        from acausal import der
+        from acausal.lang import der
         return [Eq(self.flange.phi, self.phi), Eq(der(self.phi), self.w)]
 
 

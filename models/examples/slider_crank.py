@@ -83,5 +83,5 @@ measures = {
 
 def plot(res, path):
     """``acausal simulate --plot``: the mechanism at the end of the run."""
-    from acausal.animate import plot_with_mechanism
+    from acausal.viz.animate import plot_with_mechanism
     plot_with_mechanism(res, path, title="slider-crank")

@@ -35,7 +35,7 @@ import os
 import numpy as np
 import pytest
 
-from acausal.backends import compiled_available
+from acausal.runtime.backends import compiled_available
 from acausal.errors import AcausalError
 from acausal.modelfile import compile_file, evaluate_measures
 
@@ -252,7 +252,7 @@ def test_missing_compiler_falls_back_to_the_reference(monkeypatch, tmp_path):
     scikit-sundae and says why."""
     import weakref
 
-    from acausal.backends import compiled
+    from acausal.runtime.backends import compiled
     monkeypatch.setattr(compiled, "_loaded", weakref.WeakKeyDictionary())  # nothing loaded
     monkeypatch.setenv("CC", str(tmp_path / "no-such-cc"))
     monkeypatch.setenv("ACAUSAL_CACHE_DIR", str(tmp_path))

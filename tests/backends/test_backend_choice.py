@@ -26,7 +26,7 @@ def test_cli_backend_choice_and_per_command_default(monkeypatch):
 
     from click.testing import CliRunner
 
-    from acausal.backends import compiled_available
+    from acausal.runtime.backends import compiled_available
     from acausal.cli import main
     monkeypatch.delenv("ACAUSAL_BACKEND", raising=False)
     runner = CliRunner()

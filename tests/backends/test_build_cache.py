@@ -8,7 +8,7 @@ import pytest
 
 from acausal import compile_model
 from acausal.mechanics.translational import Fixed, Mass, Spring
-from acausal.component import Model
+from acausal.lang.component import Model
 
 
 def _oscillator(c):
@@ -22,8 +22,8 @@ def _oscillator(c):
 
 
 def test_driver_objects_built_once_and_shared(tmp_path, monkeypatch):
-    pytest.importorskip("acausal.backends.compiled")
-    from acausal.backends import compiled
+    pytest.importorskip("acausal.runtime.backends.compiled")
+    from acausal.runtime.backends import compiled
     try:
         compiled._compiler()
     except compiled.Unavailable:

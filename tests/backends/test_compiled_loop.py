@@ -9,8 +9,8 @@ import os
 import numpy as np
 import pytest
 
-from acausal.backends import compiled_available, make_solver
-from acausal.initialize import _newton, initial_point, reinitialize
+from acausal.runtime.backends import compiled_available, make_solver
+from acausal.runtime.initialize import _newton, initial_point, reinitialize
 from acausal.modelfile import compile_file
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from sksundae.ida import IDA
 
-from acausal.backends.sundae import _EVENT_LOG, _clear_event_log
+from acausal.runtime.backends.sundae import _EVENT_LOG, _clear_event_log
 
 
 def _res(t, y, yp, r):

@@ -5,7 +5,7 @@ import os
 import uuid
 from pathlib import Path
 
-from acausal.executor import worker_cache
+from acausal.infra.executor import worker_cache
 
 
 def square(point):

@@ -8,7 +8,7 @@ import pytest
 
 from acausal import Experiment
 from acausal.modelfile import compile_file, run_file
-from acausal.simulate import _atol_vector
+from acausal.runtime.hybrid import _atol_vector
 from acausal.mechanics.fourbar import fourbar_angles
 from acausal.errors import UsageError
 
@@ -57,7 +57,7 @@ def test_error_test_failure_suggests_the_algebraic_tolerance():
     """IDA's 'error test failed' (status -3) with the algebraic unknowns held
     to the states' atol: the message says what to try, with the option's
     name; with atol_algebraic given it does not repeat the advice."""
-    from acausal.simulate import _Run, _failure
+    from acausal.runtime.hybrid import _Run, _failure
     _, cm = compile_file(EXAMPLE)
     p = cm.param_vector({})
     d = cm.discrete_start()

@@ -151,7 +151,7 @@ def test_calibrate_bad_folder_is_one_line_exit_2(tmp_path, model_file, case):
 
 
 def test_bad_folder_is_a_data_error_with_its_location(tmp_path, model_file):
-    from acausal.calibrate import model_dataset
+    from acausal.studies.calibrate import model_dataset
     folder = good_folder(tmp_path / "data")
     _edit("experiments.csv", "s_end [mm]", "s_end [kg]")(folder)
     with pytest.raises(DataError) as info:
@@ -278,7 +278,7 @@ def test_breaker_refuses_the_wrong_data_of_the_issue(tmp_path, edit, words):
     """The issue's two cases on the report's own data: a 'thrt [kg]' header
     (accepted, gave hook.bh = 1 +- 2000) and a missing v_impact column (every
     experiment ran at the default)."""
-    from acausal.calibrate import model_dataset
+    from acausal.studies.calibrate import model_dataset
     src = os.path.join(ROOT, "data", "report_24kv")
     for name in ("experiments.csv", "instrument.csv"):
         text = open(os.path.join(src, name), encoding="utf-8").read()

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from acausal import Model, compile_model
-from acausal.cache import cache_dir
+from acausal.infra.store import cache_dir
 from acausal.mechanics.translational import Damper, Fixed, Mass, Spring
 
 

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from acausal.calibrate import ForwardDifferences
+from acausal.studies.calibrate import ForwardDifferences
 
 
 def test_forward_differences_absolute_step_and_reuse():
@@ -29,7 +29,7 @@ def test_breaker_110V_intervals_from_the_right_jacobian():
     |log(K/K0)| gave +-0.023)."""
     import os
 
-    from acausal import calibrate as cal
+    from acausal.studies import calibrate as cal
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     model = os.path.join(root, "models", "breaker_24kv.py")
     ds, _ = cal.split(cal.model_dataset(model, os.path.join(root, "data", "report_24kv")))

@@ -5,7 +5,7 @@ Jacobian ran."""
 import numpy as np
 import pytest
 
-from acausal import calibrate as cal
+from acausal.studies import calibrate as cal
 from acausal.data import Dataset, Experiment, Instrument, Trace
 from acausal.modelfile import compile_file
 
@@ -121,7 +121,7 @@ def test_diagnosis_fit_with_the_sensitivity_jacobian(tmp_path):
     """The diagnosis's fit (acausal.diagnose.fitting.fit) with
     jacobian="sensitivities": the same optimum as with differences, and its
     Jacobian against the differences' at the optimum."""
-    from acausal.diagnose import fitting
+    from acausal.diagnose.stages import fitting
     model, ds = _data(tmp_path)
     names = ["spring.c", "damper.d"]
     kw = dict(x0={"spring.c": 100.0, "damper.d": 2.0}, low={"spring.c": 10.0, "damper.d": 0.0},

@@ -2,7 +2,7 @@
 that could be parameters-only (acausal.causalize._moves)."""
 import sympy as sp
 
-from acausal import causalize as C
+from acausal.compiler import causalize as C
 
 
 def _setup():

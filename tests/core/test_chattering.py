@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from acausal import ChatteringError, Discrete, Eq, Event, Model, Parameter, compile_model, time
-from acausal.component import Component
-from acausal.connectors import Flange
+from acausal.lang.component import Component
+from acausal.lang.connectors import Flange
 from acausal.mechanics.translational import Fixed, Mass, Spring
 
 

@@ -6,7 +6,7 @@ import math
 
 import sympy as sp
 
-from acausal.codegen import _cse_print
+from acausal.compiler.codegen import _cse_print
 
 
 def test_a_rebuilt_part_never_refers_to_a_later_name():

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy import integrate, optimize
 
-from acausal.design import (Condition, ModelRival, Signal, conditions_of,
+from acausal.studies.design import (Condition, ModelRival, Search, Signal, conditions_of,
                             design_experiment, score)
 from acausal.errors import ModelFileError
 from acausal.modelfile import compile_file
@@ -33,7 +33,7 @@ def test_two_rivals_separation_is_largest_at_the_analytic_optimum():
     # difference a (T - T^2): D = a^2 sum((T - T^2)^2) / floor^2, largest at |a| max
     conds = [Condition("a", -0.5, 2.0), Condition("b", 0.0, 1.0)]
     nxt = design_experiment({"line": _line, "parabola": _parabola}, conds,
-                            [Signal("y", 0.01)], seed=1)
+                            [Signal("y", 0.01)], search=Search(seed=1))
     expected = 2.0 * np.sqrt(np.sum((T - T ** 2) ** 2)) / 0.01
     assert nxt.conditions["a"] == pytest.approx(2.0, abs=1e-6)
     assert nxt.separation == pytest.approx(expected, rel=1e-6)
@@ -43,10 +43,11 @@ def test_two_rivals_separation_is_largest_at_the_analytic_optimum():
 
 
 def test_next_experiment_plot_is_written(tmp_path):
-    from acausal.design import plot_next_experiment
+    from acausal.studies.design import plot_next_experiment
     nxt = design_experiment({"line": _line, "parabola": _parabola},
                             [Condition("a", -0.5, 2.0), Condition("b", 0.0, 1.0)],
-                            [Signal("y", 0.01)], n_initial=12, n_refine=1, times=T)
+                            [Signal("y", 0.01)], search=Search(n_initial=12, n_refine=1),
+                            times=T)
     assert nxt.to_dict()["times"] == pytest.approx(T.tolist())
     fig = plot_next_experiment(nxt, tmp_path / "next.png")
     assert (tmp_path / "next.png").stat().st_size > 5000
@@ -61,7 +62,7 @@ def test_three_rivals_maximise_the_smallest_pairwise_separation():
     rivals = {"p1": lambda c: {"y": c["c"] * T}, "p2": lambda c: {"y": c["c"] * T ** 2},
               "p3": cubic}
     conds = [Condition("c", 0.0, 1.0), Condition("k", -1.0, 1.0)]
-    nxt = design_experiment(rivals, conds, [Signal("y", 0.01)], seed=0)
+    nxt = design_experiment(rivals, conds, [Signal("y", 0.01)], search=Search(seed=0))
 
     def min_d(c, k):
         ys = [c * T, c * T ** 2, c * T ** 3 + 0.2 * k]
@@ -214,7 +215,7 @@ def test_blind_next_experiment_splits_coulomb_friction_from_a_constant_load(tmp_
     conds = conditions_of(pairs["coulomb"][0])
     nxt = design_experiment(rivals, conds, [Signal("mass.s", FLOOR, "m"),
                                             Signal("mass.v", 1e-2, "m/s")],
-                            reference=old[0][0], n_refine=1, max_refine_evals=30)
+                            reference=old[0][0], search=Search(n_refine=1, max_refine_evals=30))
     assert nxt.baseline < 3.0                   # the old experiment: within the noise
     assert nxt.separation > 100.0 and nxt.decisive  # the new one: many floors apart
     json.dumps(nxt.to_dict())

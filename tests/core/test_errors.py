@@ -19,7 +19,7 @@ def test_every_error_class_is_an_acausal_error():
                if isinstance(c, type) and issubclass(c, BaseException)]
     assert len(classes) >= 14
     assert all(issubclass(c, AcausalError) for c in classes)
-    from acausal.calibrate import CalibrationError
+    from acausal.studies.calibrate import CalibrationError
     from acausal.data import DataError as DataError2
     from acausal.diagnose.run import DiagnosisError
     assert issubclass(CalibrationError, AcausalError) and issubclass(DiagnosisError, AcausalError)

@@ -7,8 +7,8 @@ import pytest
 
 from acausal import (Assertion, Eq, InitializationError, Model, Start, compile_model, der,
                      guess)
-from acausal.component import Component
-from acausal.declare import Variable
+from acausal.lang.component import Component
+from acausal.lang.declare import Variable
 
 L, G = 1.0, 9.81
 

@@ -10,7 +10,7 @@
 import numpy as np
 
 from acausal import Eq, Model, compile_model, time
-from acausal.initialize import initial_point
+from acausal.runtime.initialize import initial_point
 from acausal.mechanics.translational import Fixed, Mass, Spring
 
 

@@ -4,7 +4,7 @@ import numpy as np
 import sympy as sp
 
 from acausal import Model, compile_model
-from acausal.initialize import _lstsq_scaled
+from acausal.runtime.initialize import _lstsq_scaled
 from acausal.mechanics.levers import TwoArmLever
 from acausal.mechanics.translational import Force, Mass
 

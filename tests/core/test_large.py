@@ -9,10 +9,10 @@ import scipy.linalg
 import sympy as sp
 
 from acausal import Assertion, Model, Parameter, compile_model
-from acausal.batch import BatchItemError
-from acausal.component import Component
-from acausal.connectors import Flange
-from acausal.fastdiff import diff
+from acausal.runtime.batch import BatchItemError
+from acausal.lang.component import Component
+from acausal.lang.connectors import Flange
+from acausal.lang.fastdiff import diff
 from acausal.mechanics.translational import Fixed, Mass, SpringDamper
 
 M, C, D = 0.5, 3e3, 2.0
@@ -183,7 +183,7 @@ def test_sparse_initialisation_equals_the_dense_one(cm12, monkeypatch):
     (a chain with every start fixed; a fixed start on an eliminated
     spring-damper force, a row that is not a unit vector, and a free mass
     whose start is a guess), it gives the dense path's point."""
-    import acausal.initialize as ini
+    import acausal.runtime.initialize as ini
     m = Model()
     m.ground = Fixed()
     m.a = Mass(m=M, s=0.01, v=0.0)

@@ -5,8 +5,8 @@ import sympy as sp
 
 from acausal import (Discrete, Eq, Event, Model, Parameter, Start, StructuralError, compile_model,
                      der)
-from acausal.component import Component
-from acausal.connectors import Flange
+from acausal.lang.component import Component
+from acausal.lang.connectors import Flange
 from acausal.mechanics.translational import Fixed, Mass, Spring
 from acausal.mechanics.levers import TwoArmLever
 
@@ -180,9 +180,10 @@ class Toggle(Component):
 
     flange = Flange("flange")
     mode = Discrete(1, "1", "a mode that is never right")
+    F0 = Parameter(1.0, "N", "force per unit of mode")
 
     def equations(self):
-        return [Eq(self.flange.f, self.mode)]
+        return [Eq(self.flange.f, self.F0 * self.mode)]
 
     def events(self):
         def flip(state):
@@ -241,7 +242,7 @@ def test_time_window_chattering_guard(monkeypatch):
     the run, a mass rattling in a clearance (an event every ~1 ms) must trip
     it and name the component, keeping what was computed."""
     from acausal import ChatteringError
-    from acausal import simulate as sim
+    from acausal.runtime import hybrid as sim
     from acausal.mechanics.contact import Clearance
     monkeypatch.setattr(sim, "CHATTER_SPAN", 0.5)
     m = Model()

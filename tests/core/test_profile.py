@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from acausal.profile import profile_likelihood, threshold
+from acausal.studies.profile import Confidence, Coordinates, Tracing, profile_likelihood, threshold
 
 Q95 = stats.chi2.ppf(0.95, 1)
 
@@ -41,7 +41,7 @@ def test_linear_model_with_estimated_noise_is_the_student_t_interval():
     r = X @ beta - y
     s2 = float(r @ r) / (n - k)        # unit weights: the noise is estimated
     sd = np.sqrt(s2 * np.diag(np.linalg.inv(X.T @ X)))
-    p = profile_likelihood(lambda b: X @ b - y, beta, 1, dispersion=s2, dof=n - k)
+    p = profile_likelihood(lambda b: X @ b - y, beta, 1, confidence=Confidence(dispersion=s2, dof=n - k))
     half = stats.t.ppf(0.975, n - k) * sd[1]
     assert p.threshold == pytest.approx(threshold(0.95, s2, n - k))
     assert (p.lower, p.upper) == pytest.approx((beta[1] - half, beta[1] + half), abs=1e-4 * half)
@@ -72,7 +72,8 @@ def test_exponential_rate_gives_asymmetric_interval_matching_a_grid():
     def res(x):
         return (x[0] * np.exp(-x[1] * t) - y) / sigma
     opt = optimize.least_squares(res, [1.0, 1.0], xtol=1e-14, ftol=1e-14, gtol=1e-14).x
-    p = profile_likelihood(res, opt, 1, bounds=([0.0, 0.0], [np.inf, np.inf]), name="k")
+    p = profile_likelihood(res, opt, 1, coords=Coordinates(bounds=([0.0, 0.0], [np.inf, np.inf])),
+                           name="k")
     lo, hi, step = _brute_force_interval(t, y, sigma)
     assert p.lower == pytest.approx(lo, abs=2 * step)
     assert p.upper == pytest.approx(hi, abs=2 * step)
@@ -96,7 +97,7 @@ def test_one_over_p_parameter_profile_on_log_scale_matches_grid():
     chi = (((1.0 / (1.0 + np.outer(1.0 / taus, t)) - y) / sigma) ** 2).sum(axis=1)
     best = taus[chi.argmin()]
     inside = taus[chi - chi.min() <= Q95]
-    p = profile_likelihood(res, [best], 0, bounds=([1e-6], [np.inf]), log=True)
+    p = profile_likelihood(res, [best], 0, coords=Coordinates(bounds=([1e-6], [np.inf]), log=True))
     assert p.lower == pytest.approx(inside.min(), rel=1e-4)
     assert p.upper == pytest.approx(inside.max(), rel=1e-4)
 
@@ -108,20 +109,20 @@ def test_unidentifiable_parameter_gives_open_profile():
     # only the product a*b is identifiable: the profile of a is flat to its bounds
     prod = float(t @ y / (t @ t))       # the least-squares product
     p = profile_likelihood(lambda x: (x[0] * x[1] * t - y) / 0.1, [1.0, prod], 0,
-                           bounds=([0.1, 0.01], [10.0, 100.0]), log=True)
+                           coords=Coordinates(bounds=([0.1, 0.01], [10.0, 100.0]), log=True))
     assert p.open_lower and p.open_upper
     assert (p.lower, p.upper) == pytest.approx((0.1, 10.0))
     assert not p.trustworthy
     assert np.all(np.abs(p.delta_chi2) < 0.05 * p.threshold)
     # without bounds the open ends are None
     q = profile_likelihood(lambda x: ((x[0] + x[1]) * t - y) / 0.1, [1.0, prod - 1.0], 0,
-                           max_points=25)
+                           tracing=Tracing(max_points=25))
     assert q.lower is None and q.upper is None and q.open_lower and q.open_upper
     assert q.to_dict()["lower"] is None
 
 
 def test_linear_check_accepts_linear_and_rejects_asymmetric():
-    from acausal.profile import linear_check
+    from acausal.studies.profile import linear_check
     from scipy import optimize
     X, y, sigma = _quadratic_data()
     beta = np.linalg.lstsq(X, y, rcond=None)[0]
@@ -143,7 +144,7 @@ def test_breaker_K_over_all_voltages_has_an_open_profile():
     each K) is closed below, near 2.9e8, and open up to the bound 1e10.
     About 1100 simulations (1.5 min of CPU)."""
     import os
-    from acausal import calibrate as cal
+    from acausal.studies import calibrate as cal
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     model = os.path.join(root, "models", "breaker_24kv.py")
     ds = cal.model_dataset(model, os.path.join(root, "data", "report_24kv"))
@@ -161,7 +162,7 @@ def test_breaker_K_at_110V_profile_is_closed_and_shifted():
     """Two readings for two parameters (dof 0: threshold 3.84): the profile of
     K is closed, [4.07e8, 1.02e9] against the Wald [3.91e8, 9.74e8]."""
     import os
-    from acausal import calibrate as cal
+    from acausal.studies import calibrate as cal
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     model = os.path.join(root, "models", "breaker_24kv.py")
     ds, _ = cal.split(cal.model_dataset(model, os.path.join(root, "data", "report_24kv")))
@@ -175,7 +176,7 @@ def test_breaker_K_at_110V_profile_is_closed_and_shifted():
 
 def test_profiles_auto_profiles_only_what_the_linear_check_rejects():
     from scipy import optimize
-    from acausal.profile import jacobian_in_profile_variables, profiles
+    from acausal.studies.profile import jacobian_in_profile_variables, profiles
     t, y = _decay(0.15)
 
     def res(x):
@@ -185,8 +186,8 @@ def test_profiles_auto_profiles_only_what_the_linear_check_rejects():
     # on k itself the profile is skewed (see above); on log k it is nearly quadratic
     for log, flagged in (([False, False], {"k"}), ([False, True], set())):
         ju = jacobian_in_profile_variables(jx, opt, log=log)
-        auto = profiles(res, opt, ["A", "k"], log=log, jacobian=ju)
-        every = profiles(res, opt, ["A", "k"], every=True, log=log)
+        auto = profiles(res, opt, ["A", "k"], coords=Coordinates(log=log), jacobian=ju)
+        every = profiles(res, opt, ["A", "k"], every=True, coords=Coordinates(log=log))
         assert set(auto) == flagged
         assert {n for n, p in every.items() if not p.trustworthy} == flagged
         for name, p in auto.items():      # what auto profiled, it profiled the same way
@@ -266,7 +267,7 @@ def test_cli_profile_line_names_open_ends():
     y = 2.0 * t
     prod = float(t @ y / (t @ t))
     p = profile_likelihood(lambda x: (x[0] * x[1] * t - y) / 0.1, [1.0, prod], 0,
-                           bounds=([0.1, 0.01], [10.0, 100.0]), log=True)
+                           coords=Coordinates(bounds=([0.1, 0.01], [10.0, 100.0]), log=True))
     assert _profile_line(p).startswith(
         "profile-likelihood 95% CI [open at bound 0.1, open at bound 10] "
         "(the linearised interval is not trustworthy;")

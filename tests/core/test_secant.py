@@ -3,7 +3,7 @@ forward differences on a least-squares problem with a closed-form optimum."""
 import numpy as np
 from scipy import optimize
 
-from acausal.differences import ForwardDifferences, SecantDifferences
+from acausal.studies.differences import ForwardDifferences, SecantDifferences
 
 
 def _problem():

@@ -12,8 +12,8 @@ import pytest
 import sympy as sp
 
 from acausal import Model, time
-from acausal.backends import compiled_available
-from acausal.compile import compile_model
+from acausal.runtime.backends import compiled_available
+from acausal.compiler.pipeline import compile_model
 from acausal.errors import ParameterError, UsageError
 from acausal.mechanics.contact import Contact, contact_period
 from acausal.mechanics.translational import Damper, Fixed, Force, Mass, Spring
@@ -302,8 +302,8 @@ def test_compiled_callbacks_of_a_sensitivity_model_match_its_python_ones():
     discrete values and their sensitivities are used)."""
     if compiled_available() is not None:
         pytest.skip(compiled_available())
-    from acausal.backends.compiled import CompiledSolver
-    from acausal.sensitivity import sensitivity_model
+    from acausal.runtime.backends.compiled import CompiledSolver
+    from acausal.runtime.sensitivity import sensitivity_model
     cm = _bouncing()
     sm = sensitivity_model(cm, ["contact.K", "contact.e"])
     p = cm.param_vector({})

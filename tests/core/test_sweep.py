@@ -10,8 +10,8 @@ import sys
 import numpy as np
 import pytest
 
-from acausal.executor import clear_worker_cache, open_executor, worker_cache
-from acausal.sweep import SweepAborted, grid, parse_param, plot_sweep, run_sweep
+from acausal.infra.executor import clear_worker_cache, open_executor, worker_cache
+from acausal.studies.sweep import SweepAborted, grid, parse_param, plot_sweep, run_sweep
 from tests.core import sweep_tasks
 from acausal.errors import UsageError
 

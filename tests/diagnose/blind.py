@@ -56,7 +56,7 @@ def velocity_shape_error(term, law, v_max):
     difference of the fitted part over that of the truth, on the knots."""
     import numpy as np
 
-    from acausal.diagnose import generic
+    from acausal.diagnose.library import generic
     GENERIC, N_V, shape = generic.GENERIC, generic.N_V, generic.shape
     sh = shape(term["values"], GENERIC.prefix, term["ranges"], n=401)
     v, fv = sh["v"], sh["f_v"]

@@ -24,7 +24,7 @@ import os
 
 import sympy as sp
 
-from acausal.compile import compile_model
+from acausal.compiler.pipeline import compile_model
 from acausal.mechanics.rotational import Torque
 from acausal.mechanics.translational import Force
 from acausal.modelfile import compile_file, load_model_file

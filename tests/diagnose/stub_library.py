@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from acausal.compile import compile_model
+from acausal.compiler.pipeline import compile_model
 from acausal.modelfile import load_model_file
 from acausal.mechanics.rotational import Inertia, Torque
 from acausal.mechanics.translational import Force, Mass

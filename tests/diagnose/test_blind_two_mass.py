@@ -30,7 +30,7 @@ def _run(tmp_path, effect, value=None, name=None):
 def test_truth_matches_the_model():
     """The user's model file (compiled by acausal) and the scipy truth agree
     with no hidden effect: 3e-8 m measured, 0.3 % of a noise floor."""
-    from acausal.compile import compile_model
+    from acausal.compiler.pipeline import compile_model
     from acausal.modelfile import load_model_file
     mf = load_model_file(MODEL)
     t, x1, x2 = two_mass_truth.simulate(0.012)

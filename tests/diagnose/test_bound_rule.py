@@ -3,7 +3,7 @@ neutral value) is not named (stages._bound_reasons)."""
 from types import SimpleNamespace as NS
 
 from acausal.diagnose.problem import Param
-from acausal.diagnose.stages import _bound_reasons
+from acausal.diagnose.stages.chain import _bound_reasons
 
 
 def _best(c, n):

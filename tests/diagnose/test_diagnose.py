@@ -15,10 +15,10 @@ import pytest
 from click.testing import CliRunner
 
 from acausal.cli import main
-from acausal.compile import CompiledModel
+from acausal.compiler.pipeline import CompiledModel
 from acausal.diagnose.problem import FitSettings
-from acausal.diagnose.report import write_report
-from acausal.diagnose.result import summary
+from acausal.diagnose.report.markdown import write_report
+from acausal.diagnose.report.result import summary
 from acausal.diagnose.run import diagnose, run_stages
 from acausal.diagnose.synth import synthesize
 

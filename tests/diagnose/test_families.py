@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from acausal.diagnose.families import family_index, heads, member_candidates
-from acausal.diagnose.hypotheses import FAMILIES, HYPOTHESES, build_extended, build_pair
-from acausal.diagnose.fitting import Fit
+from acausal.diagnose.stages.families import family_index, heads, member_candidates
+from acausal.diagnose.library.hypotheses import FAMILIES, HYPOTHESES, build_extended, build_pair
+from acausal.diagnose.stages.fitting import Fit
 from acausal.diagnose.problem import Candidate, Param, Problem
-from acausal.diagnose.stages import Row, _heads, pair_candidates
-from acausal.diagnose.tasks import Starts
-from acausal.diagnose.library import load_library
+from acausal.diagnose.stages.chain import Row, _heads, pair_candidates
+from acausal.diagnose.stages.tasks import Starts
+from acausal.diagnose.library.loader import load_library
 
 HERE = os.path.dirname(__file__)
 SLIDER = os.path.join(HERE, "slider_model.py")     # 1 kg on a 90 N/m spring, s0 = 0.1 m
@@ -87,7 +87,7 @@ class _Dec:
 
 
 def test_members_are_seeded_from_the_head_at_its_site_only():
-    prob = Problem(SLIDER, "", "acausal.diagnose.hypotheses", ())
+    prob = Problem(SLIDER, "", "acausal.diagnose.library.hypotheses", ())
     dec = _Dec([_row("coulomb_friction", "mass", {"spring.c": 95.0, "hyp_cf.F": 2.5}),
                 _row("constant_load", "mass", {"spring.c": 95.0, "hyp_cl.F": 2.4})])
     idx = family_index(prob.library)
@@ -108,7 +108,7 @@ def test_a_pair_uses_one_hypothesis_at_two_sites(tmp_path):
     f.write_text(TWO_MASSES)
     dec = _Dec([_row("constant_load", "m1", {"k.c": 50.0, "hyp_cl.F": 1.0}),
                 _row("constant_load", "m2", {"k.c": 50.0, "hyp_cl.F": 2.0})])
-    (pair,) = pair_candidates(Problem(str(f), "", "acausal.diagnose.hypotheses", ()), dec)
+    (pair,) = pair_candidates(Problem(str(f), "", "acausal.diagnose.library.hypotheses", ()), dec)
     assert pair.hypothesis == "constant_load+constant_load" and pair.location == "m1+m2"
     assert [p.name for p in pair.params] == ["hyp_cl.F", "hyp_cl2.F"]
     assert [p.start for p in pair.params] == [1.0, 2.0]
@@ -123,11 +123,11 @@ def test_a_pair_uses_one_hypothesis_at_two_sites(tmp_path):
                                    atol=1e-6)
     # the extended model file applies both (the second renamed) and runs
     import dataclasses
-    from acausal.diagnose.stages import Ranking, extend
+    from acausal.diagnose.stages.chain import Ranking, extend
     from acausal.modelfile import compile_file
     row = _row("constant_load+constant_load", "m1+m2", {"hyp_cl.F": 1.0, "hyp_cl2.F": 2.0})
     row = dataclasses.replace(row, candidate=pair)
-    path = extend(Problem(str(f), "", "acausal.diagnose.hypotheses", ()),
+    path = extend(Problem(str(f), "", "acausal.diagnose.library.hypotheses", ()),
                   Ranking((row,), [[0]], 0, 0, None, [], (), 1.0), tmp_path / "out")
     assert ".renamed('hyp_cl2')" in open(path).read()
     mf2, cm2 = compile_file(path)
@@ -235,7 +235,7 @@ def test_blind_drag_with_another_exponent_is_named_by_its_family(tmp_path):
     import time
     from acausal.data import Dataset, Experiment, Instrument, Trace, write_dataset
     from acausal.diagnose.problem import FitSettings
-    from acausal.diagnose.result import summary
+    from acausal.diagnose.report.result import summary
     from acausal.diagnose.run import run_stages
     (tmp_path / "rig.py").write_text(RIG)
     times = np.arange(0.0, 1.5 + 1e-12, 5e-3)
@@ -270,8 +270,8 @@ def test_blind_drag_with_another_exponent_is_named_by_its_family(tmp_path):
 def test_an_uninformative_extra_parameter_does_not_take_the_name():
     """Within a family at a site, the member with fewer parameters is named
     when the richer one gains less than 2 AICc units (Arnold 2010)."""
-    from acausal.diagnose.families import prefer_simplest
-    from acausal.diagnose.stages import Ranking
+    from acausal.diagnose.stages.families import prefer_simplest
+    from acausal.diagnose.stages.chain import Ranking
     rows = (_row("coulomb_viscous_friction", "mass", {"hyp_cvf.F": 2.0, "hyp_cvf.b": 0.01}),
             _row("coulomb_friction", "mass", {"hyp_cf.F": 2.0}),
             _row("constant_load", "mass", {"hyp_cl.F": 2.0}))
@@ -297,7 +297,7 @@ def test_blind_dead_band_is_named_by_the_spring_family(tmp_path):
     import time
     from acausal.data import Dataset, Experiment, Instrument, Trace, write_dataset
     from acausal.diagnose.problem import FitSettings
-    from acausal.diagnose.result import summary
+    from acausal.diagnose.report.result import summary
     from acausal.diagnose.run import run_stages
     (tmp_path / "rig.py").write_text(RIG)
     times = np.arange(0.0, 1.5 + 1e-12, 5e-3)

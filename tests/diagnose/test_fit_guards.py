@@ -17,11 +17,11 @@ import numpy as np
 import pytest
 
 from acausal.data import Dataset, Experiment, Instrument, Trace
-from acausal.diagnose.fitting import Fit
+from acausal.diagnose.stages.fitting import Fit
 from acausal.diagnose.problem import Candidate, FitSettings, Param, Problem
-from acausal.diagnose.screen import _free_step
-from acausal.diagnose.stages import Calibration, Row, _lowest_per_key, member_refit_tasks
-from acausal.diagnose.tasks import CandidateFit, FitTask, Refiner, Starts, start_points
+from acausal.diagnose.stages.screen import _free_step
+from acausal.diagnose.stages.chain import Calibration, Row, _lowest_per_key, member_refit_tasks
+from acausal.diagnose.stages.tasks import CandidateFit, FitTask, Refiner, Starts, start_points
 from acausal.modelfile import compile_file
 
 SLIDER = os.path.join(os.path.dirname(__file__), "slider_model.py")

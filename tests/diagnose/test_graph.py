@@ -5,7 +5,7 @@ import pytest
 
 from acausal import Model, ModelError, compile_model
 from acausal.diagnose import ModelGraph, Site
-from acausal.diagnose.hypotheses import nominal_result
+from acausal.diagnose.library.hypotheses import nominal_result
 from acausal.modelfile import load_model_file
 from acausal.mechanics.contact import Clearance
 from acausal.mechanics.fourbar import fourbar_angles

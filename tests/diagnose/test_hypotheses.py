@@ -9,7 +9,7 @@ import pytest
 
 from acausal import ModelError
 from acausal.diagnose import HYPOTHESES, ModelGraph, build_extended, write_extended_model
-from acausal.diagnose.hypotheses import nominal_result
+from acausal.diagnose.library.hypotheses import nominal_result
 from acausal.modelfile import compile_file, evaluate_measures, load_model_file, run_file
 from acausal.mechanics.contact import impacts
 

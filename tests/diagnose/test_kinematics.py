@@ -14,14 +14,14 @@ import numpy as np
 import pytest
 
 from acausal.data import Dataset, Experiment, Instrument, Trace, write_dataset
-from acausal.diagnose.fitting import Fit
-from acausal.diagnose.hypotheses import HYPOTHESES, build_extended
-from acausal.diagnose.kinematics import (
+from acausal.diagnose.stages.fitting import Fit
+from acausal.diagnose.library.hypotheses import HYPOTHESES, build_extended
+from acausal.diagnose.stages.kinematics import (
     EquivalentSite, Kinematics, Tie, convert, equivalents, kinematics, prefer_site, tie)
 from acausal.diagnose.problem import Candidate, Param, Problem, free_param
-from acausal.diagnose.result import equivalent_sites
-from acausal.diagnose.stages import Ranking, Row
-from acausal.diagnose.tasks import Starts
+from acausal.diagnose.report.result import equivalent_sites
+from acausal.diagnose.stages.chain import Ranking, Row
+from acausal.diagnose.stages.tasks import Starts
 
 HERE = os.path.dirname(__file__)
 LEVER = os.path.join(HERE, "lever_model.py")
@@ -48,7 +48,7 @@ def test_a_rigid_lever_ties_its_sites_at_its_arm_and_a_spring_does_not(tmp_path)
     tie, wheel -> slider at the lever's arm (closed form, to 1e-6), with no
     spread; the tip, behind a spring, tied to nothing; the traced signal
     ``slider.s`` is the slider's coordinate."""
-    problem = Problem(LEVER, str(_dataset(tmp_path / "data")), "acausal.diagnose.hypotheses",
+    problem = Problem(LEVER, str(_dataset(tmp_path / "data")), "acausal.diagnose.library.hypotheses",
                       FREE)
     kin = kinematics(problem, SimpleNamespace(fit=SimpleNamespace(values={"k.c": 500.0})))
     assert [(t.a, t.b) for t in kin.ties] == [("wheel", "slider")]
@@ -126,7 +126,7 @@ def test_the_measured_site_is_shown_and_every_tied_site_reported():
     measured signal), the slider listed with the cause converted through
     the ratio and its own fit, and the reason says the data cannot tell them
     apart."""
-    problem = Problem(LEVER, "", "acausal.diagnose.hypotheses", FREE)
+    problem = Problem(LEVER, "", "acausal.diagnose.library.hypotheses", FREE)
     rk = prefer_site(_ranking([[0, 1], [2]]), TIED)
     assert rk.named.candidate.key == ("coulomb_friction", "wheel") and rk.after == 1
     (eq,) = equivalents(problem, TIED, rk)
@@ -147,7 +147,7 @@ def test_sites_the_data_tell_apart_or_untied_sites_keep_the_ranking():
     """The wheel's fit in another class: the slider stays shown, and the
     reason gives the AICc difference instead of claiming equivalence; with
     no tie nothing is reported."""
-    problem = Problem(LEVER, "", "acausal.diagnose.hypotheses", FREE)
+    problem = Problem(LEVER, "", "acausal.diagnose.library.hypotheses", FREE)
     rk = prefer_site(_ranking([[0], [1], [2]]), TIED)
     assert rk.after == 0
     (eq,) = equivalents(problem, TIED, rk)
@@ -167,7 +167,7 @@ def test_a_pair_member_is_found_at_the_tied_site_in_either_order():
     """Drag on the tip + friction on the slider named; the pair with the
     friction on the wheel was fitted with its members the other way round:
     it is the friction's fit at the tied site."""
-    problem = Problem(LEVER, "", "acausal.diagnose.hypotheses", FREE)
+    problem = Problem(LEVER, "", "acausal.diagnose.library.hypotheses", FREE)
     named = _row("quadratic_damping+coulomb_friction", "tip+slider",
                  {"k.c": 500.0, "hyp_qd.c": 1.0, "hyp_cf.F": 0.08}, 10.0)
     alt = _row("coulomb_friction+quadratic_damping", "wheel+tip",

@@ -3,7 +3,7 @@ degenerate_directions): closed-form cases on small Jacobians."""
 import numpy as np
 import pytest
 
-from acausal.diagnose.locate import PIN_TOL, degenerate_directions
+from acausal.diagnose.stages.locate import PIN_TOL, degenerate_directions
 
 
 def _span_contains(Q, w):
@@ -37,13 +37,13 @@ def test_a_partly_reproduced_free_parameter_is_not_pinned():
 
 
 def _fit(J, names=None):
-    from acausal.diagnose.fitting import Fit
+    from acausal.diagnose.stages.fitting import Fit
     names = names or [f"w{i}" for i in range(J.shape[1])]
     return Fit(names, {n: 0.0 for n in names}, 0.0, np.zeros(J.shape[0]), J, [], [])
 
 
 def test_effective_k_of_an_unpenalised_fit_is_its_parameter_count():
-    from acausal.diagnose.fitting import effective_k
+    from acausal.diagnose.stages.fitting import effective_k
     J = np.random.default_rng(2).normal(size=(50, 4))
     assert effective_k(_fit(J)) == pytest.approx(4.0, abs=1e-10)
 
@@ -52,7 +52,7 @@ def test_effective_k_drops_pinned_directions_and_counts_ridge_in_closed_form():
     """Ridge regression's degrees of freedom sum d^2/(d^2 + lam) over J's
     singular values d (Hastie & Tibshirani 1990); a stiff pin row removes
     about one."""
-    from acausal.diagnose.fitting import effective_k
+    from acausal.diagnose.stages.fitting import effective_k
     rng = np.random.default_rng(3)
     J = rng.normal(size=(60, 5))
     lam = 7.0

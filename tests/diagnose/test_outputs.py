@@ -15,11 +15,11 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from acausal.compile import CompiledModel
+from acausal.compiler.pipeline import CompiledModel
 from acausal.data import Dataset, Experiment, Instrument, Trace, write_dataset
 from acausal.diagnose.problem import FitSettings
-from acausal.diagnose.report import write_report
-from acausal.diagnose.result import summary
+from acausal.diagnose.report.markdown import write_report
+from acausal.diagnose.report.result import summary
 from acausal.diagnose.run import run_stages
 
 HERE = os.path.dirname(__file__)
@@ -83,7 +83,7 @@ def test_json_has_the_issue_11_keys_filled(slider):
         lo, hi = p["ci95"]
         assert lo < p["value"] < hi
     assert prof["spring.c"]["ci95"][0] < STIFF < prof["spring.c"]["ci95"][1]
-    from acausal.diagnose.result import details
+    from acausal.diagnose.report.result import details
     rows = json.loads(json.dumps(details(res)))["candidates"]
     assert {r["cause"]: r["family"] for r in rows} == {"coulomb_friction": "friction",
                                                         "constant_load": "constant_load"}
@@ -189,8 +189,8 @@ def test_blind_next_experiment_then_the_second_run_names_one_cause(tmp_path):
 def test_without_declared_conditions_the_separation_is_stated():
     """No condition to search: the rivals' separation at the experiment run
     (in floors) and why, not a null."""
-    from acausal.design import Signal
-    from acausal.diagnose.nextexp import _fixed_only
+    from acausal.studies.design import Signal
+    from acausal.diagnose.stages.nextexp import _fixed_only
     t = np.linspace(0.0, 1.0, 11)
     rivals = {"a": lambda c: {"y": c["k"] * t}, "b": lambda c: {"y": c["k"] * t + 0.02}}
     ref = Experiment("e1", {"k": 2.0}, {}, Trace(t, {"y": 2.0 * t}))
@@ -208,7 +208,7 @@ def test_a_parameter_whose_wald_interval_crosses_its_bound_is_profiled(slider):
     open at the bound below and closed above, where it agrees with the Wald
     end (the model is nearly linear in F)."""
     import dataclasses
-    from acausal.diagnose.intervals import profile_parameter, profile_tasks
+    from acausal.diagnose.stages.intervals import profile_parameter, profile_tasks
     res, _ = slider
     label, tasks = profile_tasks(res.problem, res.calibration, res.ranking)
     i = next(k for k, t in enumerate(tasks) if t.params[t.index].name.startswith("hyp_"))

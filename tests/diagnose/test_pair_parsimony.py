@@ -10,12 +10,12 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from acausal.diagnose.families import family_index, prefer_simplest
-from acausal.diagnose.fitting import Fit
-from acausal.diagnose.pairsearch import simpler_tasks
+from acausal.diagnose.stages.families import family_index, prefer_simplest
+from acausal.diagnose.stages.fitting import Fit
+from acausal.diagnose.stages.pairsearch import simpler_tasks
 from acausal.diagnose.problem import Candidate, Param, Problem, free_param
-from acausal.diagnose.stages import Ranking, Row
-from acausal.diagnose.tasks import CandidateFit, Starts
+from acausal.diagnose.stages.chain import Ranking, Row
+from acausal.diagnose.stages.tasks import CandidateFit, Starts
 
 TWO_MASS = os.path.join(os.path.dirname(__file__), "two_mass.py")
 FREE = (free_param("k1.c", 2000.0, 1000.0, 4000.0), free_param("d1.d", 1.0, 0.0, 5.0))
@@ -33,7 +33,7 @@ def _pair_fit(hyp, loc, values, cost):
 
 
 def _problem():
-    return Problem(TWO_MASS, "", "acausal.diagnose.hypotheses", FREE)
+    return Problem(TWO_MASS, "", "acausal.diagnose.library.hypotheses", FREE)
 
 
 CAL = SimpleNamespace(fit=_fit({"k1.c": 2000.0, "d1.d": 1.0}, 5000.0))

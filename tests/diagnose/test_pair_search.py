@@ -8,8 +8,8 @@ simulation (the blind pair cases in test_blind_*.py run the search)."""
 import numpy as np
 import pytest
 
-from acausal.diagnose.fitting import Fit
-from acausal.diagnose.pairsearch import (
+from acausal.diagnose.stages.fitting import Fit
+from acausal.diagnose.stages.pairsearch import (
     SCREEN_LHS,
     PairScreenTask,
     Screened,
@@ -17,8 +17,8 @@ from acausal.diagnose.pairsearch import (
     screen_starts,
 )
 from acausal.diagnose.problem import Candidate, Param, Problem
-from acausal.diagnose.stages import Row, _acted_in, partners
-from acausal.diagnose.tasks import Starts
+from acausal.diagnose.stages.chain import Row, _acted_in, partners
+from acausal.diagnose.stages.tasks import Starts
 
 
 def _row(hid, loc, values, tested=True, cost=1.0):
@@ -93,7 +93,7 @@ def test_a_cause_is_sized_against_its_neutral_value():
     A law switch whose restitution stays the model's is a well determined
     effect, though its fitted shift is near 0 (the breaker's Hunt-Crossley
     blind case); with a neutral value of 0 it is the relative half-width."""
-    from acausal.diagnose.stages import _ci_rel
+    from acausal.diagnose.stages.chain import _ci_rel
 
     def row(prior, value, half):
         cand = Candidate("h", "a", (Param("hyp_h.de", prior, -0.5, 0.26, 0.05, prior),))

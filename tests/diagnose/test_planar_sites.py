@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from acausal import Model, compile_model
-from acausal.diagnose.graph import ModelGraph
-from acausal.diagnose.hypotheses import HYPOTHESES
+from acausal.diagnose.library.graph import ModelGraph
+from acausal.diagnose.library.hypotheses import HYPOTHESES
 from acausal.mechanics.planar.contact import CircleLineContact
 from acausal.mechanics.planar.joints import Revolute
 from acausal.mechanics.planar.parts import Body, Fixed

@@ -3,7 +3,7 @@ closed forms on small linear problems."""
 import numpy as np
 import pytest
 
-from acausal.diagnose.screen import predicted_step
+from acausal.diagnose.stages.screen import predicted_step
 
 
 def predicted_cost(r0, J_own, J_free):
@@ -79,7 +79,8 @@ def test_members_within_reach_beyond_the_budget_are_returned_unfitted():
     fitted, the rest within reach come back unfitted, none beyond it."""
     from types import SimpleNamespace as NS
 
-    from acausal.diagnose import screen, stats as st
+    from acausal.diagnose.stages import screen
+    from acausal.diagnose.stages import stats as st
     from acausal.diagnose.problem import Candidate, Param, Problem
 
     n, r0 = 200, np.full(200, np.sqrt(100.0 / 200))

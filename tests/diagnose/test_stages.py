@@ -10,11 +10,11 @@ from sympy import Eq
 from acausal import Component, Flange, Model, Parameter, Variable, der
 from acausal.data import Dataset, Experiment, Trace
 from acausal.diagnose import HYPOTHESES, ModelGraph
-from acausal.diagnose.domain import ROTATIONAL, TRANSLATIONAL, domain_of
-from acausal.diagnose.fitting import Fit
-from acausal.diagnose.generic import N_V, N_X, hats, penalty, shape
+from acausal.diagnose.library.domain import ROTATIONAL, TRANSLATIONAL, domain_of
+from acausal.diagnose.stages.fitting import Fit
+from acausal.diagnose.library.generic import N_V, N_X, hats, penalty, shape
 from acausal.diagnose.problem import Candidate, FitSettings, Param, Problem
-from acausal.diagnose.tasks import CandidateFit, FitTask, Starts, _tested, lhs_values, \
+from acausal.diagnose.stages.tasks import CandidateFit, FitTask, Starts, _tested, lhs_values, \
     start_points, window
 from acausal.mechanics.rotational import Inertia
 from acausal.mechanics.translational import Fixed, Mass, Spring

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from scipy import stats as sps
 
-from acausal.diagnose import stats as st
-from acausal.diagnose.fitting import Fit, confidence, heldout_rms, linear_loo
+from acausal.diagnose.stages import stats as st
+from acausal.diagnose.stages.fitting import Fit, confidence, heldout_rms, linear_loo
 
 
 def test_chi2_test_matches_scipy():

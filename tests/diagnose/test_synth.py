@@ -5,7 +5,7 @@ import os
 import numpy as np
 import pytest
 
-from acausal.calibrate import model_dataset
+from acausal.studies.calibrate import model_dataset
 from acausal.diagnose.synth import synthesize
 from acausal.modelfile import compile_file
 from acausal.errors import UsageError

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import psutil
 
-from acausal.checkpoint import Checkpoint
+from acausal.infra.checkpoint import Checkpoint
 
 ROOT = Path(__file__).resolve().parents[2]
 HERE = Path(__file__).resolve().parent

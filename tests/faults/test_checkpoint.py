@@ -1,4 +1,4 @@
-"""acausal.checkpoint: damaged lines are ignored, later appends stay intact,
+"""acausal.infra.checkpoint: damaged lines are ignored, later appends stay intact,
 values round-trip, and the inputs' hash changes with any input."""
 import math
 from pathlib import Path
@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from acausal.checkpoint import Checkpoint, input_key
+from acausal.infra.checkpoint import Checkpoint, input_key
 
 
 def test_truncated_and_damaged_lines_are_ignored_and_appends_stay_whole(tmp_path):

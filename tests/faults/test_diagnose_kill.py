@@ -11,9 +11,9 @@ import pytest
 
 from dataclasses import dataclass
 
-from acausal.diagnose.resume import FitStore, task_key
-from acausal.diagnose.stages import run_tasks
-from acausal.executor import open_executor
+from acausal.diagnose.stages.resume import FitStore, task_key
+from acausal.diagnose.stages.chain import run_tasks
+from acausal.infra.executor import open_executor
 
 from . import helpers as h
 

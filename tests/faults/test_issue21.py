@@ -120,7 +120,7 @@ def test_an_interrupted_command_ends_within_its_grace_period():
     'interrupted' and went on at 94 % CPU)."""
     t = time.monotonic()
     r = run_py("""
-        from acausal.executor import exit_soon
+        from acausal.infra.executor import exit_soon
         exit_soon(7, grace=0.5)
         while True:
             pass
@@ -166,7 +166,7 @@ def test_a_sweep_past_its_wall_limit_stops_keeping_its_points(tmp_path):
 @settings(max_examples=60, deadline=1000)
 @given(count=st.integers(1, 10 ** 18), limit=st.integers(1, 10 ** 6))
 def test_a_grid_beyond_its_budget_is_refused_before_its_values_exist(count, limit):
-    from acausal.sweep import parse_param
+    from acausal.studies.sweep import parse_param
     t = time.perf_counter()
     spec = f"x=0:{int(count > 1)}:{count}"
     if count > limit:
@@ -189,7 +189,7 @@ def spring():
        memory=st.one_of(st.none(), st.floats(1e3, 1e13)))
 def test_an_output_grid_is_refused_unless_it_fits_every_budget(spring, t_end, step, max_rows,
                                                               memory):
-    from acausal import simulate as sim
+    from acausal.runtime import hybrid as sim
     n = sim._output_count(0.0, t_end, step, None)
     fits = (max_rows is None or n <= max_rows) and (memory is None or
                                                     n * sim._row_bytes(spring) <= memory)
@@ -255,7 +255,7 @@ def test_a_resumed_sweep_says_so_and_writes_rows_in_grid_order(tmp_path):
 
 def test_a_long_trace_is_thinned_to_what_the_instrument_supports():
     from acausal.data.records import Dataset, Experiment, Instrument, Trace
-    from acausal.diagnose.stages import MAX_TRACE_SAMPLES, thin_traces
+    from acausal.diagnose.stages.chain import MAX_TRACE_SAMPLES, thin_traces
     n = 1_000_000
     t = np.linspace(0.0, 1.0, n)
     slow = np.round(np.sin(2 * np.pi * t) / 0.01) * 0.01            # 0.01 steps, no noise

@@ -168,7 +168,7 @@ def test_windows_do_not_change_the_solution(tmp_path):
 
 
 def test_progress_bar_on_stderr(tmp_path, capsys, monkeypatch):
-    import acausal.simulate as sim
+    import acausal.runtime.hybrid as sim
 
     monkeypatch.setattr(sim, "PROGRESS_DELAY_S", 0.0)
     _, cm = compile_file(write(tmp_path, "spring.py", SPRING))

@@ -35,8 +35,8 @@ FILE_LEVEL = ("file not found", "no header row", "trace of unknown experiment")
 def breaker_units():
     """name -> unit maps of the breaker model (what calibration passes to
     load_dataset), from the flattened model: no compilation."""
-    from acausal.calibrate import _si
-    from acausal.flatten import flatten
+    from acausal.studies.calibrate import _si
+    from acausal.compiler.flatten import flatten
     from acausal.modelfile import load_model_file
     mf = load_model_file(ROOT / "models" / "breaker_24kv.py")
     flat = flatten(mf.model)

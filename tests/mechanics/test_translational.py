@@ -185,7 +185,7 @@ def test_force_constant_is_a_runtime_parameter():
 
 def test_force_expression_with_model_parameter():
     model = Model()
-    F = model.parameter("F", 4.0, "N", "push")
+    F = model.parameter("F", 4.0, "N/s", "rate of the push")
     model.mass = Mass(m=1.0, s=0.0, v=0.0)
     model.force = Force(f=F * time)
     model.connect(model.mass.flange, model.force.flange)

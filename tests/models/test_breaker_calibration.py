@@ -5,7 +5,7 @@ import os
 
 from click.testing import CliRunner
 
-from acausal import calibrate as cal
+from acausal.studies import calibrate as cal
 from acausal.cli import main
 from acausal.modelfile import run_file
 

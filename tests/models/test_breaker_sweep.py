@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from acausal import executor as executor_mod
+from acausal.infra import executor as executor_mod
 from acausal.cli import main
 from acausal.modelfile import run_file
 

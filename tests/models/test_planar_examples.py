@@ -113,7 +113,7 @@ def test_fourbar_planar_report_geometry_matches_closed_form():
 
 def _backends():
     """Both backends, compiled skipped without a C compiler."""
-    from acausal.backends import compiled_available
+    from acausal.runtime.backends import compiled_available
     why = compiled_available()
     return ["sundae", pytest.param("compiled", marks=pytest.mark.skipif(
         why is not None, reason=f"compiled backend unavailable: {why}"))]

@@ -11,7 +11,7 @@ import time
 import numpy as np
 from hypothesis import given, settings, strategies as st_
 
-from acausal.diagnose import stats as st
+from acausal.diagnose.stages import stats as st
 
 AICC = st_.one_of(st_.floats(-50, 200), st_.just(math.inf), st_.just(-math.inf),
                   st_.just(math.nan))

@@ -2,7 +2,9 @@
 in :mod:`acausal.connectors`). Each is massless and lossless: the power
 into the frame side equals the power out of the flange side."""
 
-from acausal import Eq, Flange, Parameter, ParameterError, RotFlange
+from acausal.lang import Eq, Flange, Parameter, RotFlange
+
+from acausal.errors import ParameterError
 
 from .partials import PartialOneFrame
 

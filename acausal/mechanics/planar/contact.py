@@ -27,7 +27,7 @@ the profile's normal and Coulomb friction along its tangent. Sign convention:
 """
 from sympy import sqrt, tanh
 
-from acausal import Eq, Parameter, Variable, der
+from acausal.lang import Eq, Parameter, Variable, der
 
 from ..contact import PartialContact
 from .geometry import rotate
@@ -92,7 +92,7 @@ class PartialCircleContact(PartialContact, PartialTwoFrames):
         return np.stack([np.column_stack([bx, by])], axis=1)
 
 
-def _in_world(res, frame, local):
+def in_world(res, frame, local):
     """Points (n, 2) given in a frame's axes, in the world along a result:
     an array (n_times, n, 2)."""
     import numpy as np
@@ -169,7 +169,7 @@ class CircleCircleContact(PartialCircleContact):
         p, u = self.path, np.linspace(0, 2 * np.pi, 49)
         ra, cx, cy = (float(res[f"{p}.{k}"][0]) for k in ("Ra", "px", "py"))
         local = np.column_stack([cx + ra * np.cos(u), cy + ra * np.sin(u)])
-        return _in_world(res, f"{p}.frame_a", local)
+        return in_world(res, f"{p}.frame_a", local)
 
     def geometry(self):
         a, b = self.frame_a, self.frame_b

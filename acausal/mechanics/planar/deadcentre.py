@@ -29,11 +29,11 @@ import math
 import warnings
 
 import sympy as sp
-from sympy import Eq, Piecewise, sqrt
+from sympy import Eq, Piecewise
 
-from acausal import Event
+from acausal.lang import Event
 
-from .geometry import rotate
+from .geometry import column, minor_sine, rotate  # noqa: F401  (column, minor_sine: public here too)
 
 DEAD_CENTRE_SIN = 0.05   # warn within about 2.9 deg of a dead centre
 
@@ -41,44 +41,6 @@ DEAD_CENTRE_SIN = 0.05   # warn within about 2.9 deg of a dead centre
 class DeadCentreWarning(UserWarning):
     """A kinematic loop came within :data:`DEAD_CENTRE_SIN` (about 2.9 deg)
     of a dead centre for the joints that drive it."""
-
-
-def column(joint):
-    """('r', x, y) of a revolute's pin or ('p', ux, uy) of a prismatic's
-    world axis, as expressions of the joint's frame_a."""
-    a = joint.frame_a
-    if joint.coordinate == "phi":
-        return "r", a.x, a.y
-    n = sqrt(joint.ex**2 + joint.ey**2)
-    ux, uy = rotate(a.phi, joint.ex / n, joint.ey / n)
-    return "p", ux, uy
-
-
-def minor_sine(cols):
-    """The normalised minor of three joint columns, or None when it has no
-    revolute (three sliders: singular whatever the configuration).
-
-    Three revolutes: twice the area of their triangle over the product of
-    its two shorter sides (all three over the longest), the sine of the bend
-    at the middle joint (0 in line). A slider among them: the sine of the
-    angle between the revolutes' offset turned by 90 deg and the axis (or
-    between two axes)."""
-    revs = [c for c in cols if c[0] == "r"]
-    if not revs:
-        return None
-    o = revs[0]
-    vecs = []
-    for c in cols:
-        if c is o:
-            continue
-        vecs.append((c[2] - o[2], -(c[1] - o[1])) if c[0] == "r" else (c[1], c[2]))
-    (a1, a2), (b1, b2) = vecs
-    det = a1 * b2 - a2 * b1
-    la, lb = sqrt(a1**2 + a2**2), sqrt(b1**2 + b2**2)
-    if len(revs) < 3:
-        return det / (la * lb)
-    lc = sqrt((a1 - b1)**2 + (a2 - b2)**2)
-    return det * sp.Max(la, lb, lc) / (la * lb * lc)
 
 
 def _root(comp):

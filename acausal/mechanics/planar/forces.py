@@ -2,7 +2,7 @@
 origins. Sign convention: :mod:`acausal.connectors` (:class:`Frame`);
 force law: :class:`.partials.PartialLineForce` (tension positive)."""
 
-from acausal import Eq, Parameter, der
+from acausal.lang import Eq, Parameter, der
 
 from .partials import PartialLineForce
 

@@ -3,7 +3,9 @@ spring, damper, friction, end stop or drive of the 1-D library). Sign
 convention: :mod:`acausal.connectors` (:class:`Frame`, and the mapping of
 joints to 1-D flanges)."""
 
-from acausal import Eq, Flange, Parameter, ParameterError, RotFlange, Variable, der
+from acausal.lang import Eq, Flange, Parameter, RotFlange, Variable, der
+
+from acausal.errors import ParameterError
 
 from .geometry import rotate
 from .partials import PartialJoint

@@ -34,7 +34,7 @@ import math
 
 import sympy as sp
 
-from acausal import Model, guess
+from acausal.lang import Model, guess
 from acausal.errors import ParameterError
 
 from .joints import Revolute

@@ -10,8 +10,8 @@ systems): loop k is that edge plus the tree path between its ends.
 """
 from dataclasses import dataclass
 
-from acausal.component import Model
-from acausal.connectors import Frame
+from acausal.lang.component import Model
+from acausal.lang.connectors import Frame
 from acausal.errors import AcausalError, InitializationError, SolverError
 
 
@@ -180,7 +180,7 @@ def follower_sine(model, loop, result):
     centre) of the loop's three following joints (``drives`` = 0) at the
     last point of ``result``; None when it cannot be told (no result, not
     three followers, a value missing)."""
-    from .deadcentre import column, minor_sine
+    from .geometry import column, minor_sine
     if result is None or len(loop.joints) < 4 or not len(result.t):
         return None
     try:

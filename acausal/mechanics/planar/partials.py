@@ -3,8 +3,8 @@ PlanarMechanics' PartialTwoFrames idea), so that a leaf is its parameters and
 its law. Sign convention: :mod:`acausal.connectors` (:class:`Frame`)."""
 from sympy import sqrt
 
-from acausal import Component, Discrete, Eq, Variable
-from acausal.connectors import Frame
+from acausal.lang import Component, Discrete, Eq, Variable
+from acausal.lang.connectors import Frame
 
 
 class PartialOneFrame(Component):

@@ -1,7 +1,7 @@
 """Fixed frame, rigid body and rigid (massless) link. Sign convention:
 :mod:`acausal.connectors` (:class:`Frame`)."""
 
-from acausal import Eq, Parameter, Variable, der
+from acausal.lang import Eq, Parameter, Variable, der
 
 from .geometry import rotate
 from .partials import PartialOneFrame, PartialRigidLink

@@ -48,7 +48,7 @@ import math
 
 from sympy import Eq, Piecewise, sqrt
 
-from acausal import Discrete, Event, Parameter, Variable
+from acausal.lang import Discrete, Event, Parameter, Variable
 from acausal.errors import ParameterError
 
 from .contact import PartialCircleContact
@@ -145,8 +145,8 @@ class CirclePolylineContact(PartialCircleContact):
     def drawing_profile(self, res):
         """The polyline in the world along a result (for :mod:`acausal.animate`)."""
         import numpy as np
-        from .contact import _in_world
-        return _in_world(res, f"{self.path}.frame_a", np.array(self.profile.P))
+        from .contact import in_world
+        return in_world(res, f"{self.path}.frame_a", np.array(self.profile.P))
 
     def _local(self):
         """The centre relative to each vertex, in frame_a's axes."""

@@ -8,7 +8,7 @@ import pytest
 from click.testing import CliRunner
 from PIL import Image
 
-from acausal.animate import Animator, draw_frame
+from acausal.viz.animate import Animator, draw_frame
 from acausal.cli import main
 from acausal.modelfile import compile_file
 

@@ -5,8 +5,8 @@ import pytest
 import sympy as sp
 
 from acausal import AcausalError, Model, compile_model
-from acausal.connectors import Frame
-from acausal.flatten import flatten
+from acausal.lang.connectors import Frame
+from acausal.compiler.flatten import flatten
 from acausal.mechanics import rotational as rot
 from acausal.mechanics import translational as tr
 from acausal.mechanics.planar.adaptors import AxisAdaptor, ShaftAdaptor

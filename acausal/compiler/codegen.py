@@ -1,0 +1,486 @@
+"""Stage 5: generate Python source for the residual, its Jacobian, the root
+functions and the observed variables, once per model structure.
+
+The generated functions use plain Python arithmetic on float scalars (``y``
+is unpacked with ``tolist()``), share sub-expressions through ``sympy.cse``
+and fill the solver's arrays in place (``r[i] = ...``). Parameters and
+discrete values are closure constants: ``make(p, d)`` builds the callbacks
+for one parameter vector and one set of discrete values.
+"""
+import functools
+import linecache
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import sympy as sp
+from sympy.printing.pycode import PythonCodePrinter
+
+from ..lang.fastdiff import diff
+
+_counter = [0]
+
+
+class NamedTemps:
+    """Printer mixin (for the Python and the C printer alike): every
+    sub-expression that has a name in ``temps`` (common sub-expressions, see
+    :func:`_cse_print`) is written as that name, without rebuilding any
+    expression; :meth:`definition` writes a named expression itself."""
+
+    def _setup_temps(self, temps):
+        self.temps = temps or {}
+        self._root = None
+        self._not_supported, self._number_symbols = set(), set()
+
+    def _print(self, expr, **kw):
+        if self.temps and expr is not self._root:
+            name = self.temps.get(expr)
+            if name is not None:
+                return name
+        self._root = None
+        return super()._print(expr, **kw)
+
+    def definition(self, expr):
+        """Code of ``expr`` itself (not its own name), its parts by name
+        (``doprint`` without its walk of the whole tree for
+        ``UnevaluatedExpr``, which the compiler never creates)."""
+        self._root = expr
+        return self._print(expr)
+
+
+class _Printer(NamedTemps, PythonCodePrinter):
+    """Python code of sympy expressions, common sub-expressions by name
+    (:class:`NamedTemps`)."""
+
+    def __init__(self, temps=None, symbols=None):
+        super().__init__({"fully_qualified_modules": False, "standard": "python3",
+                          "order": "none"})
+        self._setup_temps(temps)
+        self.symbols = symbols or {}
+
+    def code(self, expr):
+        """Code of ``expr`` (``doprint`` without its walk of the whole tree
+        for ``UnevaluatedExpr``, which the compiler never creates)."""
+        return self._print(expr)
+
+    def _print_Symbol(self, expr):
+        name = self.symbols.get(expr)
+        return name if name is not None else super()._print_Symbol(expr)
+
+    def _print_Heaviside(self, expr):
+        return f"heaviside({self._print(expr.args[0])})"
+
+    def _print_Pow(self, expr, rational=False):
+        """A non-integer power other than a square root as ``pow(b, e)``:
+        Python's ``**`` of a negative float makes a complex number without
+        a word, ``pow`` (``math.pow``) raises, and the IEEE variant
+        (:func:`load`) gives NaN as C does."""
+        b, e = expr.args
+        if e.is_Integer or e in (sp.S.Half, -sp.S.Half) or not e.is_number:
+            return super()._print_Pow(expr, rational=rational)
+        return f"pow({self._print(b)}, {self._print(e)})"
+
+
+def _real(name):
+    return sp.Symbol(name, real=True)
+
+
+def _namespace():
+    ns = {k: getattr(math, k) for k in dir(math) if not k.startswith("_")}
+    ns.update(np=np, heaviside=lambda x: 1.0 if x > 0 else (0.5 if x == 0 else 0.0),
+              Abs=abs, max=max, min=min)
+    return ns
+
+
+# Guarded domains (IEEE semantics). Common sub-expressions are computed before
+# the conditions that guard them: ``Piecewise((sqrt(x), x > 0), (0, True))``
+# with ``sqrt(x)`` shared evaluates ``sqrt(x)`` for every x. C gives NaN there
+# and the branch that is not taken drops it; Python's math raises. So each
+# generated callback runs on Python floats and, when that raises one of
+# _IEEE_ERRORS, is evaluated again by the same source on numpy float64 (NaN
+# and inf as in C, warnings off): the backends agree and the fast path stays.
+_IEEE_ERRORS = (ValueError, ZeroDivisionError, OverflowError)
+_NUMPY_NAMES = {"asin": "arcsin", "acos": "arccos", "atan": "arctan", "atan2": "arctan2",
+                "asinh": "arcsinh", "acosh": "arccosh", "atanh": "arctanh", "pow": "power"}
+
+
+def _fast_namespace():
+    ns = _namespace()
+    ns.update(_floats=lambda a: a.tolist(), _consts=lambda a: a, _ieee_errors=_IEEE_ERRORS,
+              _quiet=lambda: np.errstate(all="ignore"))
+    return ns
+
+
+def _ieee_namespace():
+    ns = _namespace()
+    for k in dir(math):
+        f = getattr(np, _NUMPY_NAMES.get(k, k), None)
+        if isinstance(f, np.ufunc):
+            ns[k] = f
+    ns.update(_floats=lambda a: np.asarray(a, dtype=float), _ieee_errors=(),
+              _consts=lambda a: np.asarray(a, dtype=float), _quiet=None)
+    return ns
+
+
+class Names:
+    """Maps symbols to the names used in generated code. The new symbols are
+    real (every quantity is): derivatives are then taken over real
+    symbols, so that d|x|/dx is sign(x), not an expression of re(x), im(x)
+    the printer cannot write."""
+
+    def __init__(self, y, yp, params, discretes):
+        self.map = {}
+        for i, s in enumerate(y):
+            self.map[s] = _real(f"y{i}")
+        for i, s in enumerate(yp):
+            if s is not None:
+                self.map[s] = _real(f"yp{i}")
+        for i, s in enumerate(params):
+            self.map[s] = _real(f"p{i}")
+        for i, s in enumerate(discretes):
+            self.map[s] = _real(f"d{i}")
+        from ..lang.symbols import time
+        self.map[time] = _real("t")
+        self.allowed = set(self.map.values())
+        self.code = {s: v.name for s, v in self.map.items()}
+
+    def check(self, exprs, what):
+        """``exprs`` as sympy expressions, checked to use only the DAE's
+        symbols (printed with :attr:`code`, not renamed: no rebuilding)."""
+        return [_known(sp.sympify(e), self.map, what) for e in exprs]
+
+    def rename(self, exprs, what):
+        """``exprs`` with the DAE's symbols replaced by the generated names."""
+        memo = {}
+        return [_known(replace_shared(sp.sympify(e), self.map, memo), self.allowed, what)
+                for e in exprs]
+
+
+def replace_shared(expr, mapping, memo=None):
+    """``expr.xreplace(mapping)`` that rebuilds each distinct sub-expression
+    once (``memo``: node -> its replacement, shared across calls). sympy's
+    xreplace walks the tree, so a sub-expression shared by many parents
+    (the chain rule's products in sensitivity equations) is rebuilt once
+    per path to it: 1.2 million rebuilds for the breaker's observed
+    variables with three parameters' sensitivities."""
+    memo = {} if memo is None else memo
+
+    def walk(e):
+        hit = memo.get(e)
+        if hit is not None:
+            return hit
+        if e in mapping:
+            out = mapping[e]
+        elif not e.args:
+            out = e
+        else:
+            args = [walk(a) for a in e.args]
+            out = e.func(*args) if any(a is not b for a, b in zip(args, e.args)) else e
+        memo[e] = out
+        return out
+    return walk(expr)
+
+
+def _known(e, symbols, what):
+    """``e``, checked to contain only ``symbols``."""
+    bad = [s for s in e.free_symbols if s not in symbols]
+    if bad:
+        raise ValueError(  # internal: CompiledModel.resolve checked user expressions
+            f"internal: {what} refers to {bad[0]} which is not "
+            "a state, algebraic unknown, parameter or discrete value")
+    return e
+
+
+def _body(exprs, targets, indent="        ", symbols=None):
+    """Lines computing ``targets[i] = exprs[i]`` with common sub-expressions."""
+    reps, printed = _cse_print(exprs, indent, symbols=symbols)
+    return reps + [f"{indent}{t} = {e}" for t, e in zip(targets, printed)]
+
+
+def _cse_print(exprs, indent="        ", prefix="c_", symbols=None):
+    """(lines of the common sub-expressions, printed expressions).
+
+    Common sub-expression elimination by hash-consing (as sympy's
+    ``tree_cse``, without its rebuilding of every expression and its search
+    for common sub-sums and sub-products, which dominated compile time on
+    large models): every non-atomic sub-expression met twice gets a name,
+    defined after the names it uses; work linear in the size of the
+    expressions."""
+    repeated = _repeated(exprs)
+    names = {e: f"{prefix}{k}" for k, e in enumerate(repeated)}
+    # a definition may only use the names defined before it: the printer
+    # rebuilds some parts (x**(-1/2) in a product is printed as 1/sqrt(x)),
+    # and such a rebuilt part may be a repeated expression defined later
+    printer = _Printer({}, symbols)
+    lines = []
+    for e in repeated:
+        lines.append(f"{indent}{names[e]} = {printer.definition(e)}")
+        printer.temps[e] = names[e]
+    return lines, [printer.code(e) for e in exprs]
+
+
+def _shareable(e):
+    return isinstance(e, sp.Expr) and not e.is_Atom and bool(e.args)
+
+
+def _repeated(exprs):
+    """Sub-expressions met more than once, each after the ones inside it."""
+    seen, repeated = set(), set()
+
+    def visit(e):
+        if not isinstance(e, sp.Basic) or e.is_Atom:
+            return
+        if e in seen:
+            if _shareable(e):
+                repeated.add(e)
+            return
+        seen.add(e)
+        for a in e.args:
+            visit(a)
+    for e in exprs:
+        visit(e)
+    order, done = [], set()
+
+    def post(e):
+        if not isinstance(e, sp.Basic) or e.is_Atom or e in done:
+            return
+        done.add(e)
+        for a in e.args:
+            post(a)
+        if e in repeated:
+            order.append(e)
+    for e in exprs:
+        post(e)
+    return order
+
+
+def _unpack(prefix, n, src, indent="        ", array=True, conv=None):
+    if n == 0:
+        return []
+    names = ", ".join(f"{prefix}{i}" for i in range(n))
+    if conv:
+        return [f"{indent}{names}, = {conv}({src})"]
+    return [f"{indent}{names}, = {src}{'.tolist()' if array else ''}"]
+
+
+_B = " " * 12      # the body of a guarded callback (inside its ``try``)
+
+
+def _guarded(header, pre, body, fallback, ret=False):
+    """A generated callback: ``header``, the lines ``pre``, then ``body``
+    (at :data:`_B`) inside ``try``; on one of the guarded-domain errors the
+    same callback of the IEEE variant (``fallback``, its call text) runs
+    instead (see :data:`_IEEE_ERRORS`)."""
+    call = f"{'return ' if ret else ''}{fallback}"
+    return ([header] + pre + ["        try:"] + (body or [_B + "pass"])
+            + ["        except _ieee_errors:", "            with _quiet():",
+               f"                {call}"])
+
+
+class Triplets:
+    """Storage the generated Jacobian code can fill instead of a 2-D array
+    (it only assigns ``J[i, j] = v``): collects the entries and gives the
+    ``scipy.sparse`` CSR matrix of ``shape``. The initialisation of a large
+    model uses it, so that no dense matrix is formed."""
+
+    def __init__(self, shape):
+        self.shape = shape
+        self.rows, self.cols, self.vals = [], [], []
+
+    def __setitem__(self, ij, value):
+        self.rows.append(ij[0])
+        self.cols.append(ij[1])
+        self.vals.append(value)
+
+    def tocsr(self):
+        import scipy.sparse as sps
+        return sps.csr_matrix((np.asarray(self.vals, float), (self.rows, self.cols)),
+                              shape=self.shape)
+
+
+@dataclass
+class Sparsity:
+    """Structure of the iteration matrix ``J = dF/dy + cj dF/dy'``: its
+    non-zero entries (``rows``, ``cols``, in compressed-sparse-column order,
+    the order of the flat array a sparse solver fills) and its lower and
+    upper bandwidths."""
+    n: int
+    rows: list
+    cols: list
+    lband: int
+    uband: int
+
+    @property
+    def nnz(self):
+        return len(self.rows)
+
+    def matrix(self):
+        """The pattern as a ``scipy.sparse.csc_matrix`` of ones."""
+        import scipy.sparse as sps
+        return sps.csc_matrix((np.ones(self.nnz), (self.rows, self.cols)),
+                              shape=(self.n, self.n))
+
+
+def _jacobian_entries(res, ysyms, ypsyms, columns=None):
+    """Non-zero entries (i, j, dF_i/dy_j, dF_i/dy'_j) of the residuals'
+    Jacobians, by differentiating each residual only with respect to the
+    unknowns it contains (work linear in the number of non-zeros), and,
+    with ``columns`` (:attr:`acausal.causalize.DAE.jacobian_columns`), only
+    over the slots ``columns[i]`` of row ``i``. The last few are kept: the C
+    generator (:mod:`acausal.codegen_c`) asks again for the same residuals
+    right after this module."""
+    return list(_entries(tuple(res), tuple(ysyms), tuple(ypsyms), columns))
+
+
+@functools.lru_cache(maxsize=4)
+def _entries(res, ysyms, ypsyms, columns):
+    index = {s: ("y", j) for j, s in enumerate(ysyms)}
+    index.update({s: ("yp", j) for j, s in enumerate(ypsyms) if s is not None})
+    out = []
+    for i, r in enumerate(res):
+        cols = {}
+        for s in r.free_symbols:
+            hit = index.get(s)
+            if hit is not None and (columns is None or hit[1] in columns[i]):
+                cols.setdefault(hit[1], {})[hit[0]] = diff(r, s)
+        for j in sorted(cols):
+            dy = cols[j].get("y", sp.S.Zero)
+            dyp = cols[j].get("yp", sp.S.Zero)
+            if dy != 0 or dyp != 0:
+                out.append((i, j, dy, dyp))
+    return tuple(out)
+
+
+def _sparsity(n, entries):
+    csc = sorted(((j, i) for i, j, _, _ in entries))
+    rows = [i for _, i in csc]
+    cols = [j for j, _ in csc]
+    lband = max([i - j for i, j in zip(rows, cols)] + [0])
+    uband = max([j - i for i, j in zip(rows, cols)] + [0])
+    return Sparsity(n, rows, cols, lband, uband)
+
+
+def _fixed_entries(obs, fixed_rows, ysyms, ypsyms, ns):
+    """Non-zero entries (a, k, expr) of d(observed[fixed_rows[a]])/dz with
+    z = (y, y' of the states): the rows initialisation adds for fixed starts."""
+    zs = list(ysyms) + list(ypsyms[:ns])
+    index = {s: k for k, s in enumerate(zs) if s is not None}
+    out = []
+    for a, k in enumerate(fixed_rows):
+        e = obs[k]
+        hits = sorted((index[s], s) for s in e.free_symbols if s in index)
+        for col, s in hits:
+            d = diff(e, s)
+            if d != 0:
+                out.append((a, col, d))
+    return out
+
+
+@dataclass
+class Generated:
+    """What :func:`generate` returns: the source, ``make(p, d)`` (the
+    callbacks for one parameter vector and set of discrete values),
+    ``fixjac(t, y, yp, p, d, F)`` (fills the fixed-start rows ``F``) and the
+    iteration matrix's :class:`Sparsity`."""
+    source: str
+    make: object
+    fixjac: object
+    sparsity: Sparsity
+
+
+def _make_prologue(npar, nd):
+    """The first lines of the generated ``make(p, d)``: the parameters and
+    discrete values unpacked, the step-attempt counter, and ``other(k)``,
+    the IEEE variant's callback k (:data:`_IEEE_ERRORS`), made at its first
+    use."""
+    return (["def make(p, d):"]
+            + _unpack("p", npar, "p", "    ", conv="_consts")
+            + _unpack("d", nd, "d", "    ", conv="_consts")
+            + ["    count = [0, None]  # step attempts: distinct times the residual sees",
+               "    ieee = []",
+               "    def other(k):  # the IEEE variant's callback k (made at its first use)",
+               "        if not ieee:",
+               "            ieee.append(_make_ieee(p, d))",
+               "        return ieee[0][k]"])
+
+
+def generate(dae, params, discretes, roots, observed, fixed_rows=()):
+    """Generate and compile the callbacks (see :class:`Generated`).
+
+    ``roots``: list of root expressions (resolved); ``observed``: list of
+    expressions (resolved) for every reported variable; ``fixed_rows``:
+    indices into ``observed`` of the variables with fixed start values.
+    """
+    n = len(dae.y)
+    names = Names(dae.y, dae.yp, params, discretes)
+    res = names.rename(dae.residuals, "a residual")
+    g = names.check(roots, "an event")
+    obs = names.check(observed, "an observed variable")
+    ysyms = [_real(f"y{i}") for i in range(n)]
+    ypsyms = [_real(f"yp{i}") if dae.yp[i] is not None else None for i in range(n)]
+    cj = sp.Symbol("cj")
+    entries = _jacobian_entries(res, ysyms, ypsyms, dae.jacobian_columns)
+    sparsity = _sparsity(n, entries)
+    jy = [(i, j, dy) for i, j, dy, _ in entries if dy != 0]
+    jyp = [(i, j, dyp) for i, j, _, dyp in entries if dyp != 0]
+    jcomb = [(i, j, dy + cj * dyp) for i, j, dy, dyp in entries]
+    csc_pos = {(i, j): k for k, (i, j) in enumerate(zip(sparsity.rows, sparsity.cols))}
+    fixed = _fixed_entries(dict(zip(fixed_rows, names.rename([obs[k] for k in fixed_rows],
+                                                             "a fixed start"))),
+                           fixed_rows, ysyms, ypsyms, dae.n_states)
+    npar, nd = len(params), len(discretes)
+    unpack = _unpack("y", n, "y", _B, conv="_floats") + _unpack("yp", n, "yp", _B, conv="_floats")
+    L = _make_prologue(npar, nd)
+    L += _guarded("    def res(t, y, yp, r):",
+                  ["        if t != count[1]:", "            count[0] += 1",
+                   "            count[1] = t"],
+                  unpack + _body(res, [f"r[{i}]" for i in range(n)], _B),
+                  "other(0)(t, y, yp, r)")
+    reps, jprinted = _cse_print([e for _, _, e in jcomb], _B)
+    L += _guarded("    def jac(t, y, yp, r, cj, J):", [], unpack + reps + [
+        f"{_B}J[{i}, {j}] = {e}" for (i, j, _), e in zip(jcomb, jprinted)],
+        "other(1)(t, y, yp, r, cj, J)")
+    L += _guarded("    def jac_csc(t, y, yp, r, cj, J):", [], unpack + reps + [
+        f"{_B}J[{csc_pos[i, j]}] = {e}" for (i, j, _), e in zip(jcomb, jprinted)],
+        "other(6)(t, y, yp, r, cj, J)")
+    L += _guarded("    def roots(t, y, yp, g):", [], unpack + _body(
+        g, [f"g[{i}]" for i in range(len(g))], _B, symbols=names.code),
+        "other(2)(t, y, yp, g)")
+    L += _guarded("    def jacs(t, y, yp, Jy, Jyp):", [], unpack + _body(
+        [e for _, _, e in jy] + [e for _, _, e in jyp],
+        [f"Jy[{i}, {j}]" for i, j, _ in jy] + [f"Jyp[{i}, {j}]" for i, j, _ in jyp], _B),
+        "other(3)(t, y, yp, Jy, Jyp)")
+    L += _guarded("    def observe(t, y, yp):", [], unpack + [
+        f"{_B}o = [0.0] * {len(obs)}"] + _body(
+        obs, [f"o[{i}]" for i in range(len(obs))], _B, symbols=names.code) + [
+        f"{_B}return o"], "other(4)(t, y, yp)", ret=True)
+    L += ["    return res, jac, roots, jacs, observe, count, jac_csc"]
+    L += _guarded("def fixjac(t, y, yp, p, d, F):", [], [
+        line for v, m in (("p", npar), ("d", nd), ("y", n), ("yp", n))
+        for line in _unpack(v, m, v, _B, conv="_consts")]
+        + _body([e for _, _, e in fixed], [f"F[{a}, {k}]" for a, k, _ in fixed], _B),
+        "_fixjac_ieee(t, y, yp, p, d, F)")
+    src = "\n".join(L) + "\n"
+    make, fixjac = load(src)
+    return Generated(src, make, fixjac, sparsity)
+
+
+def load(src):
+    """Compile generated source; returns its (make, fixjac). Used again when
+    a compiled model is read back from the cache."""
+    _counter[0] += 1
+    fname = f"<acausal-generated-{_counter[0]}>"
+    linecache.cache[fname] = (len(src), None, src.splitlines(True), fname)
+    ns, ieee = exec_twins(compile(src, fname, "exec"))
+    ns.update(_make_ieee=ieee["make"], _fixjac_ieee=ieee["fixjac"])
+    return ns["make"], ns["fixjac"]
+
+
+def exec_twins(code):
+    """(fast namespace, IEEE namespace) after running compiled generated
+    ``code`` in each (:data:`_IEEE_ERRORS`): the same functions on Python
+    floats and on numpy float64."""
+    ns, ieee = _fast_namespace(), _ieee_namespace()
+    exec(code, ns)
+    exec(code, ieee)
+    return ns, ieee

@@ -1,0 +1,242 @@
+"""Stage 1: from a model tree to one flat list of equations.
+
+Collects every component's parameters, variables, discrete values, equations,
+events and assertions under dotted paths, and expands connections into node
+equations (see :mod:`acausal.connectors` for the sign convention).
+"""
+from dataclasses import dataclass, field
+
+import sympy as sp
+
+from ..lang.component import Model
+from ..lang.declare import Discrete, Parameter, Start, Variable
+from ..errors import ConnectionError_, ModelError
+from ..lang.symbols import base_and_order, time
+
+
+@dataclass
+class ParamInfo:
+    symbol: sp.Symbol
+    value: object          # number, sympy expression (bound) or a choice
+    decl: Parameter
+    owner: str
+
+    @property
+    def bound(self):
+        return isinstance(self.value, sp.Basic) and not self.value.is_number
+
+
+@dataclass
+class VarInfo:
+    symbol: sp.Symbol
+    start: Start
+    unit: str
+    desc: str
+    owner: str
+    port: bool = False     # a connector variable
+    unit_declared: bool = True   # False: no unit was given (not checked)
+
+
+@dataclass
+class Equation:
+    expr: sp.Expr           # residual: expr = 0
+    origin: str             # component path (or 'connect(...)')
+    label: str = ""
+
+    def describe(self):
+        return f"{self.label or 'equation'} of {self.origin or 'the model'}: {self.expr} = 0"
+
+
+@dataclass
+class Flat:
+    params: dict = field(default_factory=dict)      # path -> ParamInfo
+    variables: dict = field(default_factory=dict)   # path -> VarInfo
+    discretes: dict = field(default_factory=dict)   # path -> VarInfo (start value)
+    equations: list = field(default_factory=list)
+    events: list = field(default_factory=list)
+    assertions: list = field(default_factory=list)
+    unconnected: list = field(default_factory=list)  # port paths
+    owners: dict = field(default_factory=dict)      # component path -> class name
+
+    def owner_of(self, sym):
+        """Component path owning a variable/parameter symbol."""
+        base, _ = base_and_order(sym)
+        info = self.variables.get(base.name) or self.params.get(base.name) \
+            or self.discretes.get(base.name)
+        return info.owner if info else ""
+
+
+def _label(comp):
+    return comp.path or "(top)"
+
+
+def flatten(model):
+    """Flatten ``model`` (a :class:`Model`) into a :class:`Flat`."""
+    if not isinstance(model, Model):
+        raise ModelError(f"expected a Model, got {type(model).__name__}")
+    flat = Flat()
+    comps = list(model.walk())
+    for comp in comps:
+        _declare(flat, comp)
+    known = _known_names(flat)
+    for comp in comps:
+        _relocate_values(flat, comp, known)
+    for comp in comps:
+        _equations(flat, comp, known)
+    _connections(flat, model, comps)
+    return flat
+
+
+def _declare(flat, comp):
+    path = comp.path
+    flat.owners[path] = type(comp).__name__
+    for name, d in comp.declarations().items():
+        sym = comp.symbol(name)
+        if isinstance(d, Parameter):
+            flat.params[sym.name] = ParamInfo(sym, comp.value(name), d, path)
+        elif isinstance(d, Variable):
+            flat.variables[sym.name] = VarInfo(sym, comp.start(name), d.unit, d.desc, path,
+                                               unit_declared=d.unit_declared)
+        elif isinstance(d, Discrete):
+            flat.discretes[sym.name] = VarInfo(sym, Start(d.start, True), d.unit, d.desc, path,
+                                               unit_declared=d.unit_declared)
+    for name, ctype in comp.connectors().items():
+        port = comp.port(name)
+        for decls, syms in zip(ctype.pairs(), port.pairs()):
+            for (vname, unit, desc), sym in zip(decls, syms):
+                flat.variables[sym.name] = VarInfo(sym, Start(0.0, False), unit, desc, path,
+                                                   True)
+
+
+def relocate(expr, comp, known, start=None):
+    """Give symbols their full paths. An expression built inside a model's
+    constructor, before the model was attached to its parent, names symbols
+    relative to that model (``body.phi`` instead of ``hook.body.phi``): each
+    unknown name is looked up under the paths of ``comp``'s ancestors,
+    nearest first."""
+    if not isinstance(expr, sp.Basic):
+        return expr
+    subs = {}
+    for s in expr.free_symbols:
+        if s == time:
+            continue
+        base, k = base_and_order(s)
+        if base.name in known:
+            continue
+        node = start if start is not None else comp
+        while node is not None:
+            p = node.path
+            cand = f"{p}.{base.name}" if p else base.name
+            if cand in known:
+                new = sp.Symbol(cand)
+                for _ in range(k):
+                    new = sp.Symbol(f"der({new.name})")
+                subs[s] = new
+                break
+            node = node._parent
+    return expr.xreplace(subs) if subs else expr
+
+
+def _relocate_values(flat, comp, known):
+    """Parameter values and start values were given by whoever built the
+    component: its parent model (``Mass(m=ma)`` inside a sub-model), or the
+    model itself for its own declarations (``self.parameter(...)``)."""
+    pre = f"{comp.path}." if comp.path else ""
+    own = comp._extra
+    for name in comp.declarations():
+        full = pre + name
+        start = comp if name in own else (comp._parent or comp)
+        info = flat.params.get(full)
+        if info is not None and not info.decl.structural:
+            info.value = relocate(info.value, comp, known, start)
+        vinfo = flat.variables.get(full)
+        if vinfo is not None and isinstance(vinfo.start.value, sp.Basic):
+            vinfo.start = Start(relocate(vinfo.start.value, comp, known, start),
+                                vinfo.start.fixed)
+
+
+def _equations(flat, comp, known):
+    path = comp.path
+    for i, eq in enumerate(comp.gather("equations")):
+        if isinstance(eq, sp.Equality):
+            expr = eq.lhs - eq.rhs
+        else:
+            expr = sp.sympify(eq)
+        if expr == 0 or expr is sp.true:
+            continue
+        expr = relocate(expr, comp, known)
+        for s in expr.free_symbols:
+            base, _ = base_and_order(s)
+            if s != time and base.name not in known:
+                raise ModelError(
+                    f"equation {i + 1} of {_label(comp)} ({type(comp).__name__}) uses "
+                    f"{s.name!r}, which is not a variable or parameter of the model",
+                    component=path, variable=s.name)
+        flat.equations.append(Equation(expr, path, f"equation {i + 1} ({type(comp).__name__})"))
+    for ev in comp.gather("events"):
+        ev.owner = path
+        ev.expr = relocate(ev.expr, comp, known)
+        flat.events.append(ev)
+    for a in comp.gather("assertions"):
+        a.owner = path
+        a.expr = relocate(a.expr, comp, known)
+        flat.assertions.append(a)
+
+
+def _known_names(flat):
+    return set(flat.params) | set(flat.variables) | set(flat.discretes)
+
+
+def _connections(flat, model, comps):
+    parent = {}
+
+    def find(p):
+        while parent[p] is not p:
+            parent[p] = parent[parent[p]]
+            p = parent[p]
+        return p
+
+    ports = {}
+    for comp in comps:
+        for name in comp.connectors():
+            port = comp.port(name)
+            ports[id(port)] = port
+            parent[port] = port
+    for comp in comps:
+        if not isinstance(comp, Model):
+            continue
+        for group in comp._connections:
+            first = group[0]
+            for p in group:
+                if id(p) not in ports:
+                    raise ModelError(
+                        f"connect() in {_label(comp)}: {p.path} is not part of this model",
+                        component=p.path)
+                if type(p.ctype).domain != type(first.ctype).domain:
+                    raise ConnectionError_(
+                        f"connect() in {_label(comp)}: cannot connect {first.path} "
+                        f"({type(first.ctype).__name__}) to {p.path} ({type(p.ctype).__name__})",
+                        component=p.path)
+                ra, rb = find(first), find(p)
+                if ra is not rb:
+                    parent[rb] = ra
+    sets = {}
+    for port in parent:
+        sets.setdefault(find(port), []).append(port)
+    for members in sets.values():
+        if len(members) == 1 and members[0].ctype.optional:
+            for _, through in members[0].pairs():   # unconnected optional: no force
+                flat.equations.append(Equation(through, members[0].path,
+                                               "unconnected optional connector"))
+            continue
+        if len(members) == 1:
+            flat.unconnected.append(members[0].path)
+            continue
+        members.sort(key=lambda p: p.path)
+        where = "connect(" + ", ".join(p.path for p in members) + ")"
+        for k, (a0, _) in enumerate(members[0].pairs()):
+            for p in members[1:]:
+                flat.equations.append(Equation(p.pairs()[k][0] - a0, where,
+                                               "connection (across equal)"))
+            flat.equations.append(Equation(sp.Add(*[p.pairs()[k][1] for p in members]),
+                                           where, "connection (through sum to zero)"))

@@ -1,0 +1,212 @@
+"""The result of a diagnosis (:class:`Diagnosis`, picklable) and its JSON
+views: :func:`summary` (``diagnosis.json``, the command's ``--json``) and
+:func:`details` (``candidates.json``: every fit in full)."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..stages.stats import OVERDISPERSION
+
+
+@dataclass
+class Diagnosis:
+    """Everything the stages produced (:mod:`.stages`)."""
+
+    problem: object               # problem.Problem
+    dataset: object               # data.Dataset
+    calibration: object           # stages.Calibration
+    n_candidates: int
+    decision: object              # stages.Decision
+    cv: object                    # stages.CrossValidation
+    ranking: object               # stages.Ranking
+    extended_model: str | None
+    views: object = None          # views.Views (None: not computed)
+    next_experiment: object = None  # nextexp.NextStep (None: not run)
+    timing: dict = field(default_factory=dict)
+    location: object = None       # locate.Location (None: not run)
+    intervals: object = None      # intervals.Intervals (None: not run)
+    families: object = None       # families.FamilyIndex (None: no families)
+    kinematics: object = None     # kinematics.Kinematics (None: not run)
+    tied: tuple = ()              # kinematics.SiteEquivalence of the shown row's members
+
+
+def num(x):
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def clean(obj):
+    """JSON-safe copy: non-finite floats -> None, numpy scalars -> Python."""
+    if isinstance(obj, dict):
+        return {str(k): clean(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [clean(v) for v in obj]
+    if isinstance(obj, (bool, np.bool_)):
+        return bool(obj)
+    if isinstance(obj, (int, np.integer)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        return num(obj)
+    return obj
+
+
+def gain(d: Diagnosis) -> dict:
+    f0, best = d.calibration.fit, d.ranking.best
+    before = dict(train=f0.rms(), heldout=d.ranking.heldout0)
+    after = dict(before) if best is None else dict(
+        train=best.fit.rms(), heldout=d.cv.heldout(best.candidate.key, best.loo))
+    return dict(before={k: num(v) for k, v in before.items()},
+                after={k: num(v) for k, v in after.items()})
+
+
+def parameters(row) -> dict:
+    out = {}
+    for name in row.fit.names:
+        lo, hi = row.fit.ci95.get(name, (float("nan"),) * 2)
+        out[name] = dict(value=row.fit.values[name], ci95=[num(lo), num(hi)])
+    return out
+
+
+def _equivalent(d: Diagnosis):
+    rk = d.ranking
+    if not d.decision.discrepancy or not rk.classes:
+        return []
+    return [dict(cause=rk.rows[i].candidate.hypothesis, location=rk.rows[i].candidate.location)
+            for i in rk.classes[0] if rk.cause is None or i != rk.cause]
+
+
+def family_of(d: Diagnosis, hid):
+    """The cause class (family) of hypothesis ``hid``: its own id without families."""
+    return d.families.family(hid) if d.families is not None else hid
+
+
+def _causes(d, row):
+    """One entry per cause of a named single or pair: its family (cause
+    class), member (the law), own parameters, and the kinematically
+    equivalent sites (:func:`equivalent_sites`) with why this site is shown."""
+    every = parameters(row)
+    out = []
+    for h, loc, names in row.candidate.members():
+        tied = next((t for t in d.tied if (t.cause, t.location) == (h, loc)), None)
+        out.append(dict(cause=h, location=loc, family=family_of(d, h), member=h,
+                        parameters={k: every[k] for k in names},
+                        equivalent_sites=equivalent_sites(tied),
+                        site_reason=None if tied is None else tied.reason))
+    return out
+
+
+def equivalent_sites(tied) -> list:
+    """The sites kinematically tied to a cause's (``kinematics.SiteEquivalence``
+    or None): each with its rate ratio (its rate per the cause's site's),
+    the ratio's spread, the cause's parameters converted through the ratio
+    (``in_range``: inside the range the hypothesis declares there), and the
+    same hypothesis's own fit there (null when not fitted) with its
+    AICc against the cause's and whether the data tell the two apart."""
+    if tied is None:
+        return []
+    return [dict(location=s.location, ratio=num(s.ratio), spread=num(s.spread),
+                 parameters={k: None if v is None else num(v) for k, v in s.values},
+                 in_range=bool(s.in_range),
+                 fitted=None if not s.fitted else dict(
+                     parameters={k: num(v) for k, v in s.fitted}, daicc=num(s.daicc),
+                     same_class=bool(s.in_class)))
+            for s in tied.sites]
+
+
+def cause_class(d: Diagnosis):
+    """The best candidate's family at its site, every member fitted there
+    (best first) and the misfit the best member leaves (RMS in floors,
+    sqrt(S/(n-k))): named as a class even when no cause is named. None with
+    no discrepancy or when the best candidate is a pair."""
+    rk, best = d.ranking, d.ranking.best
+    if best is None or "+" in best.candidate.hypothesis:
+        return None
+    hid, loc = best.candidate.key
+    fam = family_of(d, hid)
+    rows = [r for r in rk.rows if r.candidate.location == loc
+            and "+" not in r.candidate.hypothesis and family_of(d, r.candidate.hypothesis) == fam]
+    left = math.sqrt(best.S / max(best.fit.n - best.k, 1))
+    return dict(family=fam, location=loc, member=hid, named=rk.named is not None,
+                leftover_floors=num(left), within_floor=bool(left ** 2 <= OVERDISPERSION),
+                members=[dict(member=r.candidate.hypothesis, aicc=num(r.aicc),
+                              daicc=num(r.aicc - best.aicc), S=num(r.S),
+                              heldout_rmse=num(r.heldout_rmse),
+                              values={k: r.fit.values[k] for k in r.own}) for r in rows])
+
+
+def summary(d: Diagnosis) -> dict:
+    """The JSON summary (docs/diagnosis.md lists the keys)."""
+    rk = d.ranking
+    named = rk.named
+    causes = [] if named is None else _causes(d, named)
+    return dict(
+        discrepancy=d.decision.discrepancy,
+        cause=None if named is None else named.candidate.hypothesis,
+        location=None if named is None else named.candidate.location,
+        equivalent_causes=_equivalent(d),
+        parameters={} if named is None else parameters(named),
+        ranking=[dict(cause=r.candidate.hypothesis, location=r.candidate.location,
+                      aicc=num(r.aicc), heldout_rmse=num(r.heldout_rmse)) for r in rk.rows],
+        gain=gain(d),
+        extended_model=d.extended_model,
+        causes=causes,
+        unexplained=unexplained(d),
+        next_experiment=None if d.next_experiment is None else clean(
+            d.next_experiment.to_dict()),
+        profile_ci95={} if d.intervals is None else clean(d.intervals.to_dict()),
+        cause_class=cause_class(d),
+    )
+
+
+def unexplained(d: Diagnosis) -> dict:
+    """``value``: the discrepancy is not explained by the library; ``node``:
+    the body whose node the located generic term sits at (None when not
+    located); ``heldout_rmse`` of that term; ``nearest``: the best library
+    candidate."""
+    loc = d.location
+    if loc is None or not loc.terms:
+        return dict(value=False, node=None, heldout_rmse=None, nearest=None)
+    t = loc.terms[0]
+    return dict(value=loc.unexplained, node=loc.node,
+                heldout_rmse=num(t.heldout_rmse) if loc.unexplained else None,
+                nearest=loc.nearest)
+
+
+def _one(label, f, extra):
+    return dict(label, k=f.k, S=num(f.cost), train_rmse=num(f.rms()), values=f.values,
+                ci95={k: [num(a), num(b)] for k, (a, b) in f.ci95.items()},
+                n_sim=f.n_sim, wall_s=f.wall_s, message=f.message, **extra)
+
+
+def _starts(s):
+    return dict(scored=s.scored, refined=s.refined, converged=s.converged, tested=s.tested)
+
+
+def details(d: Diagnosis) -> dict:
+    """Every fit in full (for scripts and tests): the nominal model, then the
+    candidates in rank order, and the decision."""
+    cal, dec, rk = d.calibration, d.decision, d.ranking
+    out = dict(
+        nominal=_one(dict(cause=None, location=None), cal.fit,
+                     dict(aicc=num(dec.a0), starts=_starts(cal.nominal.starts))),
+        free_drift=[dict(name=x.name, prior=x.prior, calibrated=x.calibrated,
+                         relative=x.relative, far=x.far) for x in cal.drift],
+        candidates=[_one(dict(cause=r.candidate.hypothesis, location=r.candidate.location,
+                              family="+".join(family_of(d, h) for h, _, _ in
+                                              r.candidate.members())),
+                         r.fit, dict(aicc=num(r.aicc), heldout_rmse=num(r.heldout_rmse),
+                                     lr_p=num(r.lr_p), starts=_starts(r.starts)))
+                    for r in rk.rows],
+        failed=[dict(cause=r.candidate.hypothesis, location=r.candidate.location,
+                     error=r.error or (r.fit.message if r.fit is not None else ""))
+                for r in dec.failed],
+        located=[dict(node=t.node, members=list(t.members), S=num(t.S), aicc=num(t.aicc),
+                      heldout_rmse=num(t.heldout_rmse), values=t.values,
+                      ranges=list(t.ranges))
+                 for t in (d.location.terms if d.location is not None else ())],
+        decision=dec.decision, overdispersion=dec.c_hat, weak_evidence=rk.weak,
+        timing=d.timing)
+    return clean(out)

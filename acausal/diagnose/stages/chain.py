@@ -1,0 +1,767 @@
+"""The diagnosis as a chain of stages, each a function from small
+dataclasses to a new one (none mutates its input):
+
+calibrate -> candidates -> fit -> decide -> cross-validate -> rank ->
+extend -> views (the simulated traces and fingerprints the report shows);
+the family members (:mod:`.families`), the located term (:mod:`.locate`),
+the intervals (:mod:`.intervals`) and the next experiment
+(:mod:`.nextexp`) are stages of their own modules.
+
+The worker-side units of work are in :mod:`.tasks`; the statistics in
+:mod:`.stats`; :mod:`.run` chains the stages and :mod:`.report` renders
+the result.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...studies.calibrate import model_dataset
+from ...data import DataError
+from ...errors import AcausalError, DiagnosisError  # noqa: F401  (DiagnosisError re-exported)
+from ...modelfile import compile_file
+from . import pairsearch as ps
+from . import stats as st
+from .fitting import heldout_rms
+from ..library.loader import load_library
+from ..problem import NOMINAL, Candidate, FitSettings, Param, Problem, free_param, pair_of
+from .tasks import CandidateFit, FitTask, LooTask, calibrate_nominal, fit_candidate, \
+    refit_without
+
+BUDGET_FACTOR = 12.0  # a candidate fit stops when it takes this many times the nominal fit
+BUDGET_MIN_S = 60.0   # ... but at least this long [s] (machine-dependent: rarely reached)
+SMALL_N = 100         # at most this many values and ...
+SMALL_EXPERIMENTS = 12  # ... experiments: exact leave-one-out for the SMALL_TOP ...
+SMALL_TOP = 6         # ... best candidates (the linearised shortcut is poor on few data)
+DRIFT = 0.25          # a free parameter moved by more than this fraction of its prior
+
+
+# -- setup -------------------------------------------------------------------------------
+def load_problem(model_path, data_folder, library=None, settings=None):
+    """(Problem, Dataset) after checking the inputs (one clear message)."""
+    model_path, data_folder = os.path.abspath(model_path), os.path.abspath(data_folder)
+    mf, cm = compile_file(model_path)
+    try:
+        ds = model_dataset(model_path, data_folder)
+    except DataError as exc:
+        raise DiagnosisError(exc.message, file=exc.file, line=exc.line,
+                             column=exc.column) from None
+    if not ds.experiments:
+        raise DiagnosisError(f"{data_folder}: no experiments")
+    ds = thin_traces(ds)
+    if not any(e.measures or e.trace is not None for e in ds.experiments):
+        raise DiagnosisError(f"{data_folder}: no measured values (no measures, no traces)")
+    free = tuple(free_param(n, cm.params[cm.param_index(n)].default, lo, hi)
+                 for n, (lo, hi) in mf.free.items())
+    lib = load_library(library).name
+    return Problem(model_path, data_folder, lib, free, settings or FitSettings()), ds
+
+
+MAX_TRACE_SAMPLES = 4000   # samples of one trace a diagnosis fits (each fit simulates them all)
+MIN_TRACE_SAMPLES = 200    # ... and at least this many, when the trace has them
+
+
+def thin_traces(ds, max_samples=MAX_TRACE_SAMPLES, notes=None):
+    """The dataset with each long trace thinned to what its instrument
+    floor supports, evenly (every k-th sample, the last one kept): about
+    one sample per floor the signal travels (its total variation over the
+    floor, the largest over its signals; independent noise makes every
+    sample count), at least ``MIN_TRACE_SAMPLES`` and at most
+    ``max_samples``. Samples closer than the floor are not independent
+    (the quantisation error of a slow signal is correlated: :mod:`.stats`)
+    and a fit's cost grows with them (a 5 M-sample trace). Each thinning is
+    said on stderr and kept in ``ds.notes``."""
+    notes = list(getattr(ds, "notes", []) if notes is None else notes)
+    experiments = []
+    for e in ds.experiments:
+        tr = e.trace
+        n = 0 if tr is None else len(tr.time)
+        if n <= MIN_TRACE_SAMPLES:
+            experiments.append(e)
+            continue
+        supported = 0
+        for name, y in tr.signals.items():
+            inst = ds.instrument.get(name)
+            floor = inst.floor() if inst is not None else 0.0
+            if not floor > 0:
+                supported = n
+                break
+            travel = float(np.sum(np.abs(np.diff(y))))
+            supported = max(supported, int(min(travel / floor, 1e15)) + 1)
+        keep = min(n, max(supported, MIN_TRACE_SAMPLES), max_samples)
+        if keep >= n:
+            experiments.append(e)
+            continue
+        step = -(-n // keep)
+        idx = np.arange(0, n, step)
+        if idx[-1] != n - 1:
+            idx = np.append(idx, n - 1)
+        why = ("the diagnosis's limit of "
+               f"{max_samples:,} samples per trace" if supported > max_samples else
+               "what the instrument floor supports (about one sample per floor the signal "
+               "travels)")
+        note = (f"{e.name}: trace thinned from {n:,} to {len(idx):,} samples (every "
+                f"{step:,}th): {why}")
+        notes.append(note)
+        import sys
+        print(f"acausal: note: {note}", file=sys.stderr, flush=True)
+        trace = dataclasses.replace(tr, time=tr.time[idx],
+                                    signals={k: v[idx] for k, v in tr.signals.items()})
+        experiments.append(dataclasses.replace(e, trace=trace))
+    out = dataclasses.replace(ds, experiments=experiments)
+    out.notes = notes
+    return out
+
+
+def _select(items, wanted, what):
+    if wanted is None:
+        return list(items)
+    wanted = [wanted] if isinstance(wanted, str) else list(wanted)
+    unknown = [w for w in wanted if w not in items]
+    if unknown:
+        raise DiagnosisError(f"unknown {what} {', '.join(map(repr, unknown))}; "
+                             f"known: {', '.join(items)}")
+    return [i for i in items if i in wanted]
+
+
+def _heads(lib):
+    """The library's hypotheses without the non-head members of its
+    families (those are fitted where their head is competitive: :mod:`.families`)."""
+    later = {m for ms in (getattr(lib, "FAMILIES", None) or {}).values() for m in ms[1:]}
+    return {k: v for k, v in lib.HYPOTHESES.items() if k not in later}
+
+
+def candidates(problem: Problem, hypotheses=None, locations=None) -> tuple:
+    """Stage 2: every (hypothesis, location) the model graph offers, with
+    the extension's parameters (neutral starts). ``locations``: paths
+    (exact, or a prefix followed by '.') to keep. Without ``hypotheses``,
+    a family's members other than its head are left to :mod:`.families`."""
+    lib = load_library(problem.library)
+    graph = lib.graph_of(problem.model_path)
+    if hypotheses is not None and not list(hypotheses):
+        raise DiagnosisError("--hypotheses: the list is empty; known: "
+                             + ", ".join(lib.HYPOTHESES))
+    if locations is not None and not list(locations):
+        raise DiagnosisError("--locations: the list is empty")
+    out, offered = [], []
+    for hid in _select(_heads(lib) if hypotheses is None else lib.HYPOTHESES, hypotheses,
+                       "hypothesis"):
+        hyp = lib.HYPOTHESES[hid]
+        for loc in hyp.candidates(graph):
+            offered.append(loc)
+            if locations is not None and not any(
+                    loc == w or loc.startswith(w + ".") for w in locations):
+                continue
+            params = tuple(Param.from_spec(s) for s in hyp.params(graph, loc))
+            out.append(Candidate(hid, loc, params))
+    if locations is not None:      # a location no candidate is at: a typo, not "no cause"
+        unused = [w for w in locations
+                  if not any(loc == w or loc.startswith(w + ".") for loc in offered)]
+        if unused:
+            known = sorted(set(offered))
+            raise DiagnosisError(
+                f"--locations {', '.join(map(repr, unused))}: no candidate of the "
+                f"{'chosen ' if hypotheses else ''}hypotheses is there; the model graph "
+                f"offers {len(known)} locations: {', '.join(known[:12])}"
+                + (", ..." if len(known) > 12 else ""))
+    return tuple(out)
+
+
+# -- running tasks ----------------------------------------------------------------------------
+def run_tasks(ex, fn, tasks, desc, progress, collect=None):
+    """Submit ``fn(task)`` for each task; results in task order. ``collect``
+    (task, result) is called as each result arrives (a checkpoint store
+    plugs in here: results depend only on their task); a ``collect`` with
+    ``get(task)`` (:class:`.resume.FitStore`) also gives the results of
+    tasks that finished in an earlier, interrupted run, which are not
+    submitted again. Tasks are submitted longest first (:func:`longest_first`)."""
+    lookup = getattr(collect, "get", None)
+    out = [lookup(t) if lookup is not None else None for t in tasks]
+    todo = longest_first([i for i, r in enumerate(out) if r is None], tasks)
+    futures = [ex.submit(fn, tasks[i]) for i in todo]
+    index = {id(f): i for i, f in zip(todo, futures)}
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+        bar = tqdm(total=len(tasks), desc=desc, unit="fit", initial=len(tasks) - len(todo))
+    try:
+        for fut in ex.as_completed(futures):
+            i = index[id(fut)]
+            out[i] = fut.result()
+            if collect is not None:
+                collect(tasks[i], out[i])
+            if bar is not None:
+                bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
+    return out
+
+
+def longest_first(indices, tasks):
+    """``indices`` of ``tasks`` ordered by decreasing expected cost (a task's
+    ``cost`` attribute, 1 without one; ties keep their order): the pool
+    hands tasks out in submission order, so the longest ones no longer
+    start last and leave a worker idle at the end of a stage (Graham's
+    longest-processing-time-first list scheduling)."""
+    return sorted(indices, key=lambda i: -float(getattr(tasks[i], "cost", 1.0)))
+
+
+# -- stage 1: calibrate ---------------------------------------------------------------------
+@dataclass
+class Calibration:
+    """The nominal fit and what the free parameters did."""
+
+    nominal: CandidateFit
+    drift: tuple = ()             # Drift of each free parameter
+
+    @property
+    def fit(self):
+        return self.nominal.fit
+
+
+@dataclass(frozen=True)
+class Drift:
+    name: str
+    prior: float
+    calibrated: float
+    relative: float               # (calibrated - prior) / |prior|
+    far: bool                     # moved by more than DRIFT and beyond its 95 % interval
+
+
+def _drift(problem, fit):
+    out = []
+    for p in problem.free:
+        v = fit.values[p.name]
+        rel = (v - p.prior) / abs(p.prior) if p.prior else float("inf") if v else 0.0
+        lo, hi = fit.ci95.get(p.name, (-math.inf, math.inf))
+        outside = not (lo <= p.prior <= hi)
+        out.append(Drift(p.name, p.prior, v, rel, abs(rel) > DRIFT and outside))
+    return tuple(out)
+
+
+def calibrate(problem: Problem, ex, progress=True, collect=None) -> Calibration:
+    """Stage 1: the nominal model's free parameters by weighted output error
+    (multi-start and growing window: :func:`.tasks.calibrate_nominal`)."""
+    task = FitTask(problem, NOMINAL, problem.free)
+    nominal = run_tasks(ex, calibrate_nominal, [task], "calibrating", progress, collect)[0]
+    if not nominal.ok:
+        why = nominal.error or (nominal.fit.message if nominal.fit else "no fit")
+        raise DiagnosisError(f"the nominal model could not be fitted: {why}")
+    return Calibration(nominal, _drift(problem, nominal.fit))
+
+
+# -- stage 3: fit ---------------------------------------------------------------------------
+def fit_tasks(problem: Problem, cal: Calibration, cands) -> list:
+    """One :class:`FitTask` per candidate, starting from the calibrated
+    free parameters (their priors kept for the uncalibrated starts)."""
+    f0 = cal.fit
+    free = tuple(Param(p.name, f0.values[p.name], p.low, p.high, p.scale, p.prior)
+                 for p in problem.free)
+    budget = _budget(cal)
+    absorb = (list(f0.names), f0.jacobian)
+    return [FitTask(problem, c, free, absorb, budget) for c in cands]
+
+
+def fit(problem: Problem, cal: Calibration, cands, ex, progress=True, collect=None) -> tuple:
+    """Stage 3: every candidate fitted (:func:`.tasks.fit_candidate`)."""
+    tasks = fit_tasks(problem, cal, cands)
+    return tuple(run_tasks(ex, fit_candidate, tasks, "fitting candidates", progress, collect))
+
+
+# -- stage 3b: pairs ------------------------------------------------------------------------
+PAIR_TOP = 4          # pairs among the best this many single candidates (tested, distinct)
+
+
+def pairs_needed(dec) -> bool:
+    """Search pairs when a discrepancy is found and the best single cause
+    still leaves misfit beyond the instrument (S/(n-k) above OVERDISPERSION)."""
+    return bool(dec.discrepancy and dec.rows and dec.c_hat > st.OVERDISPERSION)
+
+
+def pair_candidates(problem: Problem, dec, top=PAIR_TOP) -> tuple:
+    """Pairs among the ``top`` best tested single candidates (two
+    hypotheses, or one at two sites: the second's sub-model renamed), each
+    parameter seeded from its single fit (its neutral value kept as the
+    prior). The best single's pairs with every other candidate are
+    screened by :func:`search_pairs` (:mod:`.pairsearch`)."""
+    if load_library(problem.library).build_pair is None:
+        return ()
+    singles = _singles(dec)[:top]
+    ab = [(a, b) for i, a in enumerate(singles) for b in singles[i + 1:]]
+    return tuple(_pair(a, b) for a, b in ab
+                 if not (a.candidate.location == b.candidate.location
+                         and a.candidate.hypothesis == b.candidate.hypothesis))
+
+
+def _singles(dec):
+    return [r for r in dec.rows if "+" not in r.candidate.hypothesis and r.starts.tested]
+
+
+def partners(dec, done) -> tuple:
+    """The best tested single's pairs with every other single candidate at
+    another site (tested alone or not: a free parameter may have absorbed
+    it), the partner at its neutral value; pairs whose key is in ``done``
+    are left out."""
+    singles = _singles(dec)
+    if not singles:
+        return ()
+    best = singles[0]
+    out = []
+    for r in dec.rows:
+        if "+" in r.candidate.hypothesis or r.candidate.location == best.candidate.location:
+            continue
+        c = _pair(best, r, neutral=True)
+        if c.key not in done:
+            out.append(c)
+    return tuple(out)
+
+
+def search_pairs(problem: Problem, cal, dec, ex, progress=True, collect=None):
+    """Stage 3b: (fits of the pairs, simulations spent screening): the
+    pairs among the best singles (:func:`pair_candidates`) fitted, and the
+    best single's pairs with every other candidate at another site
+    screened, the best few fitted in full; then the best pair with a simpler
+    member of a family in place of a richer one, fitted briefly from it
+    (:mod:`.pairsearch`)."""
+    top = pair_candidates(problem, dec)
+    if not top and load_library(problem.library).build_pair is None:
+        return (), 0
+    tasks = fit_tasks(problem, cal, top)
+    budget = _budget(cal)
+    others = partners(dec, {c.key for c in top})
+    screened = run_tasks(ex, ps.screen_pair, ps.screen_tasks(problem, _singles(dec)[0], others),
+                         "screening pairs", progress, collect) if others else []
+    best = _singles(dec)[0] if others else None
+    tasks += ps.full_tasks(problem, cal, ps.keep(best, screened) if best else [], budget)
+    fits = run_tasks(ex, fit_candidate, tasks, "fitting pairs", progress, collect)
+    simpler = ps.simpler_tasks(problem, cal, fits, dec.c_hat, budget,
+                               {t.candidate.key for t in tasks})
+    fits += run_tasks(ex, fit_candidate, simpler, "fitting simpler mates", progress,
+                      collect) if simpler else []
+    return tuple(fits), sum(r.n_sim for r in screened)
+
+
+def _budget(cal):
+    return max(BUDGET_MIN_S, BUDGET_FACTOR * cal.nominal.wall_s)
+
+
+def member_refit_tasks(problem: Problem, cal, dec) -> list:
+    """When the best row is a pair: each of its members alone, started from
+    the pair's fit (its own parameters and the free parameters at the
+    pair's values; one refinement on the whole record from the best scored
+    start: :meth:`.problem.Problem.from_fit`). A pair earns
+    its second cause only against the best each member can do alone, and a
+    single fit can miss its minimum where the pair found it (breaker,
+    position_dependent_force seed 6000: the coil slope alone ended at S
+    3066, above the nominal 2803, while the pair with Hunt-Crossley had
+    it at 21281 and S 693; the slope alone reaches 695 from there on the
+    whole record, where a first window of 30 % led it back to its bound)."""
+    best = dec.rows[0] if dec.rows else None
+    if best is None or "+" not in best.candidate.hypothesis:
+        return []
+    rows = {r.candidate.key: r for r in dec.rows}
+    v = best.fit.values
+    out = []
+    for h, loc, names in best.candidate.members():
+        single = rows.get((h, loc))
+        if single is None:
+            continue
+        cand = dataclasses.replace(single.candidate, params=tuple(
+            p.moved(v[n]) for p, n in zip(single.candidate.params, names)))
+        task = fit_tasks(problem.from_fit(), cal, [cand])[0]
+        out.append(dataclasses.replace(task, free=tuple(p.moved(v[p.name]) for p in task.free)))
+    return out
+
+
+def _pair(a, b, neutral=False) -> Candidate:
+    """The pair of rows ``a`` and ``b``, seeded from their fits (``b`` at
+    its neutral values when ``neutral``)."""
+    ca, cb = a.candidate, b.candidate
+    return pair_of(
+        Candidate(ca.hypothesis, ca.location,
+                  tuple(p.moved(a.fit.values[p.name]) for p in ca.params)),
+        Candidate(cb.hypothesis, cb.location,
+                  tuple(p.moved(p.prior if neutral else b.fit.values[p.name])
+                        for p in cb.params)))
+
+
+# -- stage 4: decide ------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Row:
+    """One fitted candidate, scored (a ranking row)."""
+
+    candidate: Candidate
+    fit: object                   # fitting.Fit
+    starts: object                # tasks.Starts
+    loo: dict
+    aicc: float
+    lr_p: float
+    heldout_rmse: float
+    heldout_exact: bool = False
+
+    @property
+    def k(self):
+        return self.fit.k
+
+    @property
+    def S(self):
+        return self.fit.cost
+
+    @property
+    def train_rmse(self):
+        return self.fit.rms()
+
+    @property
+    def own(self):
+        """Names of the extension's parameters."""
+        return [p.name for p in self.candidate.params]
+
+
+@dataclass
+class Decision:
+    """Is there a discrepancy (stats.discrepancy_decision), with the scored
+    candidates (by AICc, QAICc when even the best leaves misfit)."""
+
+    rows: tuple                   # Row, sorted by (aicc, heldout)
+    failed: tuple                 # CandidateFit that could not be fitted
+    chi2: dict
+    runs: list
+    decision: dict
+    c_hat: float
+    a0: float
+    alpha: float
+
+    @property
+    def discrepancy(self):
+        return bool(self.decision["discrepancy"])
+
+
+def _runs(ds, f0):
+    """Runs tests of the nominal residuals: one per (experiment, trace signal)."""
+    groups, sigs = np.asarray(f0.groups), np.asarray(f0.signals)
+    out = []
+    for e in ds.experiments:
+        if e.trace is None:
+            continue
+        for var in e.trace.signals:
+            m = (groups == e.name) & (sigs == var)
+            if np.sum(m) >= 20:
+                d = st.runs_test(f0.residuals[m])
+                d.update(experiment=e.name, signal=var)
+                out.append(d)
+    return out
+
+
+def _lowest_per_key(fits):
+    """One fit per candidate key, the lowest in S (a candidate refitted
+    from another start, e.g. a pair's member alone: :func:`member_refit_tasks`)."""
+    best = {}
+    for r in fits:
+        k = r.candidate.key
+        if k not in best or r.fit.cost < best[k].fit.cost:
+            best[k] = r
+    return list(best.values())
+
+
+def decide(ds, cal: Calibration, fits, alpha=st.ALPHA) -> Decision:
+    """Stage 4: score every fitted candidate and decide whether there is a
+    discrepancy (chi-square, runs, likelihood ratio of the best candidate)."""
+    f0 = cal.fit
+    n = f0.n
+    good = _lowest_per_key([r for r in fits if r.ok])
+    fitted = {r.candidate.key for r in good}
+    failed = tuple(r for r in fits if not r.ok and r.candidate.key not in fitted)
+    c_hat = st.overdispersion([(f0.cost, n, f0.k)] + [(r.fit.cost, n, r.fit.k) for r in good])
+    rows = [Row(r.candidate, r.fit, r.starts, r.loo, st.aicc(r.fit.cost, n, r.fit.k, c_hat),
+                st.lr_test(f0.cost, r.fit.cost, r.fit.k - f0.k), heldout_rms(r.loo))
+            for r in good]
+    rows.sort(key=lambda r: (r.aicc, r.heldout_rmse))
+    chi2 = st.chi2_test(f0.cost, n, f0.k, alpha / 3)
+    runs = _runs(ds, f0)
+    lr = dict(p_value=min(r.lr_p for r in rows), m=len(rows)) if rows else None
+    return Decision(tuple(rows), failed, chi2, runs, st.discrepancy_decision(chi2, runs, lr, alpha),
+                    c_hat, st.aicc(f0.cost, n, f0.k, c_hat), alpha)
+
+
+# -- stage 5: cross-validate ------------------------------------------------------------------
+@dataclass
+class CrossValidation:
+    """Exact leave-one-experiment-out residuals: candidate key -> experiment
+    -> residual vector (the nominal model under key (None, None))."""
+
+    exact: dict = field(default_factory=dict)
+
+    def residuals(self, key, linear):
+        """Experiment -> held-out residuals of ``key``: exact where refitted,
+        else ``linear`` (the linearised ones)."""
+        return self.exact.get(key) or linear
+
+    def heldout(self, key, linear):
+        return heldout_rms(self.residuals(key, linear))
+
+
+def _loo_tasks(problem, ds, jobs, budget):
+    out = []
+    s = problem.settings
+    for cand, f in jobs:
+        bounds = {p.name: p for p in problem.free + cand.params}
+        params = tuple(bounds[nm].moved(f.values[nm]) for nm in f.names)
+        for e in ds.experiments:
+            out.append(LooTask(problem, cand, params, e.name, max(5, s.max_nfev // 4),
+                               budget / 3))
+    return out
+
+
+def cross_validate(problem, ds, cal, dec: Decision, ex, exact=True, progress=True,
+                   ) -> CrossValidation:
+    """Stage 5: refit the nominal model and the best candidate without each
+    experiment (the SMALL_TOP best on small datasets, where the linearised
+    shortcut is poor)."""
+    if not exact or len(ds.experiments) < 2:
+        return CrossValidation()
+    n = cal.fit.n
+    jobs = [(NOMINAL, cal.fit)]
+    if n <= SMALL_N and len(ds.experiments) <= SMALL_EXPERIMENTS:
+        jobs += [(r.candidate, r.fit) for r in dec.rows[:SMALL_TOP]]
+    elif dec.discrepancy and dec.rows:
+        jobs.append((dec.rows[0].candidate, dec.rows[0].fit))
+    budget = max(BUDGET_MIN_S, BUDGET_FACTOR * cal.nominal.wall_s)
+    out = {}
+    for r in run_tasks(ex, refit_without, _loo_tasks(problem, ds, jobs, budget),
+                       "leave-one-out", progress):
+        out.setdefault(r.candidate.key, {})[r.held] = r.residuals
+    return CrossValidation(out)
+
+
+# -- stage 6: rank ----------------------------------------------------------------------------
+@dataclass
+class Ranking:
+    """Ranked rows with the exact held-out errors, the classes the data
+    cannot tell apart, and the verdict: ``cause`` (index of the named row
+    or None), ``after`` (the row the gain is measured with: the named one,
+    or the best when a discrepancy is found but nothing named), ``weak``
+    (reasons not to name)."""
+
+    rows: tuple
+    classes: list
+    cause: int | None
+    after: int | None
+    runner: int | None
+    weak: list
+    untested: tuple               # Row whose extension was never tested
+    heldout0: float
+    heldout: tuple = ()           # each row's held-out residual vector (None: one missing)
+
+    def row(self, i):
+        return None if i is None else self.rows[i]
+
+    @property
+    def named(self):
+        return self.row(self.cause)
+
+    def heldout_no_worse(self, i, j) -> bool:
+        """Is row ``i``'s held-out error no worse than row ``j``'s
+        (:func:`.stats.heldout_no_worse`: paired on their residual vectors
+        where both are known)?"""
+        vec = self.heldout or (None,) * len(self.rows)
+        a, b = self.rows[i], self.rows[j]
+        return st.heldout_no_worse(dict(heldout=vec[i], heldout_rmse=a.heldout_rmse),
+                                   dict(heldout=vec[j], heldout_rmse=b.heldout_rmse))
+
+    @property
+    def best(self):
+        return self.row(self.after)
+
+
+def _ci_rel(row: Row):
+    """The 95 % half-width of the extension's first parameter relative to
+    its distance from its neutral value (the prior: where the extension
+    changes nothing), i.e. to the size of the effect it fits. For most
+    extensions the neutral value is 0 and this is the relative half-width.
+    A law switch's restitution shift is neutral where the new law matches
+    the model's damping (Hunt-Crossley: de = 0.034 for the breaker's 0.74
+    under Lankarani-Nikravesh): a truth with the model's restitution under
+    the other law fits de = -0.0002 +- 0.0002, a well determined effect of
+    -0.034 that the half-width relative to the value (79 %) had called
+    poorly determined."""
+    if not row.own:
+        return None
+    name = row.own[0]
+    v = row.fit.values.get(name)
+    lo, hi = row.fit.ci95.get(name, (float("nan"), float("nan")))
+    prior = next((p.prior for p in row.candidate.params if p.name == name), 0.0)
+    if v is None or not math.isfinite(lo) or v == prior:
+        return float("inf")
+    return float((hi - lo) / 2 / abs(v - prior))
+
+
+def _coarse(ds, f0):
+    """The nominal misfit's RMS in resolution steps, over signals that have
+    a resolution (the largest such ratio); None if none has one."""
+    ratios = []
+    sigs = np.asarray(f0.signals)
+    for s, inst in ds.instrument.items():
+        m = sigs == s
+        if inst.resolution > 0 and np.any(m):
+            rms_floor = float(np.sqrt(np.mean(f0.residuals[m] ** 2)))
+            ratios.append(rms_floor * inst.floor() / inst.resolution)
+    return max(ratios) if ratios else None
+
+
+def _untested_reasons(untested, best):
+    return [f"{r.candidate.label} was not tested: its parameter stayed at its neutral value "
+            f"from every start and has no local effect there, so it cannot be ruled out"
+            for r in untested if r is not best][:3]
+
+
+def _acted_in(best) -> set:
+    """Keys (hypothesis, location) of the members of a best pair whose
+    parameters left their neutral values in it: a member that was not
+    tested alone (a free parameter stood in for it) acted there, and is
+    not a rival of the pair it belongs to."""
+    if best is None or "+" not in best.candidate.hypothesis:
+        return set()
+    params = {p.name: p for p in best.candidate.params}
+    return {(h, loc) for h, loc, names in best.candidate.members()
+            if any(abs(best.fit.values[n] - params[n].prior)
+                   > 1e-3 * (abs(params[n].scale) or 1.0) for n in names)}
+
+
+def _pair_reasons(best, rows):
+    """A pair is named only when it beats each of its single members by
+    STRONG AICc units and by held-out error."""
+    if "+" not in best.candidate.hypothesis:
+        return []
+    out = []
+    for h, loc, _ in best.candidate.members():
+        single = next((r for r in rows if r.candidate.key == (h, loc)), None)
+        if single is None:
+            continue
+        d = single.aicc - best.aicc
+        if d < st.STRONG or not best.heldout_rmse < single.heldout_rmse:
+            out.append(f"the pair does not earn its second cause against {h} at {loc} alone "
+                       f"(dAICc {d:.1f}, needs {st.STRONG:g}; held-out {best.heldout_rmse:.3g} "
+                       f"against {single.heldout_rmse:.3g})")
+    return out
+
+
+AT_BOUND = 1e-6      # of a parameter's range: a fitted value this close to a bound is at it
+
+
+def _bound_reasons(best):
+    """A cause whose own parameter ran to a bound of its declared range
+    (other than its neutral value) is a law that cannot reach the data at a
+    plausible size: not named (blind case: a torque setting in above a speed
+    was named as power drag at the bound of its coefficient)."""
+    out = []
+    for p in best.candidate.params:
+        v, span = best.fit.values.get(p.name), p.high - p.low
+        if v is None or not math.isfinite(span) or span <= 0:
+            continue
+        for bound in (p.low, p.high):
+            if abs(v - bound) <= AT_BOUND * span and bound != p.prior:
+                out.append(f"the cause's parameter {p.name} ran to the bound {bound:.4g} of "
+                           f"its range: the law cannot follow the data at a plausible size")
+    return out
+
+
+def _unfitted_reasons(unfitted):
+    return [f"{u.label} was screened as a plausible rival (one-step predicted AICc "
+            f"{u.predicted_aicc:.1f}) but not fitted (over the screen's fit budget), so it "
+            f"cannot be ruled out" for u in unfitted][:3]
+
+
+def rank(ds, cal: Calibration, dec: Decision, cv: CrossValidation, unfitted=()) -> Ranking:
+    """Stage 6: exact held-out errors in, classes, weak-evidence rules; a
+    cause is never named while a rival candidate is untested, or screened
+    as plausible and left unfitted (``unfitted``: :class:`.screen.Unfitted`)."""
+    rows = tuple(dataclasses.replace(r, heldout_rmse=cv.heldout(r.candidate.key, r.loo),
+                                     heldout_exact=r.candidate.key in cv.exact)
+                 for r in dec.rows)
+    held0 = cv.heldout(NOMINAL.key, cal.nominal.loo)
+    vectors = tuple(_heldout_vector(cv, r, ds) for r in rows)
+    classes = st.equivalence_classes([dict(aicc=r.aicc, heldout_rmse=r.heldout_rmse, heldout=h)
+                                      for r, h in zip(rows, vectors)]) if rows else []
+    runner = classes[1][0] if len(classes) > 1 else None
+    acted = _acted_in(rows[0] if rows else None)
+    untested = tuple(r for r in rows if not r.starts.tested and r.candidate.key not in acted)
+    weak = []
+    best = 0 if rows else None
+    if dec.discrepancy and rows:
+        b = rows[0]
+        weak = st.weak_evidence(
+            n=cal.fit.n, k=b.k, d_null=dec.a0 - b.aicc,
+            d_runner=None if runner is None else rows[runner].aicc - b.aicc,
+            heldout_nominal=held0, heldout_best=b.heldout_rmse, ci_rel=_ci_rel(b),
+            c_hat=dec.c_hat, coarse=_coarse(ds, cal.fit))
+        weak += _untested_reasons(untested, b) + _unfitted_reasons(unfitted)
+        weak += _pair_reasons(b, rows) + _bound_reasons(b)
+    cause = best if (dec.discrepancy and rows and not weak) else None
+    after = best if dec.discrepancy else None
+    return Ranking(rows, classes, cause, after, runner, weak, untested, held0, vectors)
+
+
+def _heldout_vector(cv, row, ds):
+    """The row's held-out residuals (exact where refitted, else linearised),
+    experiment by experiment in the dataset's order; None when one is missing."""
+    got = cv.residuals(row.candidate.key, row.loo)
+    parts = [got.get(e.name) for e in ds.experiments]
+    if not got or any(p is None for p in parts):
+        return None
+    return np.concatenate([np.atleast_1d(p) for p in parts])
+
+
+# -- stage 7: extend ---------------------------------------------------------------------
+def _append_second(problem, lib, part, row, path):
+    """Append the second hypothesis of a pair to a written model file."""
+    from pathlib import Path
+    from ..library.hypotheses import file_defaults
+    from ...modelfile import load_model_file
+    h, loc, names = part
+    hyp, prefix = lib.HYPOTHESES[h], names[0].split(".")[0]
+    if getattr(hyp, "prefix", prefix) != prefix:     # the same hypothesis at two sites
+        hyp = hyp.renamed(prefix)
+    vals = file_defaults(load_model_file(problem.model_path), h, loc, h=hyp)
+    vals.update({k: row.fit.values[k] for k in names})
+    code = hyp.code(loc, vals).replace("hypothesis_specs =", "hypothesis_specs_2 =")
+    Path(path).write_text(Path(path).read_text() + "\n" + code)
+
+
+def extend(problem: Problem, ranking: Ranking, out_dir) -> str | None:
+    """Stage 7: the extended model file of the named cause (or None): the
+    library writes the original plus the hypothesis with its fitted values;
+    the calibrated free parameters are set before the hypothesis is applied
+    (a hypothesis may rebind a parameter of the component it extends)."""
+    row = ranking.named
+    if row is None:
+        return None
+    from pathlib import Path
+    lib = load_library(problem.library)
+    c = row.candidate
+    parts = c.members()
+    target = Path(out_dir) / f"{Path(problem.model_path).stem}_{c.hypothesis.replace('+', '_')}.py"
+    free = problem.free_names
+    h0, l0, names0 = parts[0]
+    path = str(lib.write_extended_model(problem.model_path, h0, l0,
+                                        {k: row.fit.values[k] for k in names0}, str(target)))
+    if len(parts) > 1:
+        _append_second(problem, lib, parts[1], row, path)
+    if not free:
+        return path
+    lines = ["# calibrated free parameters (acausal diagnose)"]
+    for name in free:
+        comp, _, pname = name.rpartition(".")
+        target_expr = f"model.find({comp!r})" if comp else "model"
+        lines.append(f"{target_expr}.set({pname}={float(row.fit.values[name])!r})")
+    text = Path(path).read_text()
+    i = text.find("\n# hypothesis ")
+    if i < 0:
+        raise DiagnosisError(f"{path}: cannot place the calibrated values (no "
+                             f"'# hypothesis' line written by the library)")
+    Path(path).write_text(text[:i + 1] + "\n".join(lines) + "\n\n" + text[i + 1:])
+    return path

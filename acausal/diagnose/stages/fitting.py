@@ -1,0 +1,506 @@
+"""Output-error fits used by the diagnosis: one model (a model file, or a
+model file extended with a hypothesis) fitted to a dataset by weighted least
+squares with the event-correct simulation, plus its leave-one-experiment-out
+errors (exact refits, or the linearised shortcut from the Jacobian).
+
+Residuals are the calibration's (:func:`acausal.calibrate.residual_vector`):
+(simulated - measured) / sigma, sigma the instrument floor of the signal, so
+every number here is in units of the noise floor (1 = what the instrument
+alone explains).
+"""
+from __future__ import annotations
+
+import time
+from collections import OrderedDict
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import optimize, stats
+
+from ...studies.calibrate import FD_STEP, ForwardDifferences, resolve
+from ...data import Dataset
+from ...errors import AcausalError
+
+PENALTY = 1e3   # weighted residual given to every sample of a failed simulation
+RECENT = 16     # evaluations an Objective remembers (the optimum's residuals reused)
+MAX_STEPS = 5000  # solver steps between two outputs beyond which a run counts as failed
+# Finite differences (FD_STEP of each parameter's scale, absolute; see
+# acausal.calibrate): the residuals of an adaptive, event-located simulation
+# are not smooth below about 1e-6 relative. On the breaker, dS/d(bh) from
+# forward differences changes sign between steps 1e-6 and 1e-5 and settles
+# only from 1e-4 (within 2 % from 1e-4 to 1e-2). With scipy's relative step
+# of 1e-5 the trust region collapsed on that noise and a quadratic-drag fit
+# stopped at a tenth of its true value.
+
+
+@dataclass
+class Fit:
+    """The result of one output-error fit (picklable, plain arrays)."""
+
+    names: list                       # fitted parameters, in order
+    values: dict                      # name -> value
+    cost: float                       # S = sum of squared weighted residuals
+    residuals: np.ndarray             # weighted residual vector at the optimum
+    jacobian: np.ndarray              # d residual / d parameter (parameter units)
+    groups: list                      # experiment name of each residual
+    signals: list                     # signal name of each residual
+    ci95: dict = field(default_factory=dict)
+    n_sim: int = 0
+    wall_s: float = 0.0
+    ok: bool = True
+    message: str = ""
+
+    @property
+    def n(self):
+        return int(self.residuals.size)
+
+    @property
+    def k(self):
+        return len(self.names)
+
+    def rms(self, mask=None):
+        r = self.residuals if mask is None else self.residuals[mask]
+        return float(np.sqrt(np.mean(r ** 2))) if r.size else float("nan")
+
+
+def subset(dataset: Dataset, names) -> Dataset:
+    """The dataset restricted to the experiments ``names`` (same instrument)."""
+    keep = set(names)
+    return Dataset(dataset.folder, [e for e in dataset.experiments if e.name in keep],
+                   dataset.instrument)
+
+
+def run_options(mf, e):
+    """The simulation options of experiment ``e``: the model file's. An
+    experiment with a trace and no measures is simulated only up to its
+    last sample (a growing-window fit then pays only for its window), with
+    output at the trace's own sample times (IDA's interpolant there, in
+    place of the dense grid the samples were interpolated from: the same
+    values where the samples lie on that grid, and cheaper: about a third
+    of a breaker simulation went into storing its 950 dense rows for 100
+    samples). With measures, the dense grid (measures need every event
+    row; the samples are interpolated from it)."""
+    opts = {**mf.experiment.run_options(dense=e.trace is not None), "max_steps": MAX_STEPS}
+    if not e.measures and e.trace is not None and e.trace.time.size:
+        opts["t_end"] = min(opts["t_end"], float(e.trace.time[-1]) * (1 + 1e-9) + 1e-12)
+        opts["output_step"] = None
+        opts["output_times"] = e.trace.time
+    return opts
+
+
+def weighted_residuals(model, dataset, params, backend=None):
+    """(vector, groups, signals) of weighted residuals for ``params``, as
+    :func:`acausal.calibrate.residual_vector` (measures first, then trace
+    samples), except that an experiment without measures is simulated only
+    up to its last trace sample (a growing-window fit then pays only for
+    its window, with output at the sample times: :func:`run_options`) and its
+    measures are not evaluated. ``backend``: the
+    integrator (:func:`acausal.simulate.simulate`; None: the library's)."""
+    from ...studies.calibrate import _sigma
+    from ...modelfile import evaluate_measures
+    mf, cm = resolve(model)
+    vec, groups, signals = [], [], []
+    for e in dataset.experiments:
+        res = cm.simulate(params={**params, **e.conditions}, backend=backend,
+                          **run_options(mf, e))
+        if e.measures:
+            meas = evaluate_measures(mf, res)
+            for m, y in e.measures.items():
+                vec.append((meas[m] - y) / _sigma(dataset, m, y))
+                groups.append(e.name)
+                signals.append(m)
+        if e.trace is not None:
+            for var, ys in e.trace.signals.items():
+                sim = np.interp(e.trace.time, res.t, res[var])
+                vec.extend((sim - ys) / _sigma(dataset, var, ys))
+                groups.extend([e.name] * len(ys))
+                signals.extend([var] * len(ys))
+    return np.asarray(vec, float), groups, signals
+
+
+def scaled_columns(model, dataset, base, params, step, backend=None, r0=None, inside=True):
+    """(residuals at ``base``, forward-difference columns of ``params`` per
+    unit of each one's scale): one simulation of every experiment per column
+    (and one for ``r0`` unless given). The step is ``step`` of the scale,
+    taken backwards where it would pass the parameter's upper bound when
+    ``inside``. A failed run raises its AcausalError."""
+    if r0 is None:
+        r0 = weighted_residuals(model, dataset, base, backend)[0]
+    cols = []
+    for q in params:
+        scale = abs(q.scale) or 1.0
+        h = step * scale
+        if inside and base[q.name] + h > q.high:
+            h = -h
+        r = weighted_residuals(model, dataset, {**base, q.name: base[q.name] + h}, backend)[0]
+        cols.append((r - r0) / (h / scale))
+    return r0, (np.array(cols).T if cols else np.zeros((r0.size, 0)))
+
+
+def weighted_jacobian(model, dataset, params, names, backend=None):
+    """(vector, d vector / d params over ``names``) as
+    :func:`weighted_residuals`, the Jacobian from one simulation per
+    experiment with forward sensitivities (:mod:`acausal.sensitivity`; a
+    measure's derivative from :meth:`acausal.result.Result.measure_sensitivity`,
+    a trace sample's from the interpolated sensitivity). Raises the
+    simulation's AcausalError when a run fails."""
+    from ...studies.calibrate import _measure_derivative, _sigma
+    from ...modelfile import evaluate_measures
+    mf, cm = resolve(model)
+    vec, rows = [], []
+    for e in dataset.experiments:
+        res = cm.simulate(params={**params, **e.conditions}, backend=backend,
+                          sensitivities=list(names), **run_options(mf, e))
+        if e.measures:
+            meas = evaluate_measures(mf, res)
+            for m, y in e.measures.items():
+                sigma = _sigma(dataset, m, y)
+                vec.append((meas[m] - y) / sigma)
+                rows.append([_measure_derivative(mf, res, m, n) / sigma for n in names])
+        if e.trace is not None:
+            for var, ys in e.trace.signals.items():
+                sigma = _sigma(dataset, var, ys)
+                vec.extend((np.interp(e.trace.time, res.t, res[var]) - ys) / sigma)
+                rows.extend(np.column_stack([np.interp(e.trace.time, res.t,
+                                                       res.sensitivity(var, n)) / sigma
+                                             for n in names]))
+    return np.asarray(vec, float), np.asarray(rows, float).reshape(len(vec), len(names))
+
+
+class _OutOfTime(Exception):
+    """The fit's time budget is spent (raised inside the optimiser)."""
+
+
+class Objective:
+    """The weighted residuals of one model on one dataset as a function of
+    the fitted parameters, counting simulations, keeping the best point
+    seen, and stopping (:class:`_OutOfTime`) after ``max_evals``
+    evaluations or ``budget_s`` seconds. A failed simulation gives
+    :data:`PENALTY` residuals (after a first success, which sets the size).
+    """
+
+    def __init__(self, model, dataset, names, fixed=None, budget_s=None, max_evals=None,
+                 penalty=None, jacobian="differences", backend=None):
+        self.pair = resolve(model)
+        self.jacobian = jacobian      # "differences" or "sensitivities" (see refine)
+        self.backend = backend
+        self.penalty = penalty        # (rows P, scales) on the last P.shape[1] parameters
+        self.dataset = dataset
+        self.names = list(names)
+        self.fixed = dict(fixed or {})
+        self.budget_s, self.max_evals = budget_s, max_evals
+        self.t0 = time.perf_counter()
+        self.n_eval = self.n_sim = 0
+        self.size = None
+        self.best_cost, self.best_x = np.inf, None
+        self.timed = True
+        self.recent = OrderedDict()   # x bytes -> weighted_residuals output (RECENT last)
+        self.watch = None             # watch(x, data cost) after each evaluation (may raise)
+
+    def params(self, x):
+        return {**self.fixed, **dict(zip(self.names, np.asarray(x, float).tolist()))}
+
+    def _check(self):
+        if not self.timed:
+            return
+        if self.budget_s is not None and time.perf_counter() - self.t0 > self.budget_s:
+            raise _OutOfTime(f"stopped at the time budget ({self.budget_s:.0f} s)")
+        if self.max_evals is not None and self.n_eval >= self.max_evals:
+            raise _OutOfTime(f"stopped after {self.max_evals} evaluations")
+
+    def __call__(self, x):
+        self._check()
+        self.n_eval += 1
+        self.n_sim += len(self.dataset.experiments)
+        try:
+            vec = self._remember(x, weighted_residuals(self.pair, self.dataset, self.params(x),
+                                                       self.backend))[0]
+            self.size = vec.size
+            if not np.all(np.isfinite(vec)):
+                vec = np.nan_to_num(vec, nan=PENALTY, posinf=PENALTY, neginf=-PENALTY)
+        except AcausalError:
+            if self.size is None:
+                raise
+            vec = np.full(self.size, PENALTY)
+        if self.watch is not None:
+            self.watch(np.asarray(x, float), float(vec @ vec))
+        if self.penalty is not None:
+            P, sc = self.penalty
+            vec = np.concatenate([vec, P @ (np.asarray(x, float)[-P.shape[1]:] / sc)])
+        c = float(vec @ vec)
+        if c < self.best_cost:
+            self.best_cost, self.best_x = c, np.array(x, float)
+        return vec
+
+
+    def _remember(self, x, out):
+        self.recent[np.asarray(x, float).tobytes()] = out
+        while len(self.recent) > RECENT:
+            self.recent.popitem(last=False)
+        return out
+
+    def residuals_at(self, x):
+        """:func:`weighted_residuals` at ``x``: an evaluation's own output when
+        ``x`` is one of the last :data:`RECENT` evaluated (the simulations are
+        deterministic), else simulated (and counted)."""
+        got = self.recent.get(np.asarray(x, float).tobytes())
+        if got is None:
+            got = weighted_residuals(self.pair, self.dataset, self.params(x), self.backend)
+            self.n_sim += len(self.dataset.experiments)
+        return got
+
+    def jac_x(self, x):
+        """d residuals / d x from forward sensitivities (:func:`weighted_jacobian`),
+        penalty rows included; a failed run raises its AcausalError."""
+        self._check()
+        self.n_sim += len(self.dataset.experiments)
+        J = weighted_jacobian(self.pair, self.dataset, self.params(x), self.names,
+                              self.backend)[1]
+        if not np.all(np.isfinite(J)):
+            from ...errors import SolverError
+            raise SolverError("non-finite sensitivities")
+        if self.penalty is not None:
+            P, sc = self.penalty
+            Jp = np.zeros((P.shape[0], len(self.names)))
+            Jp[:, len(self.names) - P.shape[1]:] = P / sc
+            J = np.vstack([J, Jp])
+        return J
+
+
+def score_starts(obj, starts, lo, hi, absorb=None):
+    """Evaluate each start (an array over ``obj.names``) once; with
+    ``absorb`` = (names, jacobian) of parameters calibrated beforehand, each
+    start is scored after a linearised re-calibration of those parameters
+    and moved there (so that a start is not rejected because a free
+    parameter currently absorbs the effect). Returns [(cost, x)] sorted by
+    cost (starts that fail to simulate are left out)."""
+    a_idx = a_jac = None
+    if absorb is not None and absorb[0]:
+        a_idx = np.array([obj.names.index(n) for n in absorb[0]])
+        a_jac = np.asarray(absorb[1], float)
+    out = []
+    for x in starts:
+        x = np.clip(np.asarray(x, float), lo, hi)
+        try:
+            r = obj(x)
+        except AcausalError:
+            continue
+        except _OutOfTime:
+            break
+        c = float(r @ r)
+        m = a_jac.shape[0] if a_jac is not None else 0
+        if a_jac is not None and m <= r.size:
+            d = np.linalg.lstsq(a_jac, -r[:m], rcond=None)[0]
+            moved = np.clip(x[a_idx] + d, lo[a_idx], hi[a_idx])
+            rr = r[:m] + a_jac @ (moved - x[a_idx])
+            c = float(rr @ rr) + float(r[m:] @ r[m:])
+            c = float(rr @ rr)
+            x = x.copy()
+            x[a_idx] = moved
+        out.append((c, x))
+    return sorted(out, key=lambda cx: cx[0])
+
+
+def refine(obj, x_start, lo, hi, sc, max_nfev, tol):
+    """Trust-region least squares (scipy, bounded, on value/scale) from
+    ``x_start`` with forward differences of a step FD_STEP of each scale,
+    or with the Jacobian from forward sensitivities when ``obj.jacobian`` is
+    "sensitivities" (:class:`acausal.calibrate.SensitivityJacobian`: the
+    differences answer where a sensitivity run fails).
+    Returns (x, jacobian in parameter units, ok, message); when the budget
+    runs out the best point seen is kept and the Jacobian taken there."""
+    fd = ForwardDifferences(lambda z: obj(z * sc), FD_STEP, hi / sc)
+    jac, secant = fd.jac, None
+    kind = getattr(obj, "jacobian", "differences")
+    if kind == "sensitivities":
+        from ...studies.calibrate import SensitivityJacobian
+        jac = SensitivityJacobian(obj.jac_x, lambda z: z * sc, lambda z: sc, fd).jac
+    elif kind == "secant":
+        from ...studies.differences import SecantDifferences
+        secant = SecantDifferences(fd)
+        jac = secant.jac
+    obj.best_cost, obj.best_x = np.inf, None
+    try:
+        sol = optimize.least_squares(fd, x_start / sc, jac=jac, bounds=(lo / sc, hi / sc),
+                                     x_scale=1.0, xtol=tol, ftol=tol, gtol=tol,
+                                     max_nfev=max_nfev)
+        J = sol.jac if secant is None or secant.fresh else fd.jac(sol.x)
+        return sol.x * sc, J / sc, sol.status >= 0, str(sol.message)
+    except _OutOfTime as stop:
+        obj.timed = False
+        x = obj.best_x if obj.best_x is not None else x_start
+        J = fd.jac(x / sc) / sc
+        obj.timed = True
+        return x, J, True, f"{stop}; best point kept"
+
+
+def _arrays(names, *dicts):
+    return [np.array([float(d[n]) for n in names]) for d in dicts]
+
+
+def fit(model, dataset, names, x0, low, high, scale, *, fixed=None, starts=None,
+        max_nfev=60, tol=1e-8, budget_s=None, absorb=None, max_evals=None,
+        jacobian="differences") -> Fit:
+    """Weighted output-error least squares over ``names`` from the best of
+    the starting points.
+
+    ``x0``, ``low``, ``high``, ``scale``: per-name start, bounds and typical
+    magnitude (the optimiser works on value/scale). ``fixed``: other
+    parameter overrides. ``starts``: extra starting points (dicts name ->
+    value, merged into ``x0``), scored by :func:`score_starts` (with
+    ``absorb``); the best is refined by :func:`refine`. ``budget_s`` /
+    ``max_evals``: a wall-time / evaluation budget (the best point is kept).
+    ``jacobian``: "differences" (default) or "sensitivities" (see :func:`refine`).
+    """
+    names = list(names)
+    x0, lo, hi = _arrays(names, x0, low, high)
+    sc = np.array([abs(float(scale[n])) or 1.0 for n in names])
+    obj = Objective(model, dataset, names, fixed, budget_s, max_evals, jacobian=jacobian)
+    cands = [x0]
+    for st in starts or []:
+        cands.append(np.array([float(st.get(n, v)) for n, v in zip(names, x0)]))
+    scored = score_starts(obj, cands, lo, hi, absorb)
+    if not scored:
+        return failed_fit(names, x0, obj, "every starting point failed to simulate")
+    return finish(obj, *refine_or_keep(obj, scored[0][1], lo, hi, sc, max_nfev, tol), lo)
+
+
+def refine_or_keep(obj, x, lo, hi, sc, max_nfev, tol):
+    """:func:`refine` when there is something to fit, else the start."""
+    if not obj.names:
+        return x, np.zeros((0, 0)), True, ""
+    return refine(obj, x, lo, hi, sc, max_nfev, tol)
+
+
+def failed_fit(names, x0, obj, message):
+    return Fit(list(names), dict(zip(names, np.asarray(x0, float).tolist())), float("inf"),
+               np.zeros(0), np.zeros((0, len(names))), [], [], n_sim=obj.n_sim,
+               wall_s=time.perf_counter() - obj.t0, ok=False, message=message)
+
+
+def finish(obj, x, J, ok, message, lo):
+    """The :class:`Fit` at ``x``: residuals there (:meth:`Objective.residuals_at`:
+    the optimiser's own evaluation of ``x``, or a new one), the Jacobian
+    reshaped, intervals (log intervals for positive parameters)."""
+    r, groups, signals = obj.residuals_at(x)
+    names = obj.names
+    J = np.asarray(J)[:r.size].reshape(r.size, len(names)) if names else np.zeros((r.size, 0))
+    out = Fit(names, dict(zip(names, np.asarray(x, float).tolist())), float(r @ r), r, J,
+              groups, signals, n_sim=obj.n_sim, wall_s=time.perf_counter() - obj.t0,
+              ok=bool(ok), message=str(message))
+    out.ci95 = confidence(out, positive=[n for n, low in zip(names, lo) if low > 0])
+    return out
+
+
+def confidence(f: Fit, level=0.95, positive=()) -> dict:
+    """Intervals from the Jacobian at the optimum (Student t), the covariance
+    scaled by max(1, S/(n-k)): never narrower than the instrument model says,
+    wider when the fit leaves misfit beyond the noise. A parameter in
+    ``positive`` (its lower bound is above zero: a stiffness, a mass) gets its
+    interval on the logarithm, as :func:`acausal.calibrate.least_squares`
+    does: asymmetric, never crossing zero."""
+    n, k = f.n, f.k
+    if k == 0:
+        return {}
+    dof = n - k
+    v = np.array([f.values[nm] for nm in f.names], float)
+    sc = np.where(v != 0, np.abs(v), 1.0)
+    Js = f.jacobian * sc                     # columns per relative change
+    norms = np.linalg.norm(Js, axis=0)
+    live = norms > 1e-9 * max(norms.max(initial=0.0), 1e-300)
+    cov = np.full((k, k), np.inf)
+    if np.any(live):
+        JtJ = Js[:, live].T @ Js[:, live]
+        w, V = np.linalg.eigh(JtJ)
+        good = w > 1e-12 * w.max()
+        inv = (V[:, good] / w[good]) @ V[:, good].T
+        sub = np.full(JtJ.shape, np.inf)
+        # a parameter that loads on an unidentifiable direction gets no interval
+        blind = np.abs(V[:, ~good]).max(axis=1) > 1e-3 if np.any(~good) else \
+            np.zeros(len(w), bool)
+        ok = ~blind
+        sub[np.ix_(ok, ok)] = inv[np.ix_(ok, ok)]
+        cov[np.ix_(live, live)] = sub
+    s2 = f.cost / dof if dof > 0 else 1.0
+    sd = np.sqrt(np.clip(np.diag(cov), 0, None) * max(s2, 1.0)) * sc
+    q = stats.t.ppf(0.5 + level / 2, dof) if dof > 0 else stats.norm.ppf(0.5 + level / 2)
+    out = {}
+    for name, s, scale in zip(f.names, sd, sc):
+        v = f.values[name]
+        if name in positive and v > 0:
+            # the columns of Js are derivatives per relative change, i.e. per
+            # unit of log(value): s / scale is the standard deviation of log(value)
+            w = min(q * s / scale, 700.0)    # exp(700) ~ 1e304: open above, not an overflow
+            out[name] = (float(v * np.exp(-w)), float(v * np.exp(w)) if w < 700 else np.inf)
+        else:
+            out[name] = (float(v - q * s), float(v + q * s))
+    return out
+
+
+def linear_loo(f: Fit, penalty=None) -> dict:
+    """Leave-one-experiment-out residuals predicted from the full fit.
+
+    For experiment G, one Gauss-Newton step from the optimum without G's
+    rows: delta = -lstsq(J[-G], r[-G]); predicted held-out residuals
+    r[G] + J[G] delta. Exact for a model linear in its parameters (the
+    classical PRESS residuals); a first-order estimate otherwise, and free
+    (no simulation). ``penalty`` = (rows P, scales) of a penalised fit
+    (:class:`Objective`) on its last P.shape[1] parameters: the step keeps
+    the penalty rows, as the refit would (the PRESS residuals of a
+    penalised fit). Returns experiment -> residual vector.
+    """
+    groups = np.asarray(f.groups)
+    Jp, rp = _penalty_rows(f, penalty)
+    out = {}
+    for g in dict.fromkeys(f.groups):
+        m = groups == g
+        if f.k == 0 or not np.any(~m):
+            out[g] = f.residuals[m]
+            continue
+        A = np.vstack([f.jacobian[~m], Jp])
+        delta = np.linalg.lstsq(A, -np.concatenate([f.residuals[~m], rp]), rcond=None)[0]
+        out[g] = f.residuals[m] + f.jacobian[m] @ delta
+    return out
+
+
+def _penalty_rows(f: Fit, penalty):
+    """(Jacobian rows, residuals) of the penalty at the fit, in parameter units."""
+    if penalty is None or f.k == 0:
+        return np.zeros((0, f.k)), np.zeros(0)
+    P, sc = penalty
+    q = P.shape[1]
+    x = np.array([f.values[n] for n in f.names[-q:]], float)
+    J = np.zeros((P.shape[0], f.k))
+    J[:, -q:] = P / sc
+    return J, P @ (x / sc)
+
+
+def penalty_cost(f: Fit, penalty) -> float:
+    """The penalty rows' share of the cost at the fit (0 without a penalty)."""
+    rp = _penalty_rows(f, penalty)[1]
+    return float(rp @ rp)
+
+
+def effective_k(f: Fit, penalty=None) -> float:
+    """The number of parameters a (penalised) fit spends: the trace of its
+    hat matrix, tr[J (J'J + Jp'Jp)^+ J'] (the effective degrees of freedom of
+    a penalised least-squares fit; Hastie & Tibshirani, Generalized Additive
+    Models, 1990, sec. 3.5). It is ``f.k`` for an unpenalised fit of full
+    rank; a direction pinned by a stiff penalty row counts about zero, and a
+    smoothing penalty counts a fraction of each weight it ties."""
+    if f.k == 0 or f.jacobian.size == 0:
+        return 0.0
+    Jp, _ = _penalty_rows(f, penalty)
+    J = f.jacobian
+    # with [J; Jp] = U S V' the data rows of the hat matrix are U_J U_J'
+    # (U_J = U's first n rows): its trace is |U_J|^2, with no normal equations
+    # to square a stiff pin row's condition number
+    U, s, _ = np.linalg.svd(np.vstack([J, Jp]), full_matrices=False)
+    keep = s > s[0] * max(U.shape) * np.finfo(float).eps
+    return float(np.sum(U[:J.shape[0], keep] ** 2))
+
+
+def heldout_rms(loo: dict) -> float:
+    """RMS of all held-out residuals (noise-floor units)."""
+    r = np.concatenate([np.atleast_1d(v) for v in loo.values()]) if loo else np.zeros(0)
+    return float(np.sqrt(np.mean(r ** 2))) if r.size else float("nan")

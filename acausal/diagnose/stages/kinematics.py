@@ -1,0 +1,354 @@
+"""Stage: kinematically equivalent sites.
+
+Two sites whose motions are tied by a (near-)constant ratio over the data
+(a lever, gears, a four-bar over the range the experiments cover) are one
+place to a cause that acts on a site's coordinate: a torque tau at the hook
+does the same work as tau / r at the main shaft when the main shaft turns r
+times as fast (virtual power), so the data cannot tell a friction at one
+from a friction at the other. The breaker's hook and main shaft turn together
+through the four-bar at a rate ratio of about -1.6e-3: hook friction of
+0.74 N*m was reported as 460 N*m on the main shaft, and ``location`` and
+``parameters`` then named the main shaft (issue 11).
+
+Which sites are tied is read from the calibrated nominal simulation of every
+experiment (:func:`kinematics`), not from the model graph: the graph says
+that two bodies are linked, but not whether the link's ratio stays constant
+over the range the data cover (a four-bar's does not in general; a spring
+between two masses ties them only below its resonance). Each site's rate is
+its coordinate's finite-difference derivative on the simulation's output
+grid, all experiments joined; two sites are tied when the two rate series are
+proportional within :data:`KIN_TOL` (the sine of the angle between them, the
+RMS of the part of one that the best constant ratio leaves over, relative to
+its size). The ratio is that least-squares constant.
+
+For the named cause (:func:`equivalents`), the parameters at each tied site
+are converted through the ratio (:func:`convert`: a parameter of dimension
+force^a length^b scales by |r|^(b - a); a law that is not odd in the motion,
+a constant load, also takes the sign of r), and the same hypothesis fitted
+there, when it was, is reported beside them with its AICc. Which tied site
+is shown first (:func:`prefer_site`) is never claimed to be the data's
+choice: among the tied sites whose fits the data cannot tell apart (one
+class, :func:`.stats.equivalence_classes`), the one whose coordinate is a
+measured signal is shown, with that reason; otherwise the ranking's order
+stands, and the report says that it is not evidence.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import sympy as sp
+
+from ..library.domain import DOMAINS, domain_name
+from ..library.loader import load_library
+from ..problem import NOMINAL
+from .tasks import dataset_of, model_of
+from .views import simulate_all
+
+# Rate series whose best constant ratio leaves more than this fraction (RMS,
+# relative) are not tied. 5 %: the converted parameter is then right to
+# about that, half the 10 % the issue asks of a named parameter. Measured on
+# the breaker's nominal run: hook and main shaft 1.3 % (the four-bar's ratio
+# varies over the stroke), armature and hook far apart (the armature moves
+# alone before the contact).
+KIN_TOL = 0.05
+# A traced signal is a site's coordinate when their rates agree to this
+# (ratio +1, spread): a sensor on the site's flange or the same variable. Not
+# a looser "about +-1": on the planar breaker the cam pin turns at -1.0017
+# times the hook (spread 4e-5) and its angle is not the measured hook angle.
+SAME_TOL = 1e-3
+
+
+@dataclass(frozen=True)
+class Tie:
+    """Sites ``a`` and ``b`` move together: rate at b = ``ratio`` x rate at
+    a; ``spread``: sine of the angle between the two rate series."""
+
+    a: str
+    b: str
+    ratio: float
+    spread: float
+
+
+@dataclass(frozen=True)
+class Kinematics:
+    """The tied sites of a model over the data (``ties``), and ``measured``:
+    (site, signal) pairs whose coordinate a traced signal records (the same
+    rate, :data:`SAME_TOL`). ``message``: why nothing was found, when so."""
+
+    ties: tuple = ()
+    measured: tuple = ()
+    message: str = ""
+
+    def tied(self, loc) -> list:
+        """[(other site, rate ratio other/``loc``, spread)] of ``loc``."""
+        out = []
+        for t in self.ties:
+            if t.a == loc:
+                out.append((t.b, t.ratio, t.spread))
+            elif t.b == loc:
+                out.append((t.a, 1.0 / t.ratio, t.spread))
+        return out
+
+    def signal_of(self, loc):
+        """The traced signal that records ``loc``'s coordinate, or None."""
+        return next((sig for site, sig in self.measured if site == loc), None)
+
+
+def rates(runs) -> np.ndarray:
+    """The finite-difference rate of a coordinate over ``runs`` = [(t, x)]
+    joined (steps of zero length, at events, left out)."""
+    out = []
+    for t, x in runs:
+        t, x = np.asarray(t, float), np.asarray(x, float)
+        dt = np.diff(t)
+        keep = dt > 0
+        out.append(np.diff(x)[keep] / dt[keep])
+    return np.concatenate(out) if out else np.zeros(0)
+
+
+def tie(va, vb, tol=KIN_TOL):
+    """(ratio, spread) of rate series ``vb`` against ``va`` when tied
+    (spread <= ``tol``), else None (also when either does not move or a
+    value is not finite)."""
+    va, vb = np.asarray(va, float), np.asarray(vb, float)
+    if va.size == 0 or va.size != vb.size or not (np.all(np.isfinite(va))
+                                                  and np.all(np.isfinite(vb))):
+        return None
+    na, nb = float(np.linalg.norm(va)), float(np.linalg.norm(vb))
+    if na == 0.0 or nb == 0.0:
+        return None
+    cos = float(va @ vb) / (na * nb)
+    spread = math.sqrt(max(0.0, 1.0 - cos * cos))
+    return (float(va @ vb) / na ** 2, spread) if spread <= tol else None
+
+
+def ties_of(series: dict, tol=KIN_TOL) -> tuple:
+    """Every tied pair among ``series`` (name -> rate series), in order."""
+    names = list(series)
+    out = []
+    for i, a in enumerate(names):
+        for b in names[i + 1:]:
+            got = tie(series[a], series[b], tol)
+            if got is not None:
+                out.append(Tie(a, b, *got))
+    return tuple(out)
+
+
+def coordinates(graph) -> dict:
+    """site path -> the name of its coordinate (a body's position, a planar
+    joint's axis angle) for every body and joint site of a 1-D domain."""
+    out = {}
+    for s in graph.sites("bodies") + graph.sites("joints"):
+        comp = s.component
+        dom = DOMAINS.get(domain_name(comp))
+        if dom is None or s.path in out:
+            continue
+        flange = getattr(type(comp), "diagnosis_flange", None)
+        out[s.path] = f"{s.path}.{flange}.{dom.across}" if flange else f"{s.path}.{dom.across}"
+    return out
+
+
+def kinematics(problem, cal, tol=KIN_TOL) -> Kinematics:
+    """The stage: simulate the calibrated nominal model on every experiment
+    (one run each, main process) and tie the sites' rates (module doc); an
+    experiment whose run fails is left out."""
+    lib = load_library(problem.library)
+    try:
+        coords = coordinates(lib.graph_of(problem.model_path))
+    except Exception as exc:  # noqa: BLE001 - a stand-in library without sites
+        return Kinematics(message=f"no sites: {type(exc).__name__}: {exc}")
+    ds = dataset_of(problem)
+    runs = [r for r in simulate_all(model_of(problem, NOMINAL), ds, cal.fit.values,
+                                    problem.settings.integrator).values() if r is not None]
+    if not coords or not runs:
+        return Kinematics(message="no sites" if not coords else "every nominal run failed")
+    signals = sorted({s for e in ds.experiments if e.trace is not None for s in e.trace.signals})
+    series = {}
+    for name, var in list(coords.items()) + [(s, s) for s in signals]:
+        try:
+            series[name] = rates([(res.t, res[var]) for res in runs])
+        except KeyError:
+            continue
+    sites = [p for p in coords if p in series]
+    ties = ties_of({p: series[p] for p in sites}, tol)
+    measured = tuple((p, s) for p in sites for s in signals if s in series and p != s
+                     and _same(tie(series[p], series[s], SAME_TOL)))
+    return Kinematics(ties, measured)
+
+
+def _same(got) -> bool:
+    """A tie at ratio +1: the signal is the site's coordinate."""
+    return got is not None and abs(got[0] - 1.0) <= SAME_TOL
+
+
+# -- converting a cause's parameters --------------------------------------------------
+def exponents(unit: str, domain: str):
+    """(a, b): the powers of force and length in ``unit`` (a hypothesis
+    parameter's unit in ``domain``: N, m in translational; N*m, rad in
+    rotational); None when it does not reduce to them."""
+    if unit.strip() in ("", "1", "-"):
+        return 0, 0
+    F, L, s, N, m, kg, rad = sp.symbols("F L s N m kg rad", positive=True)
+    base = ({N: F, m: L, kg: F * s ** 2 / L, rad: 1} if domain == "translational" else
+            {N: F / m, rad: L, kg: F * s ** 2 / (L * m ** 2)})
+    try:
+        expr = sp.sympify(unit.replace("^", "**"), locals=dict(N=N, m=m, kg=kg, rad=rad, s=s))
+    except (sp.SympifyError, TypeError):
+        return None
+    powers = sp.powsimp(sp.expand_power_base(expr.xreplace(base), force=True)).as_powers_dict()
+    if set(powers) - {F, L, s, 1}:
+        return None
+    return int(powers.get(F, 0)), int(powers.get(L, 0))
+
+
+def convert(value, unit, domain, ratio, odd=True):
+    """A parameter of a cause at one site as the same cause at a site that
+    moves ``ratio`` times as fast: force / r, length x r, so a parameter of
+    force^a length^b scales by |r|^(b - a); a law not odd in the motion (a
+    constant load) also takes the sign of r on its force-like parameters.
+    None when the unit does not reduce to force and length."""
+    ab = exponents(unit, domain)
+    if ab is None or ratio == 0:
+        return None
+    a, b = ab
+    out = value * abs(ratio) ** (b - a)
+    return out * (math.copysign(1.0, ratio) if not odd and a % 2 else 1.0)
+
+
+@dataclass(frozen=True)
+class EquivalentSite:
+    """The named cause at a tied site: the rate ratio (its rate per the
+    cause's site's), the cause's parameters converted through it
+    (``values``: (name, value) pairs, named as at that site), the same
+    hypothesis's own fit there (``fitted``, empty when it was not fitted),
+    its AICc against the cause's (``daicc``), whether the data tell it
+    apart from the cause (``in_class``: False when they do) and whether the
+    converted values lie in the hypothesis's declared range at that site
+    (``in_range``: a fit there cannot reach them otherwise)."""
+
+    location: str
+    ratio: float
+    spread: float
+    values: tuple
+    fitted: tuple = ()
+    daicc: float | None = None
+    in_class: bool = False
+    in_range: bool = True
+
+
+@dataclass(frozen=True)
+class SiteEquivalence:
+    """One member of the named cause (``cause`` at ``location``), its tied
+    sites and why ``location`` is the one shown (``reason``)."""
+
+    cause: str
+    location: str
+    sites: tuple
+    reason: str = ""
+
+
+# -- the stage's verdict: which tied site is shown, and the cause at each ---------------
+def _class_of(rk, i) -> list:
+    return next((c for c in rk.classes if i in c), [i])
+
+
+def _members(candidate) -> list:
+    return sorted((h, loc) for h, loc, _ in candidate.members())
+
+
+def _alternative(rk, row, i, site):
+    """Index of the ranked row that is ``row`` with its member ``i`` at
+    ``site`` instead, a pair's members in either order (None: not fitted)."""
+    want = [(h, site if k == i else loc) for k, (h, loc, _) in
+            enumerate(row.candidate.members())]
+    return next((j for j, r in enumerate(rk.rows) if _members(r.candidate) == sorted(want)),
+                None)
+
+
+def prefer_site(rk, kin: Kinematics):
+    """The ranking with the shown (and named) row moved to the same cause at
+    a tied site whose coordinate is a measured signal, when the shown row's
+    site is not measured and the row there is tested and in the shown row's
+    class (the data cannot tell the two apart). Rows and classes unchanged."""
+    if rk.after is None or not kin.ties:
+        return rk
+    row, cls = rk.rows[rk.after], _class_of(rk, rk.after)
+    for i, (_, loc, _) in enumerate(row.candidate.members()):
+        if kin.signal_of(loc) is not None:
+            continue
+        for other, _, _ in kin.tied(loc):
+            j = _alternative(rk, row, i, other)
+            if (j is not None and j in cls and rk.rows[j].starts.tested
+                    and kin.signal_of(other) is not None):
+                return dataclasses.replace(rk, after=j,
+                                           cause=j if rk.cause is not None else None)
+    return rk
+
+
+def equivalents(problem, kin: Kinematics, rk) -> tuple:
+    """:class:`SiteEquivalence` of each member of the shown row (the named
+    cause, or the best candidate) that has tied sites where its hypothesis
+    can act."""
+    row = rk.best
+    if row is None or not kin.ties:
+        return ()
+    lib = load_library(problem.library)
+    graph = lib.graph_of(problem.model_path)
+    out = []
+    for i, (h, loc, names) in enumerate(row.candidate.members()):
+        hyp = lib.HYPOTHESES.get(h)
+        if hyp is None:
+            continue
+        where = hyp.candidates(graph)
+        sites = tuple(_at(rk, row, i, hyp, graph, other, ratio, spread)
+                      for other, ratio, spread in kin.tied(loc) if other in where)
+        if sites:
+            out.append(SiteEquivalence(h, loc, sites, _reason(kin, loc, sites)))
+    return tuple(out)
+
+
+def _at(rk, row, i, hyp, graph, other, ratio, spread) -> EquivalentSite:
+    """Member ``i`` of ``row`` at the tied site ``other`` (rate ratio
+    ``ratio`` against its own site)."""
+    h, loc, names = row.candidate.members()[i]
+    prefix = names[0].partition(".")[0]
+    dom = domain_name(graph.components[loc])
+    odd = getattr(hyp, "odd", True)
+    values, in_range = [], True
+    for here, there, name in zip(hyp.params(graph, loc), hyp.params(graph, other), names):
+        v = convert(row.fit.values[name], here.unit, dom, ratio, odd)
+        values.append((f"{prefix}.{there.name.partition('.')[2]}", v))
+        in_range = in_range and v is not None and there.low <= v <= there.high
+    j = _alternative(rk, row, i, other)
+    if j is None:
+        return EquivalentSite(other, ratio, spread, tuple(values), in_range=in_range)
+    alt = rk.rows[j]
+    there = next(nm for hh, at, nm in alt.candidate.members() if (hh, at) == (h, other))
+    fitted = tuple((nm, alt.fit.values[nm]) for nm in there)
+    return EquivalentSite(other, ratio, spread, tuple(values), fitted, alt.aicc - row.aicc,
+                          j in _class_of(rk, rk.after), in_range)
+
+
+def _reason(kin: Kinematics, loc, sites) -> str:
+    """Why ``loc`` is the site shown, never as the data's choice among
+    sites they cannot tell apart."""
+    same = [s.location for s in sites if s.in_class]
+    sig = kin.signal_of(loc)
+    if not same:
+        return (f"`{loc}` is shown: the same cause at the tied site(s) "
+                + ", ".join(f"`{s.location}`" + (" was not fitted" if s.daicc is None else
+                                                 f" ranks {s.daicc:+.3g} AICc units apart")
+                            + ("" if s.in_range else " (its converted parameters lie "
+                               "outside the range declared there, which a fit cannot leave)")
+                            for s in sites) + ".")
+    txt = (f"The data cannot tell `{loc}` from " + ", ".join(f"`{x}`" for x in same)
+           + ": the sites move together at a fixed ratio and the fits there are one class.")
+    if sig is not None:
+        return txt + f" `{loc}` is shown because its coordinate is the measured signal `{sig}`."
+    lead = min(s.daicc for s in sites if s.in_class)
+    return txt + (f" `{loc}` is shown because it ranks first by AICc ({lead:.3g} units "
+                  f"ahead), which between tied sites is not evidence." if lead >= 0 else
+                  f" `{loc}` is shown in the ranking's order, not by the data's choice.")

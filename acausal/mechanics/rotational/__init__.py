@@ -1,0 +1,16 @@
+"""Rotational (1-D) mechanics: components, sources and sensors.
+
+Sign convention: :mod:`acausal.connectors` (torques positive INTO the
+component; angles about one positive axis). Two-flange elements report
+``tau`` = ``flange_b.tau`` (positive when the element is twisted
+positively, ``phi_rel > phi_rel0`` for a spring) and
+``phi_rel = flange_b.phi - flange_a.phi``.
+
+Several components may be connected to one flange (an inertia has a single
+flange; the torques of everything connected to it add up there).
+"""
+from .components import Fixed, Inertia, TorsionSpring, RotationalDamper, SpringDamper, Spring, Damper
+from .sources import Torque, RelativeTorque, Angle
+from .sensors import AngleSensor, SpeedSensor, AccSensor, TorqueSensor, RelAngleSensor, RelSpeedSensor
+
+__all__ = ["Fixed", "Inertia", "TorsionSpring", "RotationalDamper", "SpringDamper", "Spring", "Damper", "Torque", "RelativeTorque", "Angle", "AngleSensor", "SpeedSensor", "AccSensor", "TorqueSensor", "RelAngleSensor", "RelSpeedSensor"]

@@ -1,0 +1,462 @@
+"""The compiled backend: SUNDIALS IDA calling generated C, with no Python
+call per residual, Jacobian or root evaluation.
+
+The model's residual, iteration matrix and root functions are generated as
+C (:mod:`acausal.codegen_c`), compiled with the system's C compiler together
+with a small segment driver (``ida_driver.c``), and linked against the
+SUNDIALS 7 libraries that the scikit-sundae wheel ships, so nothing but pip
+and a C compiler is needed. The library is cached on disk, keyed by a hash
+of its sources, the compiler and the SUNDIALS libraries. Python sees one
+call per segment (and one per located root or full output buffer).
+
+IDA is set up as :mod:`acausal.backends.sundae` sets it up, so both
+backends run the same integrator; the hybrid loop is shared.
+
+When there is no C compiler or no SUNDIALS library to link against,
+:class:`Unavailable` says why and :func:`acausal.backends.make_solver`
+falls back to the reference backend (``res.stats["backend_fallback"]``).
+"""
+import ctypes
+import glob
+import hashlib
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import weakref
+
+import numpy as np
+
+try:
+    import fcntl
+except ImportError:   # pragma: no cover - not on Windows (where the backend falls back)
+    fcntl = None
+from sympy.printing.codeprinter import PrintMethodNotImplementedError
+
+from ...compiler.codegen_c import generate_c
+from . import Root, Segment, SegmentSolver
+
+_HERE = os.path.dirname(os.path.abspath(__file__))
+_DRIVER = os.path.join(_HERE, "ida_driver.c")
+_REINIT = os.path.join(_HERE, "reinit.c")     # the re-initialisation Newton in C
+_LIBS = ("sundials_core", "sundials_nvecserial", "sundials_sunmatrixdense",
+         "sundials_sunlinsoldense", "sundials_ida")
+_ROOT, _FULL = 2, 99
+_MESSAGES = {
+    -1: "the maximum number of steps was taken before reaching the output time",
+    -2: "the requested accuracy could not be achieved",
+    -3: "Error tests failed too many times, or reached min step size.",
+    -4: "the corrector (Newton) iteration failed to converge too many times",
+    -5: "the linear solver's setup failed",
+    -6: "the linear solver's solve failed",
+    -8: "the residual function failed",
+    -10: "the root function failed",
+}
+_loaded = weakref.WeakKeyDictionary()   # CompiledModel -> _Library
+
+
+class Unavailable(Exception):
+    """The compiled backend cannot run here (the message says why)."""
+
+
+def _compiler():
+    cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc") or \
+        shutil.which("clang")
+    if not cc or not shutil.which(cc.split()[0]):
+        raise Unavailable(f"no C compiler found ({cc or 'cc, gcc, clang'})")
+    return cc
+
+
+def _sundials_libs():
+    """Full paths of the SUNDIALS shared libraries of the scikit-sundae wheel."""
+    try:
+        import sksundae
+    except ImportError as exc:   # pragma: no cover - a core dependency
+        raise Unavailable(f"scikit-sundae cannot be imported: {exc}") from None
+    base = os.path.dirname(os.path.dirname(os.path.abspath(sksundae.__file__)))
+    paths = []
+    for lib in _LIBS:
+        hits = sorted(glob.glob(os.path.join(base, "scikit_sundae.libs", f"lib{lib}-*.so*")))
+        if not hits:
+            raise Unavailable(f"no {lib} library in the scikit-sundae installation "
+                              f"({sys.platform}); the compiled backend needs the Linux wheel")
+        paths.append(hits[0])
+    return paths
+
+
+def _cache_dir():
+    """``compiled/`` in the compiled-model cache (:func:`acausal.cache.cache_dir`,
+    ``$ACAUSAL_CACHE``), or in ``$ACAUSAL_CACHE_DIR``; a library has to live
+    somewhere, so with the model cache off it is ``~/.cache/acausal``."""
+    from ...infra.store import cache_dir
+    d = os.environ.get("ACAUSAL_CACHE_DIR") or cache_dir() or os.path.join(
+        os.path.expanduser("~"), ".cache", "acausal")
+    d = os.path.join(str(d), "compiled")
+    os.makedirs(d, exist_ok=True)
+    return d
+
+
+def _key(cm, cc, libs):
+    """Cache key of a model's library: the model's generated Python source
+    (which fixes its DAE, roots and symbols), the C generator, the driver,
+    the compiler and the SUNDIALS libraries; so a cached library is found
+    without generating C again."""
+    import acausal.compiler.codegen_c as gen
+    parts = [cm.source, cc] + libs
+    for path in (_DRIVER, _REINIT, gen.__file__):
+        with open(path) as fh:
+            parts.append(fh.read())
+    return hashlib.sha256("\0".join(parts).encode()).hexdigest()[:24]
+
+
+def _build(cm):
+    """Path of the shared library of ``cm`` (compiled once per cache) and
+    whether it was compiled now."""
+    cc, libs = _compiler(), _sundials_libs()
+    try:
+        out = os.path.join(_cache_dir(), f"acs_{_key(cm, cc, libs)}.so")
+        if not _once(out, lambda: _compile(cm, cc, libs, out)):
+            return out, False
+    except OSError as exc:
+        raise Unavailable(f"cannot write the compiled-library cache: {exc} "
+                          "(set ACAUSAL_CACHE_DIR to a writable folder)") from None
+    return out, True
+
+
+def _compile(cm, cc, libs, out):
+    try:
+        csrc = generate_c(cm)
+    except PrintMethodNotImplementedError as exc:
+        raise Unavailable("an expression of the model has no C form: "
+                          + str(exc).splitlines()[0]
+                          + " (give its sympy Function a _ccode method)") from None
+    tmpdir = tempfile.mkdtemp(dir=os.path.dirname(out))
+    try:
+        model_c = os.path.join(tmpdir, "model.c")
+        with open(model_c, "w") as fh:
+            fh.write(csrc.text)
+        tmp_so = os.path.join(tmpdir, "lib.so")
+        libdir = os.path.dirname(libs[0])
+        objs = [_driver_object(cc, src) for src in (_DRIVER, _REINIT)]
+        _run_cc(cc.split() + ["-O1", "-shared", "-fPIC", "-o", tmp_so, model_c, *objs] + libs
+                + [f"-Wl,-rpath,{libdir}", "-lm"], "the generated code")
+        os.replace(tmp_so, out)   # atomic: a reader never sees a partial file
+    finally:
+        shutil.rmtree(tmpdir, ignore_errors=True)
+
+
+def _run_cc(cmd, what):
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    if proc.returncode != 0:
+        raise Unavailable(f"the C compiler failed on {what}: "
+                          + (proc.stderr.strip().splitlines() or ["?"])[-1])
+
+
+def _driver_object(cc, src):
+    """The object file of one of the driver's C sources (the same for every
+    model: compiled once per cache, keyed by the compiler and the source
+    text), so that a model's build compiles only its own generated code."""
+    with open(src) as fh:
+        key = hashlib.sha256("\0".join([cc, fh.read()]).encode()).hexdigest()[:24]
+    out = os.path.join(_cache_dir(), f"{os.path.basename(src)[:-2]}_{key}.o")
+
+    def make():
+        tmp = f"{out}.{os.getpid()}.tmp.o"
+        _run_cc(cc.split() + ["-O1", "-fPIC", "-c", src, "-o", tmp], os.path.basename(src))
+        os.replace(tmp, out)    # atomic: a reader never sees a partial file
+    _once(out, make)
+    return out
+
+
+def _once(out, make):
+    """Make the file ``out`` with ``make()`` unless it exists; concurrent
+    processes (sweep workers) wait for one build. Returns whether it was
+    made now."""
+    if os.path.exists(out):
+        return False
+    with open(out + ".lock", "w") as lock:
+        if fcntl is not None:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+        if os.path.exists(out):
+            return False
+        make()
+    return True
+
+
+class _Library:
+    """The loaded shared library of one compiled model."""
+
+    def __init__(self, cm):
+        self.n_pd = len(cm.param_syms) + len(cm.disc_syms)
+        self.path, self.built = _build(cm)
+        lib = self.lib = ctypes.CDLL(self.path)
+        dp, ip = ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_int)
+        vp = ctypes.c_void_p
+        lib.acs_new.restype = vp
+        lib.acs_new.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_int, ctypes.c_double, dp,
+                                dp, ip, ctypes.c_double, ctypes.c_long]
+        lib.acs_free.argtypes = [vp]
+        # arrays go in as raw addresses (``a.ctypes.data``: cheaper per call)
+        lib.acs_start.argtypes = [vp, ctypes.c_double, vp, vp, vp, ctypes.c_double]
+        lib.acs_advance.argtypes = [vp, vp, ctypes.c_int, ip, ctypes.c_int, vp, vp, vp,
+                                    ctypes.c_int, ip, vp, vp, vp, vp]
+        lib.acs_counters.argtypes = [vp, vp]
+        lib.acs_flag_name.restype = ctypes.c_char_p
+        lib.acs_flag_name.argtypes = [ctypes.c_long]
+        lib.acs_eval.argtypes = [ctypes.c_int, ctypes.c_double, dp, dp, dp, ctypes.c_double,
+                                 dp]
+        # the generated functions and the re-initialisation, called from
+        # Python with raw addresses (see CCallbacks)
+        lib.acs_res.argtypes = [ctypes.c_double, vp, vp, vp, vp]
+        lib.acs_roots.argtypes = [ctypes.c_double, vp, vp, vp, vp]
+        lib.acs_jacs.argtypes = [ctypes.c_double, vp, vp, vp, vp, vp]
+        lib.acs_reinit.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_double, vp, vp, vp]
+        lib.acs_observe.argtypes = [ctypes.c_double, vp, vp, vp, vp]
+        lib.acs_init_newton.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_double, vp, vp,
+                                        ctypes.c_int, vp, vp, ctypes.c_int, vp, ctypes.c_int]
+        lib.acs_init_check.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_double, vp, vp,
+                                       ctypes.c_int, vp, vp]
+        self.n_fixed = sum(1 for nm in cm.var_names if cm.flat.variables[nm].start.fixed)
+        # the C observe serves the model's observe callback when it gives the
+        # same values (a sensitivity model observes their sensitivities too,
+        # which its C does not: its Python observe then serves)
+        n_obs = getattr(cm, "n_observed", len(cm.var_names))
+        self.n_obs = n_obs if lib.acs_has_observe() and lib.acs_n_observed() == n_obs else None
+        self.idle = {}
+        weakref.finalize(self, _free_idle, lib, self.idle)
+
+
+    # IDA handles of finished runs, by settings: every segment starts with
+    # IDAReInit (acs_start), so a later run of the model takes one over
+    # instead of creating SUNDIALS objects again
+    IDLE = 2   # kept per setting
+
+    def take(self, key):
+        idle = self.idle.get(key)
+        return idle.pop() if idle else None
+
+    def give(self, key, h):
+        idle = self.idle.setdefault(key, [])
+        if len(idle) < self.IDLE:
+            idle.append(h)
+        else:
+            self.lib.acs_free(ctypes.c_void_p(h))
+
+
+def _free_idle(lib, idle):
+    for handles in idle.values():
+        for h in handles:
+            lib.acs_free(ctypes.c_void_p(h))
+
+
+def library(cm):
+    """The compiled library of ``cm``, generated, built and loaded once."""
+    lib = _loaded.get(cm)
+    if lib is None:
+        lib = _loaded[cm] = _Library(cm)
+    return lib
+
+
+def _ptr(a, kind=ctypes.c_double):
+    return a.ctypes.data_as(ctypes.POINTER(kind))
+
+
+class CompiledSolver(SegmentSolver):
+    """A segment solver on the compiled library of ``cm``: one IDA handle
+    per run, re-initialised at each segment with that mode's discrete
+    values (``pd`` = parameters then discrete values)."""
+    name = "compiled"
+
+    def __init__(self, cm, p, opts):
+        self.cm, self.p = cm, np.asarray(p, float)
+        L = self.L = library(cm)
+        self.detail = "SUNDIALS IDA calling generated C" + (" (compiled now)" if L.built
+                                                              else " (from the cache)")
+        L.built = False
+        n = self.n = len(cm.dae.y)
+        self.nr = cm.n_roots
+        atol = np.ascontiguousarray(np.broadcast_to(np.asarray(opts["atol"], float), (n,)))
+        ident = np.zeros(n)
+        ident[:cm.dae.n_states] = 1.0
+        self.dirs = np.array([e.direction for e in cm.events] + [-1] * len(cm.assertions)
+                             or [0], dtype=np.intc)
+        self.terminal = [not e.observer for e in cm.events] + [True] * len(cm.assertions)
+        rtol, hmax = float(opts["rtol"]), float(opts.get("max_step") or 0.0)
+        key = (rtol, atol.tobytes(), hmax, int(opts["max_num_steps"]))
+        self.h = L.take(key) or L.lib.acs_new(n, self.nr, L.n_pd, rtol, _ptr(atol), _ptr(ident),
+                                              _ptr(self.dirs, ctypes.c_int), hmax, key[3])
+        if not self.h:
+            raise Unavailable("SUNDIALS refused the solver settings")
+        self._free = weakref.finalize(self, L.give, key, self.h)
+        self.troot = np.zeros(1)
+        self.yroot, self.yproot = np.zeros(n), np.zeros(n)
+        self.rootinfo = np.zeros(max(self.nr, 1), dtype=np.intc)
+        self.counters = np.zeros(3, dtype=np.int_)
+
+    def solve(self, cb, d, t, y, yp, tout, every_step):
+        L, n = self.L.lib, self.n
+        tout = np.ascontiguousarray(tout, dtype=float)
+        y0, yp0 = np.array(y, float), np.array(yp, float)
+        pd = np.concatenate([self.p, np.asarray(d, float)])
+        flag = L.acs_start(self.h, float(t), y0.ctypes.data, yp0.ctypes.data, pd.ctypes.data,
+                           float(tout[-1]))
+        if flag < 0:
+            return Segment(np.array([t]), y0[None], yp0[None], flag, self._message(flag))
+        # (a dense grid's buffer fills every 256 rows too: the guard then
+        # sees a limit or a stop request within a bounded time)
+        cap = 1024 if every_step else min(len(tout) + 1, 256)
+        T, Y, YP = [np.array([t])], [y0[None]], [yp0[None]]
+        roots, iout, nrows = [], ctypes.c_int(0), ctypes.c_int(0)
+        bt, by, byp = np.empty(cap), np.empty((cap, n)), np.empty((cap, n))
+        ptrs = (bt.ctypes.data, by.ctypes.data, byp.ctypes.data, cap, ctypes.byref(nrows),
+                self.troot.ctypes.data, self.yroot.ctypes.data, self.yproot.ctypes.data,
+                self.rootinfo.ctypes.data)
+        while True:
+            flag = L.acs_advance(self.h, tout.ctypes.data, len(tout), ctypes.byref(iout),
+                                 int(bool(every_step)), *ptrs)
+            k = nrows.value
+            if k:
+                T.append(bt[:k].copy()), Y.append(by[:k].copy()), YP.append(byp[:k].copy())
+            if flag == _FULL:
+                if self.guard is not None:
+                    L.acs_counters(self.h, self.counters.ctypes.data)
+                    if self.guard(int(self.counters[0])):
+                        flag = 0      # stopped: the rows so far are the segment
+                        break
+                continue
+            if flag != _ROOT:
+                break
+            fired = [i for i in range(self.nr) if self.rootinfo[i] != 0]
+            roots.append(Root(float(self.troot[0]), self.yroot.copy(), self.yproot.copy(),
+                              fired))
+            if any(self.terminal[i] for i in fired):
+                T.append(self.troot.copy()), Y.append(self.yroot[None].copy())
+                YP.append(self.yproot[None].copy())
+                break
+        L.acs_counters(self.h, self.counters.ctypes.data)
+        steps, nfev, njev = (int(c) for c in self.counters)
+        return Segment(np.concatenate(T), np.concatenate(Y), np.concatenate(YP),
+                       int(flag) if flag < 0 else (_ROOT if flag == _ROOT else 0),
+                       self._message(flag), roots, nfev, njev, steps)
+
+    def _message(self, flag):
+        if flag >= 0:
+            return "ok"
+        name = self.L.lib.acs_flag_name(flag)
+        return _MESSAGES.get(flag, "IDA failed") + (f" ({name.decode()})" if name else "")
+
+    def serve(self, model, p, d):
+        """Mode ``d``'s callbacks of ``model`` calling the compiled library;
+        its generated Python callbacks are made only if one of theirs is
+        called (the dense and sparse Jacobians, which IDA here takes from C)."""
+        return CCallbacks(library(model), model, p, d, lambda: model.callbacks(p, d))
+
+
+def _f64(a):
+    """``a`` as a C-contiguous float64 array (``a`` itself when it is one)."""
+    if type(a) is np.ndarray and a.dtype == np.float64 and a.flags.c_contiguous:
+        return a
+    return np.ascontiguousarray(a, dtype=float)
+
+
+def _into(fn, out, *args):
+    """Call ``fn(*args, address of out)``, through a temporary when ``out``
+    is not a C-contiguous float64 array."""
+    buf = _f64(out)
+    fn(*args, buf.ctypes.data)
+    if buf is not out:
+        out[...] = buf.reshape(np.shape(out))
+
+
+def _fixed_arrays(fixed):
+    """(indices, values) of the fixed starts ``fixed`` ((index, value, name)
+    triples) as the C initialisation takes them (one dummy entry when none)."""
+    return (np.array([k for k, _, _ in fixed] or [0], dtype=np.intc),
+            np.array([v for _, v, _ in fixed] or [0.0], dtype=float))
+
+
+class CCallbacks(tuple):
+    """The callbacks tuple of one mode (``cm.callbacks(p, d)``, same order
+    and signatures) with the residual, the root functions and the two
+    Jacobians ``jacs`` calling the compiled C instead of the generated
+    Python (the same expressions), for what the hybrid loop computes in
+    Python between segments: the initialisation, event actions and
+    re-initialisation. ``reinit(t, y, yp)`` is the re-initialisation in C
+    (``reinit.c``; :func:`acausal.initialize.reinitialize` calls it), or
+    None where the Python version must run; ``init_newton(t, z0,
+    guess_rows, fixed)`` the initialisation's Gauss-Newton in C (the same
+    return as :func:`acausal.initialize._newton`, or NotImplemented where the
+    Python version must run); ``init_check(t, z, fixed)`` the consistency
+    test of :func:`acausal.initialize._check` in C (True, False, or
+    NotImplemented where the Python test must run). The observed variables (``cb[4]``, an array
+    here) are C too unless one has no C form. ``make()`` returns the mode's
+    generated Python callbacks; it is called only when one of those runs."""
+
+    def __new__(cls, L, cm, p, d, make):
+        lib, n, ns = L.lib, len(cm.dae.y), cm.dae.n_states
+        pd = np.ascontiguousarray(np.concatenate([np.asarray(p, float),
+                                                  np.asarray(d, float)]))
+        pdp = pd.ctypes.data or 0
+
+        def res(t, y, yp, r):
+            y, yp = _f64(y), _f64(yp)
+            _into(lib.acs_res, r, t, y.ctypes.data, yp.ctypes.data, pdp)
+
+        def roots(t, y, yp, g):
+            y, yp = _f64(y), _f64(yp)
+            _into(lib.acs_roots, g, t, y.ctypes.data, yp.ctypes.data, pdp)
+
+        def jacs(t, y, yp, Jy, Jyp):
+            y, yp = _f64(y), _f64(yp)
+            jy = _f64(Jy)
+            _into(lib.acs_jacs, Jyp, t, y.ctypes.data, yp.ctypes.data, pdp, jy.ctypes.data)
+            if jy is not Jy:
+                Jy[...] = jy.reshape(np.shape(Jy))
+
+        def observe(t, y, yp):
+            y, yp = _f64(y), _f64(yp)
+            o = np.empty(L.n_obs)
+            lib.acs_observe(t, y.ctypes.data, yp.ctypes.data, pdp, o.ctypes.data)
+            return o
+
+        def init_newton(t, z0, guess_rows, fixed, max_iter=50):
+            if L.n_obs is None or len(fixed) != L.n_fixed:
+                return NotImplemented
+            z = np.array(z0, dtype=float)
+            fk, fv = _fixed_arrays(fixed)
+            gk = np.array(list(guess_rows) or [0], dtype=np.intc)
+            flag = lib.acs_init_newton(n, ns, float(t), z.ctypes.data, pdp, len(fixed),
+                                       fk.ctypes.data, fv.ctypes.data, len(guess_rows),
+                                       gk.ctypes.data, max_iter)
+            return z if flag == 0 else (None if flag == 1 else NotImplemented)
+
+        def init_check(t, z, fixed):
+            if L.n_obs is None or len(fixed) != L.n_fixed:
+                return NotImplemented
+            z = _f64(z)
+            fk, fv = _fixed_arrays(fixed)
+            ok = lib.acs_init_check(n, ns, float(t), z.ctypes.data, pdp, len(fixed),
+                                    fk.ctypes.data, fv.ctypes.data)
+            return NotImplemented if ok < 0 else bool(ok)
+
+        def reinit(t, y, yp):
+            y2, yp2 = np.array(y, dtype=float), np.array(yp, dtype=float)
+            flag = lib.acs_reinit(n, ns, float(t), y2.ctypes.data, yp2.ctypes.data, pdp)
+            return (y2, yp2) if flag == 0 else None
+
+        made = []
+
+        def python(k):   # the generated Python callback k, made on first use
+            def call(*args):
+                if not made:
+                    made.append(make())
+                return made[0][k](*args)
+            return call
+
+        obs = python(4) if L.n_obs is None else observe
+        # count: the step attempts the Python residual sees (none here)
+        self = super().__new__(cls, (res, python(1), roots, jacs, obs, [0, None], python(6)))
+        self.pd, self.reinit, self.init_newton = pd, reinit, init_newton
+        self.init_check = init_check
+        return self

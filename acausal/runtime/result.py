@@ -1,0 +1,160 @@
+"""Simulation results: every variable by dotted path, events, statistics."""
+import csv
+
+import numpy as np
+
+from ..errors import UnknownNameError
+
+
+class Result:
+    """What a simulation produced.
+
+    ``res["hook.phi"]`` is the time series of any variable (including those
+    eliminated as aliases), discrete value or parameter; ``res.t`` the time
+    points (requested output times plus both sides of every event);
+    ``res.events`` a list of ``(t, name)``; ``res.stats`` solver statistics.
+    """
+
+    def __init__(self, cm, p, t, y, yp, d, events, stats, status="ok", message=""):
+        self.model = cm
+        self.p = np.asarray(p, dtype=float)
+        self.t = np.asarray(t, dtype=float)
+        self.y = np.asarray(y, dtype=float)
+        self.yp = np.asarray(yp, dtype=float)
+        self.d = np.asarray(d, dtype=float)
+        self.events = events
+        self.stats = stats
+        self.status = status
+        self.message = message
+        self._obs = None
+        self.sensitivities = None   # acausal.sensitivity.Sensitivities of a run that asked
+
+    # -- access ----------------------------------------------------------------
+    @property
+    def names(self):
+        cm = self.model
+        return list(cm.var_names) + [d.symbol.name for d in cm.discretes]
+
+    def _observed(self):
+        if self._obs is None:
+            cm = self.model
+            cache = {}
+            out = np.empty((len(self.t), len(cm.var_names)))
+            for k in range(len(self.t)):
+                key = tuple(self.d[k]) if self.d.size else ()
+                cb = cache.get(key)
+                if cb is None:
+                    cb = cache[key] = cm.callbacks(self.p, list(key))
+                out[k] = cb[4](self.t[k], self.y[k], self.yp[k])
+            self._obs = out
+        return self._obs
+
+    def __getitem__(self, name):
+        cm = self.model
+        if name in ("time", "t"):
+            return self.t
+        try:
+            k = cm.var_names.index(name)
+        except ValueError:
+            k = None
+        if k is not None:
+            j = cm.y_column(name) if self._obs is None and self.y.ndim == 2 else None
+            return self.y[:, j] if j is not None else self._observed()[:, k]
+        for j, dsc in enumerate(cm.discretes):
+            if dsc.symbol.name == name:
+                return self.d[:, j]
+        for j, prm in enumerate(cm.params):
+            if prm.name == name:
+                return np.full(len(self.t), self.p[j])
+        raise UnknownNameError(f"no variable {name!r} in the result; try one of: "
+                       + ", ".join(self.names[:12]) + (" ..." if len(self.names) > 12 else ""))
+
+    def __contains__(self, name):
+        try:
+            self[name]
+            return True
+        except KeyError:
+            return False
+
+    def final(self):
+        """Every variable's value at the last time point (SI units)."""
+        obs = self._observed()[-1]
+        out = {n: float(v) for n, v in zip(self.model.var_names, obs)}
+        for j, dsc in enumerate(self.model.discretes):
+            out[dsc.symbol.name] = float(self.d[-1, j])
+        return out
+
+    def sensitivity(self, name, param):
+        """d(``name``)/d(``param``) at every ``res.t``: the forward sensitivity of
+        a variable (state, algebraic unknown or any observed variable) with
+        respect to a parameter named in ``simulate(sensitivities=[...])``, in
+        the variable's unit per the parameter's unit."""
+        return self._sens().of(name, param)
+
+    def event_sensitivity(self, param, name=None):
+        """d(event time)/d(``param``) of the events called ``name`` (all if
+        None), in the order of :meth:`event_times` (NaN for an event whose
+        time is not differentiable, a grazing root)."""
+        e = self._sens().event(param)
+        return np.array([v for (_, n), v in zip(self.events, e) if name is None or n == name])
+
+    def measure_sensitivity(self, fn, param):
+        """d fn(res) / d(``param``) of a measure ``fn`` (a function of a
+        result, as a model file's measures), from the sensitivities, with no
+        further simulation (:meth:`acausal.sensitivity.Sensitivities.measure`)."""
+        return self._sens().measure(self, fn, param)
+
+    def _sens(self):
+        if self.sensitivities is None:
+            from ..errors import UsageError
+            raise UsageError("this result has no sensitivities: simulate with "
+                             "sensitivities=[parameter names]")
+        return self.sensitivities
+
+    def event_times(self, name=None):
+        """Times of the events called ``name`` (all events if None)."""
+        return [t for t, n in self.events if name is None or n == name]
+
+    def at(self, name, t):
+        """Linear interpolation of a variable at time ``t``."""
+        return float(np.interp(t, self.t, self[name]))
+
+    def unit(self, name):
+        """The declared unit of a variable, discrete value or parameter
+        (``"s"`` for time); the values in the result are in this unit."""
+        cm = self.model
+        if name in ("time", "t"):
+            return "s"
+        info = cm.flat.variables.get(name)
+        if info is not None:
+            return info.unit
+        for dsc in cm.discretes:
+            if dsc.symbol.name == name:
+                return dsc.unit
+        for prm in cm.params:
+            if prm.name == name:
+                return prm.unit
+        raise UnknownNameError(f"no variable {name!r} in the result", variable=name)
+
+    # -- export --------------------------------------------------------------------
+    def to_csv(self, path, names=None):
+        """Write ``names`` (default: every variable and discrete value) as
+        columns after ``time``; headers carry units: ``hook.phi [rad]``."""
+        names = names or self.names
+        cols = [self[n] for n in names]
+        with open(path, "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(["time [s]"] + [f"{n} [{self.unit(n)}]" for n in names])
+            for k in range(len(self.t)):
+                w.writerow([repr(float(self.t[k]))] + [repr(float(c[k])) for c in cols])
+        return path
+
+    def plot(self, names=None, path=None, title=None):
+        """Stacked panels, one per variable (default: the states), labelled
+        with their units. Returns the figure."""
+        from ..viz.plot import plot_result, state_variables
+        return plot_result(self, names or state_variables(self.model), path, title)
+
+    def __repr__(self):
+        return (f"<Result {len(self.t)} points, t = {self.t[0]:g}..{self.t[-1]:g}, "
+                f"{len(self.events)} events, {self.status}>")

@@ -1,0 +1,321 @@
+"""The next experiment, computed: model-discrimination design.
+
+Given rival models that explain the data so far equally well, find the
+experiment (conditions within their declared ranges, and the signal to
+record) whose predicted outcomes differ most between the rivals, measured
+against the instrument's noise floor (Hunter and Reiner, "Designs for
+discriminating between two rival models", Technometrics 7 (1965); Box and
+Hill, "Discrimination among mechanistic models", Technometrics 9 (1967)).
+
+Criterion (Hunter-Reiner, with the rivals at their fitted parameters): for
+rivals a and b and a signal with floor sigma,
+
+    D_ab = sum over samples of ((y_a - y_b) / sigma)^2,
+
+the rise of chi^2 that the wrong rival would show (before refitting) if the
+other one were true. With more than two rivals the experiment maximises the
+smallest D over the pairs (it must split every pair). The *separation in
+floors* reported is sqrt(min D): the norm of the difference of predictions
+in noise-floor units (10 floors: the wrong rival's chi^2 rises by 100);
+``rms_floors`` is the same per sample.
+
+Search: a Latin hypercube over the conditions' ranges
+(``scipy.stats.qmc.LatinHypercube``), then a bounded Powell refinement
+(``scipy.optimize.minimize``) of log(min D) from the best few points. A
+rival that cannot predict an experiment (its simulation fails: it returns
+None) makes that experiment unusable.
+
+A rival is any callable conditions -> {signal: samples} (all rivals sample
+at the same times); :class:`ModelRival` makes one from a model file (or a
+(ModelFile, CompiledModel) pair) and a parameter set, through the public
+``CompiledModel.simulate`` and ``Result`` API.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from itertools import combinations
+from typing import Callable, Mapping, Sequence
+
+import numpy as np
+from scipy import optimize
+from scipy.stats import qmc
+
+from ..errors import AcausalError, UsageError
+from ..modelfile import compile_file, evaluate_measures
+
+Rival = Callable[[Mapping[str, float]], "Mapping[str, np.ndarray] | None"]
+
+
+@dataclass(frozen=True)
+class Condition:
+    """An experiment condition the experimenter can set: a model parameter
+    (an impact velocity, a start position) and its range [low, high]."""
+
+    name: str
+    low: float
+    high: float
+    unit: str = ""
+
+
+@dataclass(frozen=True)
+class Signal:
+    """A signal the instrument could record, with its noise floor (per-sample
+    standard deviation, the signal's units)."""
+
+    name: str
+    floor: float
+    unit: str = ""
+
+
+@dataclass(frozen=True)
+class NextExperiment:
+    """The computed next experiment.
+
+    ``conditions``: name -> value; ``signal``: what to record;
+    ``separation``: sqrt of the smallest pairwise D (noise floors, see the
+    module docstring) at that experiment; ``rms_floors``: the same per
+    sample; ``closest_pair``: the two rivals that are hardest to split there;
+    ``pairwise``: "a | b" -> separation of every pair; ``predictions``:
+    rival -> predicted samples of ``signal``; ``baseline``: the smallest
+    separation at the reference conditions (``reference`` of
+    :func:`design_experiment`; None if not given); ``decisive``: the
+    separation reaches ``min_separation`` of :func:`design_experiment`, else
+    ``message`` says that no experiment in the declared ranges splits them;
+    ``times``: the sample times of the predictions, when given."""
+
+    conditions: dict
+    signal: str
+    separation: float
+    rms_floors: float
+    closest_pair: tuple
+    pairwise: dict
+    predictions: dict
+    n_evaluations: int
+    baseline: float | None = None
+    decisive: bool = True
+    message: str = ""
+    times: np.ndarray | None = None
+
+    def to_dict(self) -> dict:
+        """JSON-ready (the diagnosis's ``next_experiment`` key)."""
+        return dict(conditions={k: float(v) for k, v in self.conditions.items()},
+                    signal=self.signal, separation_floors=float(self.separation),
+                    rms_floors=float(self.rms_floors), closest_pair=list(self.closest_pair),
+                    pairwise={k: float(v) for k, v in self.pairwise.items()},
+                    predictions={k: np.asarray(v, float).tolist()
+                                 for k, v in self.predictions.items()},
+                    n_evaluations=self.n_evaluations,
+                    baseline_floors=None if self.baseline is None else float(self.baseline),
+                    decisive=self.decisive, message=self.message,
+                    times=None if self.times is None else np.asarray(self.times).tolist())
+
+
+def conditions_of(modelfile) -> list:
+    """The :class:`Condition` list a model file declares (its ``conditions``)."""
+    out = []
+    for n, (lo, hi, unit) in modelfile.conditions.items():
+        if lo is None:
+            raise UsageError(f"{modelfile.path}: condition {n!r} has no range; declare "
+                             f"conditions = {{{n!r}: (low, high, unit)}} to search it")
+        out.append(Condition(n, lo, hi, unit))
+    return out
+
+
+@dataclass(frozen=True)
+class _Score:
+    """Separation of one experiment: the best signal's smallest pairwise D."""
+
+    d2: float
+    signal: str | None
+    pairwise: dict
+    predictions: dict
+
+
+def score(predictions: Mapping[str, Mapping[str, np.ndarray] | None],
+          signals: Sequence[Signal]) -> _Score:
+    """The Hunter-Reiner score of one experiment from each rival's predicted
+    signals: for each signal the smallest pairwise D (sum of squared
+    differences over floor^2), and the signal where it is largest."""
+    names = list(predictions)
+    if len(names) < 2:
+        raise UsageError("experiment design needs at least two rival models")
+    if any(p is None for p in predictions.values()):
+        return _Score(-math.inf, None, {}, {})
+    best = _Score(-math.inf, None, {}, {})
+    for sig in signals:
+        ys = {n: np.asarray(predictions[n][sig.name], float) for n in names}
+        pair = {f"{a} | {b}": float(np.sum(((ys[a] - ys[b]) / sig.floor) ** 2))
+                for a, b in combinations(names, 2)}
+        d2 = min(pair.values())
+        if np.isfinite(d2) and d2 > best.d2:
+            best = _Score(d2, sig.name, pair, ys)
+    return best
+
+
+class _Evaluator:
+    """Every rival at one experiment (unit-cube coordinates), cached."""
+
+    def __init__(self, rivals, conditions, signals, fixed):
+        self.rivals, self.conds, self.signals = dict(rivals), list(conditions), list(signals)
+        self.fixed = dict(fixed or {})
+        self.lo = np.array([c.low for c in self.conds], float)
+        self.span = np.array([c.high - c.low for c in self.conds], float)
+        self.cache, self.n = {}, 0
+
+    def values(self, unit) -> dict:
+        x = self.lo + np.clip(unit, 0.0, 1.0) * self.span
+        return {**self.fixed, **{c.name: float(v) for c, v in zip(self.conds, x)}}
+
+    def __call__(self, unit) -> _Score:
+        key = tuple(np.round(np.clip(unit, 0.0, 1.0), 12))
+        if key not in self.cache:
+            self.n += 1
+            cond = self.values(np.array(key))
+            self.cache[key] = score({n: r(cond) for n, r in self.rivals.items()}, self.signals)
+        return self.cache[key]
+
+    def loss(self, unit) -> float:
+        """-log(1 + min D): smooth enough for Powell, finite where a rival fails."""
+        s = self(unit)
+        return -math.log1p(s.d2) if np.isfinite(s.d2) else 1e3
+
+
+@dataclass(frozen=True)
+class Search:
+    """How the conditions' ranges are searched: a Latin hypercube of
+    ``n_initial`` points (default 8 per condition, at least 12), then a
+    bounded Powell search from the ``n_refine`` best, each of at most
+    ``max_refine_evals`` evaluations; ``seed`` of the hypercube."""
+
+    n_initial: int | None = None
+    n_refine: int = 3
+    max_refine_evals: int = 60
+    seed: int = 0
+
+
+def design_experiment(rivals: Mapping[str, Rival], conditions: Sequence[Condition],
+                      signals: Sequence[Signal], *, fixed: Mapping[str, float] | None = None,
+                      reference: Mapping[str, float] | None = None, search: Search = Search(),
+                      min_separation: float = 3.0, times=None) -> NextExperiment:
+    """The experiment within the conditions' ranges whose predicted outcomes
+    differ most between ``rivals`` (name -> callable conditions -> {signal:
+    samples}, or None when it cannot predict), in noise floors of the best of
+    ``signals``. ``fixed``: further parameter settings passed to every rival
+    unchanged. ``reference``: the conditions of the data so far (its
+    separation is reported as ``baseline``). ``search``: :class:`Search`.
+    ``min_separation`` [floors]: below it the result is not ``decisive``
+    (3 floors: the wrong rival's chi^2 rises by 9, p = 0.003 for one degree
+    of freedom). ``times``: the rivals' sample times, kept in the result for
+    its plot."""
+    conds = list(conditions)
+    if not conds:
+        raise UsageError("no experiment conditions to search (declare `conditions` "
+                         "with their ranges in the model file)")
+    ev = _Evaluator(rivals, conds, signals, fixed)
+    n0 = search.n_initial or max(12, 8 * len(conds))
+    pts = qmc.LatinHypercube(d=len(conds), seed=search.seed).random(n0)
+    pts = np.vstack([np.full(len(conds), 0.5), pts])
+    scored = sorted(pts, key=ev.loss)
+    for start in scored[:search.n_refine]:
+        if not np.isfinite(ev(start).d2):
+            continue
+        optimize.minimize(ev.loss, start, method="Powell", bounds=[(0.0, 1.0)] * len(conds),
+                          options=dict(maxfev=search.max_refine_evals, xtol=1e-3, ftol=1e-4))
+    best_key = max(ev.cache, key=lambda k: ev.cache[k].d2)
+    best = ev.cache[best_key]
+    if best.signal is None:
+        raise AcausalError("experiment design: no experiment in the declared ranges could be "
+                           "predicted by every rival model")
+    base = None
+    if reference is not None:
+        ref = score({n: r({**ev.fixed, **reference}) for n, r in ev.rivals.items()},
+                    ev.signals)
+        base = math.sqrt(max(ref.d2, 0.0)) if np.isfinite(ref.d2) else None
+    return _result(ev, best_key, best, base, min_separation, times)
+
+
+def _result(ev: _Evaluator, key, best: _Score, base, min_separation, times) -> NextExperiment:
+    pair = min(best.pairwise, key=best.pairwise.get)
+    n_samples = max(np.asarray(next(iter(best.predictions.values()))).size, 1)
+    vals = ev.values(np.array(key))
+    cond = {c.name: vals[c.name] for c in ev.conds}
+    sep = math.sqrt(best.d2)
+    decisive = sep >= min_separation
+    message = "" if decisive else (
+        f"no experiment within the declared ranges of {', '.join(c.name for c in ev.conds)} "
+        f"separates {pair} by more than {sep:.3g} noise floors (needs {min_separation:g}): "
+        "declare other conditions (a start state, a load, a reversal of the motion)")
+    return NextExperiment(cond, best.signal, sep, math.sqrt(best.d2 / n_samples),
+                          tuple(pair.split(" | ")),
+                          {k: math.sqrt(v) for k, v in best.pairwise.items()},
+                          best.predictions, ev.n, base, decisive, message,
+                          None if times is None else np.asarray(times, float))
+
+
+def plot_next_experiment(nxt: NextExperiment, path=None, title=None):
+    """Each rival's predicted signal at the computed experiment (against the
+    sample times when known, else the sample index), with the separation in
+    the title. Returns the matplotlib figure; writes it to ``path`` if given."""
+    from matplotlib.figure import Figure
+    fig = Figure(figsize=(7, 3.2))
+    ax = fig.subplots()
+    for name, y in nxt.predictions.items():
+        y = np.asarray(y, float)
+        x = nxt.times if nxt.times is not None and len(nxt.times) == y.size else np.arange(y.size)
+        ax.plot(x, y, lw=1.2, marker="o" if y.size < 3 else None, label=name)
+    ax.set_xlabel("time [s]" if nxt.times is not None else "sample")
+    ax.set_ylabel(nxt.signal)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    cond = ", ".join(f"{k} = {v:.4g}" for k, v in nxt.conditions.items())
+    ax.set_title(title or f"next experiment: {cond}; {nxt.separation:.3g} floors apart",
+                 fontsize=9)
+    fig.tight_layout()
+    if path:
+        fig.savefig(path, dpi=120)
+    return fig
+
+
+def signals_of(dataset, names: Sequence[str]) -> list:
+    """:class:`Signal` list for ``names`` with the floors of a dataset's
+    instrument (``acausal.data.Dataset``; a signal it does not describe is
+    an error: its floor would be a guess)."""
+    out = []
+    for n in names:
+        inst = dataset.instrument.get(n)
+        if inst is None or not inst.floor() > 0:
+            raise AcausalError(f"experiment design: the instrument description has no noise "
+                               f"floor for {n!r} (instrument.csv)")
+        out.append(Signal(n, float(inst.floor())))
+    return out
+
+
+class ModelRival:
+    """A rival from a model file (path or (ModelFile, CompiledModel) pair)
+    and its fitted parameters: conditions -> {signal: samples at ``times``}
+    by ``CompiledModel.simulate`` (the model file's run options, ``t_end``
+    at least the last sample time) and linear interpolation of the
+    ``Result``; a signal that is one of the model file's ``measures`` (a
+    response time) is that scalar, one sample. A run that fails (an
+    AcausalError) predicts nothing (None)."""
+
+    def __init__(self, model, params: Mapping[str, float], signals: Sequence[str],
+                 times: np.ndarray, options: Mapping | None = None):
+        self.mf, self.cm = model if isinstance(model, tuple) else compile_file(model)
+        self.params, self.signals = dict(params), list(signals)
+        self.times = np.asarray(times, float)
+        self.options = dict(options or {})
+
+    def __call__(self, conditions: Mapping[str, float]):
+        opts = self.mf.experiment.run_options()
+        opts.update(self.options)
+        opts["t_end"] = max(float(opts.get("t_end") or 0.0), float(self.times[-1]))
+        try:
+            res = self.cm.simulate(params={**self.params, **conditions}, **opts)
+            measures = [s for s in self.signals if s in self.mf.measures]
+            scalars = evaluate_measures(self.mf, res) if measures else {}
+            return {s: np.atleast_1d(scalars[s]) if s in scalars
+                    else np.interp(self.times, res.t, res[s]) for s in self.signals}
+        except AcausalError:
+            return None

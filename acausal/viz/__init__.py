@@ -1,0 +1,1 @@
+"""Pictures: result plots (:mod:`.plot`) and planar animations (:mod:`.animate`)."""
