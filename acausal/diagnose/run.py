@@ -167,7 +167,6 @@ def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
     from .report.markdown import write_report
     write_report(out_dir, d, plots=plots)
     out = summary(d)
-    out["notes"] = list(getattr(d.dataset, "notes", []))
     (out_dir / "diagnosis.json").write_text(json.dumps(out, indent=1))
     (out_dir / "candidates.json").write_text(json.dumps(details(d), indent=1))
     if store is not None:

@@ -72,13 +72,19 @@ def test_an_interrupted_simulation_writes_its_partial_result(tmp_path, sig, step
     solver call too) and --out/--json get the rows up to there, exit 130."""
     model = tmp_path / "spring.py"
     model.write_text(LONG_SPRING.format(step=step))
-    out = tmp_path / "o.csv"
-    proc = h.cli(["simulate", model, "--backend", backend, "--out", out, "--json",
-                  "--max-rows", "1e8", "--max-memory", "2GB"], h.env(tmp_path / "log"))
-    time.sleep(6.0 if backend == "sundae" else 8.0)
-    assert proc.poll() is None, proc.communicate()
-    proc.send_signal(sig)
-    stdout, stderr = proc.communicate(timeout=60)
+    out, err = tmp_path / "o.csv", tmp_path / "stderr.txt"
+    with open(err, "w") as f:
+        proc = subprocess.Popen([sys.executable, "-m", "acausal.cli", "simulate", str(model),
+                                 "--backend", backend, "--out", str(out), "--json",
+                                 "--max-rows", "1e8", "--max-memory", "2GB", "--progress"],
+                                env=h.env(tmp_path / "log"), stdout=subprocess.PIPE,
+                                stderr=f, text=True)
+        # the progress bar shows once the run has lasted 2 s: it is running
+        h.wait_for(lambda: "simulate:" in err.read_text(), proc)
+        time.sleep(1.0)
+        proc.send_signal(sig)
+        stdout, _ = proc.communicate(timeout=60)
+    stderr = err.read_text()
     assert proc.returncode == 130, stderr
     assert "Traceback" not in stderr
     assert f"by an interruption ({signal.Signals(sig).name})" in stderr
