@@ -936,6 +936,10 @@ def tolerance(file, spec, n, sampling, seed, measures, out, plot_prefix, json_pa
             if json_path:
                 with open(json_path, "w", encoding="utf-8") as f:
                     json.dump(tol.summary_json(res), f, indent=1)
+    except tol.SpecError as exc:                # one line per bad row of the spec
+        for line in exc.lines:
+            click.echo(f"acausal: error: {_one_line(line)}", err=True)
+        sys.exit(2)
     except (AcausalError, click.BadParameter) as exc:
         _fail(exc)
     for line in tol.report_lines(res, lambda m, v: show_measure(mf, m, v)):
