@@ -411,9 +411,12 @@ def summarize(design: Design, values: Mapping[str, np.ndarray], status: np.ndarr
              "percentiles": {p: float(np.percentile(yo, p)) if len(yo) else math.nan
                              for p in PERCENTILES}}
         yy = np.where(ok, y, np.nan)
-        reg = regression_shares(design.X, yy)
+        # Saltelli's AB_i rows repeat A's and B's columns: the given-data
+        # estimates use the independent rows only (A and B)
+        rows = slice(0, 2 * design.n) if design.saltelli else slice(None)
+        reg = regression_shares(design.X[rows], yy[rows])
         s.update(src=reg["src"], slope=reg["slope"], r2=reg["r2"],
-                 eta2=correlation_ratios(design.X, yy))
+                 eta2=correlation_ratios(design.X[rows], yy[rows]))
         if design.saltelli:
             idx = sobol_indices(yy, design.n, d)
             s.update(S1=idx["S1"], ST=idx["ST"], used=idx["used"])
