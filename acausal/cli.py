@@ -1,4 +1,5 @@
-"""The ``acausal`` command: simulate, animate, variables, calibrate, sweep, tolerance, diagnose.
+"""The ``acausal`` command: simulate, animate, variables, linearize, calibrate, sweep,
+tolerance, diagnose, fmu.
 
 Exit codes: 0 success, 2 a model or input error (an AcausalError, a bad
 option value, a budget that refuses the work before it starts: one readable
@@ -547,6 +548,70 @@ def variables(file):
 
 @main.command()
 @click.argument("file", type=click.Path(dir_okay=False))
+@click.option("--at", "at", default="start", show_default=True,
+              metavar="start|equilibrium|T|STATE=V,...",
+              help="operating point: the consistent start, the static equilibrium (trim), "
+                   "the state reached at time T [s], or these states' values "
+                   "(e.g. rev.phi=-1.5708,rev.w=0)")
+@click.option("--inputs", default="", metavar="U1,U2,...",
+              help="free parameters to take as inputs (B and D columns)")
+@click.option("--outputs", default="", metavar="Y1,Y2,...",
+              help="variables to take as outputs (C and D rows; default: the states)")
+@click.option("--set", "sets", multiple=True, metavar="PATH=VALUE",
+              help="override a parameter or fixed start value, e.g. --set damper.d=0.2")
+@click.option("--out", type=click.Path(dir_okay=False),
+              help="write A, B, C, D, the names, the point and the eigenvalues "
+                   "(.json or .npz)")
+@click.option("--json", "as_json", is_flag=True, help="print one JSON object")
+def linearize(file, at, inputs, outputs, sets, out, as_json):
+    """Linearise a model file: A, B, C, D and the eigenvalues of A."""
+    from .analysis import linearize as lin_
+    from .modelfile import compile_file
+    try:
+        params = _parse_sets(sets)
+        mf, cm = compile_file(file)
+        point = _parse_at(at)
+        lin = lin_(cm, at=point, inputs=inputs, outputs=outputs, params=params,
+                   t=mf.experiment.t0 if not isinstance(point, float) else None,
+                   rtol=mf.experiment.rtol, atol=mf.experiment.atol)
+        if out:
+            lin.save(out)
+    except (AcausalError, click.BadParameter) as exc:
+        if as_json:
+            click.echo(json.dumps({"error": _error_dict(exc)}, indent=1))
+        _fail(exc)
+    if as_json:
+        click.echo(json.dumps(lin.as_dict(), indent=1))
+    else:
+        click.echo(str(lin))
+    if out:
+        click.echo(f"wrote {out}", err=as_json)
+
+
+def _parse_at(text):
+    """``--at``: 'start', 'equilibrium', a time [s] or NAME=VALUE pairs."""
+    text = text.strip()
+    if text in ("start", "equilibrium"):
+        return text
+    if "=" not in text:
+        try:
+            return float(text)
+        except ValueError:
+            raise UsageError(f"--at {text!r}: expected start, equilibrium, a time [s] or "
+                             "STATE=VALUE,...") from None
+    out = {}
+    for item in (x.strip() for x in text.split(",") if x.strip()):
+        name, _, value = item.partition("=")
+        try:
+            out[name.strip()] = float(value)
+        except ValueError:
+            raise UsageError(f"--at {item!r}: {value!r} is not a number",
+                             variable=name.strip()) from None
+    return out
+
+
+@main.command()
+@click.argument("file", type=click.Path(dir_okay=False))
 @click.argument("data", type=click.Path(file_okay=False))
 @click.option("--fit", required=True, metavar="P1,P2,...",
               help="parameters to fit; with --method report give PARAM:MEASURE pairs "
@@ -1091,6 +1156,32 @@ def diagnose(file, data, json_path, report_dir, scheduler, workers, max_wall, ma
     if out["extended_model"]:
         click.echo(f"extended model: {out['extended_model']}")
     click.echo(f"report: {report_dir}/report.md" + (f"; JSON: {json_path}" if json_path else ""))
+
+
+@main.command()
+@click.argument("file", type=click.Path(dir_okay=False))
+@click.option("-o", "--out", required=True, type=click.Path(dir_okay=False),
+              help="the FMU to write (.fmu)")
+@click.option("--output", "outputs", multiple=True, metavar="NAME",
+              help="a variable exported as an output (repeat for more); the model file's "
+                   "measures are outputs too")
+@click.option("--input", "inputs", multiple=True, metavar="PARAMETER",
+              help="a free parameter the importer drives as an input, held over each "
+                   "communication step (repeat for more)")
+@click.option("--measures/--no-measures", default=True,
+              help="export the model file's measures as outputs (default: yes)")
+@click.option("--fmu-backend", type=click.Choice(["sundae", "compiled"]),
+              help="the integrator inside the FMU (default: the library's, or "
+                   "ACAUSAL_BACKEND where it runs)")
+def fmu(file, out, outputs, inputs, measures, fmu_backend):
+    """Export a model file as an FMU (FMI 2.0 Co-Simulation)."""
+    from .interop.fmu import export_fmu
+    try:
+        path = export_fmu(file, out, outputs=outputs, inputs=inputs, measures=measures,
+                          backend=fmu_backend)
+    except AcausalError as exc:
+        _fail(exc)
+    click.echo(f"wrote {path}")
 
 
 if __name__ == "__main__":  # pragma: no cover

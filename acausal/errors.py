@@ -14,6 +14,7 @@ Hierarchy::
         ModelFileError                a model file could not be loaded
       DataError                       a measured-data file is wrong (file:line, column)
       CalibrationError                a calibration cannot be carried out
+      AnalysisError                   a linearisation or trim cannot be carried out
       DiagnosisError                  a diagnosis cannot be carried out
       SolverError                     the integrator failed (t, component, result)
         ChatteringError               too many events in a tiny window
@@ -151,6 +152,12 @@ class CalibrationError(AcausalError):
 
 class DiagnosisError(AcausalError):
     """The diagnosis could not be carried out (bad data, no fit, ...)."""
+
+
+class AnalysisError(AcausalError):
+    """A linearisation or trim cannot be carried out: an operating point
+    that is not consistent, a name that is not an input, state or output,
+    no static equilibrium (:mod:`acausal.analysis`)."""
 
 
 class UsageError(AcausalError):

@@ -9,9 +9,11 @@ from dataclasses import dataclass, field
 import sympy as sp
 
 from ..lang.component import Model
-from ..lang.declare import Discrete, Parameter, Start, Variable
+from ..lang.connectors import SignalPort
+from ..lang.declare import Discrete, Parameter, Start, TimeEvent, Variable
 from ..errors import ConnectionError_, ModelError
 from ..lang.symbols import base_and_order, time
+from .timeevents import find_time_switches
 
 
 @dataclass
@@ -34,6 +36,7 @@ class VarInfo:
     desc: str
     owner: str
     port: bool = False     # a connector variable
+    internal: bool = False  # made by the compiler (a time switch), not declared
     unit_declared: bool = True   # False: no unit was given (not checked)
 
 
@@ -57,6 +60,8 @@ class Flat:
     assertions: list = field(default_factory=list)
     unconnected: list = field(default_factory=list)  # port paths
     owners: dict = field(default_factory=dict)      # component path -> class name
+    time_switches: list = field(default_factory=list)  # compiler/timeevents.TimeSwitch
+    time_events: list = field(default_factory=list)    # lang.declare.TimeEvent
 
     def owner_of(self, sym):
         """Component path owning a variable/parameter symbol."""
@@ -84,6 +89,7 @@ def flatten(model):
     for comp in comps:
         _equations(flat, comp, known)
     _connections(flat, model, comps)
+    flat.time_switches = find_time_switches(flat)
     return flat
 
 
@@ -102,6 +108,11 @@ def _declare(flat, comp):
                                                unit_declared=d.unit_declared)
     for name, ctype in comp.connectors().items():
         port = comp.port(name)
+        if isinstance(port, SignalPort):
+            sym = port.symbol
+            flat.variables[sym.name] = VarInfo(sym, Start(0.0, False), ctype.unit, ctype.desc,
+                                               path, True, unit_declared=ctype.unit_declared)
+            continue
         for decls, syms in zip(ctype.pairs(), port.pairs()):
             for (vname, unit, desc), sym in zip(decls, syms):
                 flat.variables[sym.name] = VarInfo(sym, Start(0.0, False), unit, desc, path,
@@ -175,6 +186,9 @@ def _equations(flat, comp, known):
         flat.equations.append(Equation(expr, path, f"equation {i + 1} ({type(comp).__name__})"))
     for ev in comp.gather("events"):
         ev.owner = path
+        if isinstance(ev, TimeEvent):
+            flat.time_events.append(ev)
+            continue
         ev.expr = relocate(ev.expr, comp, known)
         flat.events.append(ev)
     for a in comp.gather("assertions"):
@@ -223,16 +237,21 @@ def _connections(flat, model, comps):
     sets = {}
     for port in parent:
         sets.setdefault(find(port), []).append(port)
+    dangling = []
     for members in sets.values():
-        if len(members) == 1 and members[0].ctype.optional:
-            for _, through in members[0].pairs():   # unconnected optional: no force
-                flat.equations.append(Equation(through, members[0].path,
-                                               "unconnected optional connector"))
+        members.sort(key=lambda p: p.path)
+        if isinstance(members[0], SignalPort):
+            dangling += _signal_node(flat, members)
             continue
         if len(members) == 1:
-            flat.unconnected.append(members[0].path)
+            # Modelica's rule: an unconnected connector's through variables
+            # are zero; the check lists it (flat.unconnected), it is no error
+            for _, through in members[0].pairs():
+                flat.equations.append(Equation(through, members[0].path,
+                                               "unconnected connector (no force)"))
+            if not members[0].ctype.optional:
+                flat.unconnected.append(members[0].path)
             continue
-        members.sort(key=lambda p: p.path)
         where = "connect(" + ", ".join(p.path for p in members) + ")"
         for k, (a0, _) in enumerate(members[0].pairs()):
             for p in members[1:]:
@@ -240,3 +259,31 @@ def _connections(flat, model, comps):
                                                "connection (across equal)"))
             flat.equations.append(Equation(sp.Add(*[p.pairs()[k][1] for p in members]),
                                            where, "connection (through sum to zero)"))
+    if dangling:
+        dangling.sort()
+        if len(dangling) == 1:
+            msg = (f"{dangling[0]}: input not connected (connect it to an output, e.g. a "
+                   "signal source's y)")
+        else:
+            msg = "inputs not connected: " + ", ".join(dangling) + \
+                " (connect each to an output, e.g. a signal source's y)"
+        raise ConnectionError_(msg, component=dangling[0])
+
+
+def _signal_node(flat, members):
+    """Equations of a node of signal connectors: every input equals the one
+    output. Returns the inputs of a node without an output (not connected)."""
+    outputs = [p for p in members if p.causality == "output"]
+    inputs = [p for p in members if p.causality == "input"]
+    if len(outputs) > 1:
+        raise ConnectionError_(
+            f"outputs {outputs[0].path} and {outputs[1].path} are connected to each other: "
+            "a signal has one source (connect an output to inputs only)",
+            component=outputs[1].path)
+    if not outputs:
+        return [p.path for p in inputs]
+    out = outputs[0].symbol
+    where = "connect(" + ", ".join(p.path for p in members) + ")"
+    for p in inputs:
+        flat.equations.append(Equation(p.symbol - out, where, "connection (input = output)"))
+    return []

@@ -118,8 +118,6 @@ class CompiledModel:
         clock.lap("structure")
         self.dae = build_dae(g, dummies, set(self.param_syms), values)
         clock.lap("causalize")
-        if not self.dae.y:
-            raise ModelError(_nothing_to_integrate(flat))
         self._subs = dict(red.param_subs)
         self._alias = red.subs
         observed = self.observed_exprs()

@@ -122,8 +122,9 @@ def check_structure(equations, unknowns, flat):
         involved = [p for p in flat.unconnected
                     if any(p.startswith(o + ".") or p == o for o in owners if o)]
         if flat.unconnected:
-            lines.append("unconnected connectors (each needs a connection, or a component "
-                         "that sets its force/torque): " + ", ".join(involved or flat.unconnected))
+            lines.append("unconnected connectors (their force/torque is zero; connect them "
+                         "if something should act there): "
+                         + ", ".join(involved or flat.unconnected))
     raise StructuralError("\n".join(lines), excess=[equations[i] for i in excess],
                           missing=[unknowns[j] for j in missing])
 

@@ -85,6 +85,11 @@ class Component:
                     f"{type(self).__name__} {self.path or '(top)'} has no parameter or "
                     f"variable {key!r}; it has: {valid}", component=self.path, variable=key)
             if isinstance(d, Parameter):
+                if d.final:
+                    raise ParameterError(
+                        f"{type(self).__name__} {self.path or ''}: parameter {key!r} is "
+                        f"computed ({d.desc}); set the parameters it is computed from",
+                        component=self.path, variable=key)
                 self._values[key] = d.check(value, self.path or type(self).__name__)
             elif isinstance(d, Variable):
                 start = value if isinstance(value, Start) else Start(value, True)
@@ -96,8 +101,35 @@ class Component:
         return self
 
     def value(self, name):
-        """The value given to a parameter (number, expression or choice)."""
-        return self._values[name]
+        """The value given to a parameter (number, expression or choice).
+        A parameter left at a default that is a function of the component
+        (``Parameter(lambda c: ..., ...)``: a derived parameter, or one
+        taken from an :meth:`outer` component) is that function's value now;
+        the compiler asks when it flattens the model, when every path is
+        final."""
+        v = self._values[name]
+        if callable(v) and not isinstance(v, sp.Basic):
+            v = v(self)
+        return v
+
+    def outer(self, kind):
+        """The component of class ``kind`` that an enclosing model declares,
+        as Modelica's ``inner``/``outer``: the nearest one (among this
+        component's siblings, then its parent's siblings, ...), or None when
+        no enclosing model has one. Two in one model is a
+        :class:`~acausal.errors.ModelError` (which one is meant?)."""
+        node = self._parent
+        while node is not None:
+            hits = [c for c in node._children.values() if isinstance(c, kind) and c is not self]
+            if len(hits) > 1:
+                raise ModelError(
+                    f"{node.path or 'the model'} has {len(hits)} {kind.__name__} components "
+                    f"({', '.join(c.path for c in hits)}); {self.path} needs exactly one",
+                    component=self.path)
+            if hits:
+                return hits[0]
+            node = node._parent
+        return None
 
     def start(self, name):
         return self._starts[name]
@@ -118,7 +150,7 @@ class Component:
         port = self._ports.get(name)
         if port is None:
             ctype = self.connectors()[name]
-            port = self._ports[name] = Port(self, name, ctype)
+            port = self._ports[name] = ctype.make_port(self, name)
         return port
 
     # -- behaviour (overridden by subclasses) --------------------------------

@@ -41,13 +41,23 @@ class Parameter(Declaration):
     ``max_open`` make a bound strict). A ``structural`` parameter (a choice of
     law, a flag) is baked into the generated code: changing it recompiles.
     Its value is read as a plain Python value, not a symbol.
+
+    ``default`` may be a function of the component, evaluated when the
+    model is flattened (:meth:`acausal.lang.Component.value`): a derived
+    parameter (a body's mass from its dimensions and density) or one taken
+    from an enclosing component (a body's gravity from the world's,
+    :meth:`acausal.lang.Component.outer`). Its value is then an expression
+    of other parameters, which a run cannot set on its own. ``final``: a
+    derived parameter that cannot be given a value (Modelica's ``final``).
     """
 
     kind = "parameter"
 
     def __init__(self, default, unit=None, desc="", *, min=None, max=None,
-                 min_open=False, max_open=False, structural=False, choices=None):
+                 min_open=False, max_open=False, structural=False, choices=None,
+                 final=False):
         super().__init__(unit, desc)
+        self.final = final
         self.default = default
         self.min, self.max = min, max
         self.min_open, self.max_open = min_open, max_open
@@ -165,6 +175,32 @@ class Event:
         self.terminal = terminal
         self.recheck = recheck
         self.observer = observer
+        self.log = log
+        self.owner = None  # set by flattening: the component path
+
+
+class TimeEvent:
+    r"""Events at instants known without integrating (a table's breakpoints,
+    a clock), which a component returns from ``events()`` beside its
+    :class:`Event`\ s. The integrator stops exactly at each one (IDA's stop
+    time, not a root search) and the hybrid loop runs ``action``.
+
+    ``next_time(state)``: the first instant of this event strictly after
+    ``state.t`` [s] (``math.inf`` for none); it may read parameters and
+    discrete values (``state[symbol]``), not variables.
+    ``action(state)``: sets the discrete values (``state[d] = v``) for the
+    interval that begins at ``state.t``; it runs at the start of a run (to
+    set them for the first interval; variables cannot be read there) and
+    at each of this event's instants (recorded in ``res.events`` under
+    ``name`` unless ``log=False``).
+    """
+
+    def __init__(self, name, next_time, action, *, log=True):
+        if not callable(next_time) or not callable(action):
+            raise ModelError(f"time event {name}: next_time and action must be functions")
+        self.name = name
+        self.next_time = next_time
+        self.action = action
         self.log = log
         self.owner = None  # set by flattening: the component path
 

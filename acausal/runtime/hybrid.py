@@ -21,6 +21,7 @@ from ..errors import ChatteringError, Interrupted, LimitError, OutputGridError, 
 from .events import EventState
 from .initialize import ask_components, initial_point, reinitialize, suspect_parameters
 from .result import Result
+from .timeevents import TimeSchedule
 
 CHATTER_COUNT = 100     # this many firings of one event (root) ...
 CHATTER_SPAN = 1e-9     # ... within this fraction of the time span is chattering
@@ -296,6 +297,8 @@ def _start(cm, t0, t_end, params, rtol, atol, atol_algebraic, max_step, max_step
         model = sensitivity_model(cm, sensitivities)
         atol = model.atol(atol, p)
     run = _Run(model, p, t0, t_end, rtol, atol, max_step, max_steps, backend, linsolver)
+    run.schedule = TimeSchedule(cm, p, t0, t_end)
+    d, _ = run.schedule.update(t0, d, start=True)   # the time switches' values at t0
     cb = run.serve(cm, d) if sensitivities else run.callbacks(d)
     run.cb_d = list(d)
     y, yp = initial_point(cm, p, d, cb, t0, starts)
@@ -307,13 +310,19 @@ def _start(cm, t0, t_end, params, rtol, atol, atol_algebraic, max_step, max_step
     return run, y, yp, d, cb, stop
 
 
-def _integrate(run, watch, cb, t, y, yp, d, stop, tout, output_step):
+def _integrate(run, watch, cb, t, y, yp, d, stop, tout, output_step, t_stop=None):
     """The hybrid loop: segments between events (each ends at a terminal
     root, the end or a window of the watch), observer roots, event actions
-    with re-initialisation and event iteration; output is recorded in ``run``."""
-    t_end = run.t_end
+    with re-initialisation and event iteration; output is recorded in ``run``.
+    It ends at ``t_stop`` (default: the run's end) or at a terminal event,
+    and returns the point it reached: (t, y, y', d, callbacks, stop)."""
+    t_end = run.t_end if t_stop is None else t_stop
     while not stop and t < t_end:
-        tspan = _tspan(t, tout, t_end, watch.horizon(t))
+        if not run.schedule.empty():
+            y, yp, d, cb, stop = _time_events(run, cb, t, y, yp, d)
+            if stop:
+                break
+        tspan = _tspan(t, tout, t_end, watch.horizon(t), run.schedule.next(t, d))
         seg = watch.solve(run.solver(), watch.wrap(cb, tspan), d, tspan, y, yp,
                           every_step=output_step == 0)
         run.nfev += seg.nfev
@@ -347,7 +356,99 @@ def _integrate(run, watch, cb, t, y, yp, d, stop, tout, output_step):
         y, yp, d, cb, stop = _handle(run, cb, t, y, yp, d, fired)
         if list(d) != d_before:
             run.record(t, y, yp, d)
+    return t, y, yp, d, cb, stop
 
+
+
+class Stepper:
+    """The hybrid loop advanced on demand, one interval at a time (a
+    co-simulation's doStep, :mod:`acausal.interop.fmu`).
+
+    ``Stepper(cm, params, t0, **options)`` initialises at ``t0`` exactly as
+    :func:`simulate` does (the consistent start, then the event iteration);
+    ``options`` are :func:`simulate`'s ``t_end`` (the end of the whole run,
+    which sizes the chattering guard), ``rtol``, ``atol``, ``atol_algebraic``,
+    ``max_step``, ``max_steps``, ``backend``, ``linsolver`` and
+    ``output_step``. :meth:`advance` integrates to a later time across every
+    event on the way (each interval starts the integrator afresh, as an event
+    does); :meth:`set_parameters` changes free parameters between intervals
+    (the states are kept, the algebraic unknowns and derivatives
+    re-initialised, then the event iteration runs). ``keep=True`` keeps every
+    output row on :meth:`result` (on the ``output_step`` grid, 0: every
+    solver step), for measures of the run so far; else only the last point.
+    ``stopped`` is True once a terminal event fired; ``t, y, yp, d`` is the
+    point reached."""
+
+    OPTIONS = dict(t_end=1.0, rtol=1e-6, atol=1e-8, atol_algebraic=None, max_step=None,
+                   max_steps=100000, backend=None, linsolver="auto", output_step=None)
+
+    def __init__(self, cm, params=None, t0=0.0, keep=False, **options):
+        unknown = sorted(set(options) - set(self.OPTIONS))
+        if unknown:
+            raise UsageError(f"Stepper: unknown option {unknown[0]!r}; options: "
+                             + ", ".join(self.OPTIONS))
+        o = {**self.OPTIONS, **options}
+        wall0 = _time.perf_counter()
+        self.cm, self.keep, self.t_end = cm, keep, float(o["t_end"])
+        self.output_step = o["output_step"] if keep else None
+        run, y, yp, d, cb, stop = _start(cm, t0, self.t_end, params, o["rtol"], o["atol"],
+                                         o["atol_algebraic"], o["max_step"], o["max_steps"],
+                                         _backend(o["backend"]), o["linsolver"], None)
+        self.run, self.cb, self.stopped = run, cb, stop
+        self.t, self.y, self.yp, self.d = float(t0), y, yp, list(d)
+        self.grid = (_output_times(t0, self.t_end, self.output_step, None)
+                     if keep and self.output_step != 0 else np.zeros(0))
+        run.record(t0, y, yp, d)
+        self.watch = _Watch(run, wall0, None, None, None, False)
+
+    def advance(self, t_to):
+        """Integrate from :attr:`t` to ``t_to`` (or to a terminal event before
+        it: then :attr:`stopped`). A solver failure raises its SolverError."""
+        t_to = float(t_to)
+        if self.stopped or not t_to > self.t:
+            return
+        if not self.keep:   # only the last point is kept
+            run = self.run
+            for rows in (run.T, run.Y, run.YP, run.D):
+                rows[:] = [rows[-1][-1:]]
+        tout = self.grid[(self.grid > self.t) & (self.grid < t_to)]
+        tout = np.append(tout, t_to)
+        t, y, yp, d, cb, stop = _integrate(self.run, self.watch, self.cb, self.t, self.y,
+                                           self.yp, self.d, False, tout, self.output_step,
+                                           t_stop=t_to)
+        self.t, self.y, self.yp, self.d, self.cb = float(t), y, yp, list(d), cb
+        self.stopped = bool(stop)
+
+    def set_parameters(self, values):
+        """Set free parameters (name -> value, checked against their bounds)
+        at the current time; a change re-initialises the algebraic unknowns
+        and derivatives (the states are kept) and runs the event iteration."""
+        cm, run = self.cm, self.run
+        p = run.p.copy()
+        for name, value in values.items():
+            i = cm.param_index(name)
+            p[i] = cm.param_vector({name: value})[i]
+        if np.array_equal(p, run.p):
+            return
+        run.p[:] = p
+        run._cbs.clear()
+        run._served.clear()
+        run._solver = None   # a new segment solver takes the new values
+        cb = run.callbacks(self.d)
+        run.cb_d = list(self.d)
+        y, yp = reinitialize(cm, cb, self.t, self.y, self.yp)
+        y, yp, d, cb, stop = _event_iteration(run, cb, self.t, y, yp, self.d)
+        self.y, self.yp, self.d, self.cb = y, yp, list(d), cb
+        self.stopped = self.stopped or bool(stop)
+        run.record(self.t, y, yp, d)
+
+    def observed(self):
+        """The values of ``cm.var_names`` at the current point."""
+        return np.asarray(self.cb[4](self.t, self.y, self.yp), dtype=float)
+
+    def result(self):
+        """The :class:`Result` of the run so far (see ``keep``)."""
+        return self.run.result("stopped" if self.stopped else "ok")
 
 
 # ---------------------------------------------------------------------------
@@ -427,10 +528,14 @@ def _check_output_size(cm, t0, t_end, output_step, output_times, max_rows, max_m
             "t_end, or raise the limit (--max-memory)", t=t0)
 
 
-def _tspan(t, tout, t_end, horizon):
+def _tspan(t, tout, t_end, horizon, t_event=np.inf):
     """Times of the next solver call: ``t``, then the output times after it,
     up to ``t_end`` (which ends the span), or up to ``horizon`` when a watch
-    cuts the run into windows (at least one output time)."""
+    cuts the run into windows (at least one output time), or up to the
+    next time event ``t_event`` (which then ends the span: the solver
+    stops exactly there)."""
+    if t_event < t_end and (horizon is None or t_event <= horizon):
+        return np.concatenate([[t], tout[(tout > t) & (tout < t_event)], [t_event]])
     later = tout[tout > t]
     if horizon is not None and horizon < t_end:
         cut = later[later <= horizon]
@@ -736,6 +841,27 @@ def _handle(run, cb, t, y, yp, d, fired):
         stop = stop or stop2
     if run.sens is not None:
         run.sens.dtau[:] = 0.0   # the instant is over
+    return y, yp, d, cb, stop
+
+
+def _time_events(run, cb, t, y, yp, d):
+    """The time events due at ``t`` (:mod:`acausal.runtime.timeevents`):
+    the switches set to their values after ``t``, the due time events'
+    actions run and logged; a changed mode is re-initialised and iterated
+    like any event's, and recorded after the row before it."""
+    obs = cb[4](t, y, yp)
+    d_new, fired = run.schedule.update(t, d, obs)
+    if run.sens is not None and fired:
+        run.sens.dtau[:] = run.schedule.time_sensitivity(t, d, run.sens.sm.pidx)
+    for ev in {ev.name: ev for ev in fired}.values():   # one entry per name and instant
+        _log_event(run, t, ev, run.sens.dtau.copy() if run.sens is not None else None)
+    stop = False
+    if list(d_new) != list(d):
+        d, cb, y, yp = _new_mode(run, [], t, y, yp, list(d), d_new, obs)
+        y, yp, d, cb, stop = _event_iteration(run, cb, t, y, yp, d)
+        run.record(t, y, yp, d)
+    if run.sens is not None:
+        run.sens.dtau[:] = 0.0
     return y, yp, d, cb, stop
 
 

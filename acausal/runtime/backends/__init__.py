@@ -109,7 +109,11 @@ class BackendError(AcausalError):
 def make_solver(name, cm, p, opts):
     """A :class:`SegmentSolver` of backend ``name`` for model ``cm`` with
     parameter vector ``p`` and options ``opts`` (rtol, atol, max_step,
-    max_num_steps)."""
+    max_num_steps). A model with no states gets an
+    :class:`~acausal.runtime.backends.algebraic.AlgebraicSolver` on that
+    backend's callbacks (there is nothing for IDA to integrate)."""
+    if cm.dae.n_states == 0:
+        return _stateless(name, cm, p, opts)
     if name in (None, "sundae"):
         from .sundae import SundaeSolver
         return SundaeSolver(cm, p, opts)
@@ -122,6 +126,26 @@ def make_solver(name, cm, p, opts):
             solver = SundaeSolver(cm, p, opts)
             solver.fallback = f"compiled backend unavailable: {exc}"
             return solver
+    raise BackendError(f"unknown backend {name!r}; choose one of: {', '.join(BACKENDS)}")
+
+
+def _stateless(name, cm, p, opts):
+    from .algebraic import AlgebraicSolver
+    if name == "compiled":
+        from .compiled import CCallbacks, Unavailable, library
+        try:
+            library(cm)
+        except Unavailable as exc:
+            solver = AlgebraicSolver(cm, p, opts, "sundae",
+                                     lambda model, q, d: model.callbacks(q, d))
+            solver.fallback = f"compiled backend unavailable: {exc}"
+            return solver
+
+        def serve(model, q, d):
+            return CCallbacks(library(model), model, q, d, lambda: model.callbacks(q, d))
+        return AlgebraicSolver(cm, p, opts, "compiled", serve)
+    if name in (None, "sundae"):
+        return AlgebraicSolver(cm, p, opts, "sundae", lambda model, q, d: model.callbacks(q, d))
     raise BackendError(f"unknown backend {name!r}; choose one of: {', '.join(BACKENDS)}")
 
 
