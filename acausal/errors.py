@@ -14,9 +14,14 @@ Hierarchy::
         ModelFileError                a model file could not be loaded
       DataError                       a measured-data file is wrong (file:line, column)
       CalibrationError                a calibration cannot be carried out
+      AnalysisError                   a linearisation or trim cannot be carried out
       DiagnosisError                  a diagnosis cannot be carried out
       SolverError                     the integrator failed (t, component, result)
         ChatteringError               too many events in a tiny window
+        LimitError                    a limit stopped the run (the partial result kept)
+          Interrupted                 Ctrl-C, SIGTERM or a watchdog stopped the run
+      UsageError                      an option or argument that cannot be used
+        BudgetError                   the work asked for exceeds a budget (before it starts)
 """
 import re
 
@@ -119,6 +124,11 @@ class LimitError(SolverError):
     ``component`` names the component whose events dominated."""
 
 
+class Interrupted(LimitError):
+    """The run was interrupted (Ctrl-C, SIGTERM, a memory or wall-time
+    watchdog); ``result`` holds what was computed up to ``t``."""
+
+
 class ModelFileError(ModelError):
     """A model file could not be loaded; the message names file and line."""
 
@@ -144,9 +154,26 @@ class DiagnosisError(AcausalError):
     """The diagnosis could not be carried out (bad data, no fit, ...)."""
 
 
+class AnalysisError(AcausalError):
+    """A linearisation or trim cannot be carried out: an operating point
+    that is not consistent, a name that is not an input, state or output,
+    no static equilibrium (:mod:`acausal.analysis`)."""
+
+
 class UsageError(AcausalError):
     """An option or argument that cannot be used as given (a malformed
     ``--param`` spec, ``workers=0``, a missing optional package, ...)."""
+
+
+class BudgetError(UsageError):
+    """The work asked for exceeds a budget before anything runs (memory
+    estimated as points x rows, a count of points or rows): a usage error."""
+
+
+class OutputGridError(BudgetError, LimitError):
+    """An output grid of more rows than ``max_rows`` (or than the memory
+    limit holds), refused before the run: a usage error, and a LimitError
+    as it always was for callers that catch one."""
 
 
 class UnknownNameError(AcausalError, KeyError):

@@ -9,9 +9,11 @@ from dataclasses import dataclass, field
 import sympy as sp
 
 from ..lang.component import Model
-from ..lang.declare import Discrete, Parameter, Start, Variable
+from ..lang.connectors import SignalPort
+from ..lang.declare import Discrete, Parameter, Start, TimeEvent, Variable
 from ..errors import ConnectionError_, ModelError
 from ..lang.symbols import base_and_order, time
+from .timeevents import find_time_switches
 
 
 @dataclass
@@ -35,6 +37,8 @@ class VarInfo:
     owner: str
     port: bool = False     # a connector variable
     unit_declared: bool = True   # False: no unit was given (not checked)
+    internal: bool = False  # made by the compiler (a time switch), not declared
+    nominal: float = None   # Modelica's nominal value (scales the absolute tolerance)
 
 
 @dataclass
@@ -57,6 +61,8 @@ class Flat:
     assertions: list = field(default_factory=list)
     unconnected: list = field(default_factory=list)  # port paths
     owners: dict = field(default_factory=dict)      # component path -> class name
+    time_switches: list = field(default_factory=list)  # compiler/timeevents.TimeSwitch
+    time_events: list = field(default_factory=list)    # lang.declare.TimeEvent
 
     def owner_of(self, sym):
         """Component path owning a variable/parameter symbol."""
@@ -83,7 +89,9 @@ def flatten(model):
         _relocate_values(flat, comp, known)
     for comp in comps:
         _equations(flat, comp, known)
-    _connections(flat, model, comps)
+    bound = _bindings(flat, comps, known)
+    _connections(flat, model, comps, bound)
+    flat.time_switches = find_time_switches(flat)
     return flat
 
 
@@ -96,12 +104,18 @@ def _declare(flat, comp):
             flat.params[sym.name] = ParamInfo(sym, comp.value(name), d, path)
         elif isinstance(d, Variable):
             flat.variables[sym.name] = VarInfo(sym, comp.start(name), d.unit, d.desc, path,
-                                               unit_declared=d.unit_declared)
+                                               unit_declared=d.unit_declared,
+                                               nominal=comp.nominal(name))
         elif isinstance(d, Discrete):
             flat.discretes[sym.name] = VarInfo(sym, Start(d.start, True), d.unit, d.desc, path,
                                                unit_declared=d.unit_declared)
     for name, ctype in comp.connectors().items():
         port = comp.port(name)
+        if isinstance(port, SignalPort):
+            sym = port.symbol
+            flat.variables[sym.name] = VarInfo(sym, Start(0.0, False), ctype.unit, ctype.desc,
+                                               path, True, unit_declared=ctype.unit_declared)
+            continue
         for decls, syms in zip(ctype.pairs(), port.pairs()):
             for (vname, unit, desc), sym in zip(decls, syms):
                 flat.variables[sym.name] = VarInfo(sym, Start(0.0, False), unit, desc, path,
@@ -173,8 +187,13 @@ def _equations(flat, comp, known):
                     f"{s.name!r}, which is not a variable or parameter of the model",
                     component=path, variable=s.name)
         flat.equations.append(Equation(expr, path, f"equation {i + 1} ({type(comp).__name__})"))
+    for k, eq in enumerate(comp.gather("initial_equations")):
+        _initial_equation(flat, comp, known, k, eq)
     for ev in comp.gather("events"):
         ev.owner = path
+        if isinstance(ev, TimeEvent):
+            flat.time_events.append(ev)
+            continue
         ev.expr = relocate(ev.expr, comp, known)
         flat.events.append(ev)
     for a in comp.gather("assertions"):
@@ -183,11 +202,46 @@ def _equations(flat, comp, known):
         flat.assertions.append(a)
 
 
+def _initial_equation(flat, comp, known, k, eq):
+    """An initial equation ``lhs = rhs`` (Modelica's ``initial equation``):
+    a variable ``<path>._initial<k>`` = lhs - rhs at every time, with the
+    fixed start 0, so the initialisation imposes it at the start only."""
+    path = comp.path
+    expr = eq.lhs - eq.rhs if isinstance(eq, sp.Equality) else sp.sympify(eq)
+    expr = relocate(expr, comp, known)
+    sym = sp.Symbol(f"{path}._initial{k}" if path else f"_initial{k}")
+    flat.variables[sym.name] = VarInfo(sym, Start(0.0, True), "1",
+                                       f"initial equation {k + 1}: {expr} = 0 at the start",
+                                       path, unit_declared=False, internal=True)
+    known.add(sym.name)
+    flat.equations.append(Equation(sym - expr, path,
+                                   f"initial equation {k + 1} ({type(comp).__name__})"))
+
+
+def _bindings(flat, comps, known):
+    """Equations of the inputs bound to expressions (``Position(s_ref=...)``);
+    returns the paths of those inputs."""
+    bound = set()
+    for comp in comps:
+        for name, expr in comp._bindings.items():
+            port = comp.port(name)
+            expr = relocate(expr, comp, known, comp._parent or comp)
+            for s in expr.free_symbols:
+                if s != time and base_and_order(s)[0].name not in known:
+                    raise ModelError(f"input {port.path} is bound to {expr}, which uses "
+                                     f"{s.name!r}: not a variable or parameter of the model",
+                                     component=comp.path, variable=s.name)
+            flat.equations.append(Equation(port.symbol - expr, comp.path,
+                                           f"binding of input {name}"))
+            bound.add(port.path)
+    return bound
+
+
 def _known_names(flat):
     return set(flat.params) | set(flat.variables) | set(flat.discretes)
 
 
-def _connections(flat, model, comps):
+def _connections(flat, model, comps, bound=frozenset()):
     parent = {}
 
     def find(p):
@@ -223,16 +277,21 @@ def _connections(flat, model, comps):
     sets = {}
     for port in parent:
         sets.setdefault(find(port), []).append(port)
+    dangling = []
     for members in sets.values():
-        if len(members) == 1 and members[0].ctype.optional:
-            for _, through in members[0].pairs():   # unconnected optional: no force
-                flat.equations.append(Equation(through, members[0].path,
-                                               "unconnected optional connector"))
+        members.sort(key=lambda p: p.path)
+        if isinstance(members[0], SignalPort):
+            dangling += _signal_node(flat, members, bound)
             continue
         if len(members) == 1:
-            flat.unconnected.append(members[0].path)
+            # Modelica's rule: an unconnected connector's through variables
+            # are zero; the check lists it (flat.unconnected), it is no error
+            for _, through in members[0].pairs():
+                flat.equations.append(Equation(through, members[0].path,
+                                               "unconnected connector (no force)"))
+            if not members[0].ctype.optional:
+                flat.unconnected.append(members[0].path)
             continue
-        members.sort(key=lambda p: p.path)
         where = "connect(" + ", ".join(p.path for p in members) + ")"
         for k, (a0, _) in enumerate(members[0].pairs()):
             for p in members[1:]:
@@ -240,3 +299,37 @@ def _connections(flat, model, comps):
                                                "connection (across equal)"))
             flat.equations.append(Equation(sp.Add(*[p.pairs()[k][1] for p in members]),
                                            where, "connection (through sum to zero)"))
+    if dangling:
+        dangling.sort()
+        if len(dangling) == 1:
+            msg = (f"{dangling[0]}: input not connected (connect it to an output, e.g. a "
+                   "signal source's y)")
+        else:
+            msg = "inputs not connected: " + ", ".join(dangling) + \
+                " (connect each to an output, e.g. a signal source's y)"
+        raise ConnectionError_(msg, component=dangling[0])
+
+
+def _signal_node(flat, members, bound):
+    """Equations of a node of signal connectors: every input equals the one
+    source of the node (its output, or an input bound to an expression).
+    Returns the inputs of a node without a source (not connected)."""
+    sources = [p for p in members if p.causality == "output" or p.path in bound]
+    inputs = [p for p in members if p not in sources]
+    if len(sources) > 1:
+        a, b = sources[:2]
+        if a.path in bound or b.path in bound:
+            what = [f"input {p.path} (bound to an expression)" if p.path in bound
+                    else f"output {p.path}" for p in (a, b)]
+            msg = f"{what[0]} and {what[1]} are connected to each other"
+        else:
+            msg = f"outputs {a.path} and {b.path} are connected to each other"
+        raise ConnectionError_(msg + ": a signal has one source (connect an output to inputs "
+                               "only)", component=b.path)
+    if not sources:
+        return [p.path for p in inputs]
+    src = sources[0].symbol
+    where = "connect(" + ", ".join(p.path for p in members) + ")"
+    for p in inputs:
+        flat.equations.append(Equation(p.symbol - src, where, "connection (input = output)"))
+    return []

@@ -20,7 +20,6 @@ from .causalize import build_dae
 from .codegen import Generated, generate, load as load_generated
 from ..infra import store
 from ..lang.declare import Start
-from ..errors import ModelError
 from ..lang.fastdiff import diff
 from .flatten import flatten
 from .units import check_units
@@ -79,8 +78,6 @@ def _compile(model, flat, stage_s, key):
     clock.lap("structure")
     dae = build_dae(g, dummies, set(param_syms), values)
     clock.lap("causalize")
-    if not dae.y:
-        raise ModelError(_nothing_to_integrate(flat))
     resolve = Resolver.of(red, dae, param_syms, disc_syms)
     observed = [resolve(info.symbol) for info in flat.variables.values()]
     roots = [resolve(e.expr) for e in flat.events] + [resolve(a.expr) for a in flat.assertions]
@@ -219,23 +216,6 @@ def _alias_starts(flat, red):
             out[r] = Start((sp.sympify(st.value) - off) / sign, st.fixed)
             via[r] = (name, float(sign), off)
     return out, via
-
-
-def _nothing_to_integrate(flat):
-    """Why a model leaves the solver no unknown: its bodies' motion is
-    prescribed (a mass tied to a wall), or it has no dynamic element."""
-    moving = sorted({base_and_order(s)[0].name for eq in flat.equations
-                     for s in sp.sympify(eq.expr).free_symbols if base_and_order(s)[1] > 0})
-    if moving:
-        shown = ", ".join(moving[:4]) + (" ..." if len(moving) > 4 else "")
-        return ("the model leaves nothing to integrate: the motion of every body is "
-                f"prescribed ({shown} follow from the constraints alone, e.g. a mass "
-                "connected directly to a fixed support or to a prescribed motion cannot "
-                "move); join such a body to its support through a spring or a damper, or "
-                "remove the body")
-    return ("the model leaves nothing to integrate: it has no dynamic element (every "
-            "variable is given explicitly by constants or prescribed motion); add a mass, "
-            "an inertia or a damper between moving parts")
 
 
 def _is_zero(v):

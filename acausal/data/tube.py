@@ -51,6 +51,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import UsageError
+
 __all__ = ["TubeResult", "tube_compare", "tube_size", "tube_bounds"]
 
 _TINY = 1e-12     # csv-compare's guard on the time base (and 2.0.3's on the value base)
@@ -112,14 +114,14 @@ def _as_curve(t, y, what):
     t = np.asarray(t, dtype=float).ravel()
     y = np.asarray(y, dtype=float).ravel()
     if t.shape != y.shape:
-        raise ValueError(f"{what}: time has {t.size} points, values {y.size}")
+        raise UsageError(f"{what}: time has {t.size} points, values {y.size}")
     if t.size == 0:
-        raise ValueError(f"{what}: no points")
+        raise UsageError(f"{what}: no points")
     if not np.all(np.isfinite(t)):
-        raise ValueError(f"{what}: time is not finite")
+        raise UsageError(f"{what}: time is not finite")
     if np.any(np.diff(t) < 0):
         k = int(np.nonzero(np.diff(t) < 0)[0][0])
-        raise ValueError(f"{what}: time decreases at point {k + 1} "
+        raise UsageError(f"{what}: time decreases at point {k + 1} "
                          f"({t[k]!r} -> {t[k + 1]!r})")
     return t, y
 
@@ -131,9 +133,9 @@ def tube_size(t_ref, y_ref, tol=1e-3, *, nominal=1e-3, dt_abs=None, dy_abs=None)
     ``dt_abs`` / ``dy_abs`` give them."""
     t, y = _as_curve(t_ref, y_ref, "reference")
     if not np.all(np.isfinite(y)):
-        raise ValueError("reference: values are not finite")
+        raise UsageError("reference: values are not finite")
     if not 0 <= tol <= 1:
-        raise ValueError(f"tol must be in [0, 1], not {tol!r}")
+        raise UsageError(f"tol must be in [0, 1], not {tol!r}")
     if dt_abs is None:
         dt = tol * max(float(t[-1] - t[0]), abs(float(t[0])), _TINY)
     else:
@@ -143,7 +145,7 @@ def tube_size(t_ref, y_ref, tol=1e-3, *, nominal=1e-3, dt_abs=None, dy_abs=None)
     else:
         dy = float(dy_abs)
     if dt < 0 or dy < 0:
-        raise ValueError("the tube's size must not be negative")
+        raise UsageError("the tube's size must not be negative")
     return dt, dy
 
 
@@ -202,14 +204,15 @@ def tube_bounds(t_ref, y_ref, t, dt, dy):
 
 
 def tube_compare(t_ref, y_ref, t_test, y_test, tol=1e-3, *, nominal=1e-3,
-                 dt_abs=None, dy_abs=None, require_coverage=True):
+                 absolute=None, require_coverage=True):
     """Compare a test signal with a reference by csv-compare's tube.
 
     ``t_ref``, ``y_ref``: the reference (time non-decreasing; an event is two
     points at one time). ``t_test``, ``y_test``: the signal to check (the
     same). ``tol``: the tube's relative size in time and in value (see the
-    module's docstring); ``nominal``: the least value base; ``dt_abs`` /
-    ``dy_abs``: absolute half-width / half-height instead.
+    module's docstring); ``nominal``: the least value base; ``absolute``:
+    ``(dt, dy)``, an absolute half-width / half-height instead (either may be
+    None).
     ``require_coverage``: fail when the test's time span falls short of the
     reference's by more than ``dt`` at either end.
 
@@ -217,6 +220,7 @@ def tube_compare(t_ref, y_ref, t_test, y_test, tol=1e-3, *, nominal=1e-3,
     """
     tr, yr = _as_curve(t_ref, y_ref, "reference")
     tt, yt = _as_curve(t_test, y_test, "test")
+    dt_abs, dy_abs = absolute if absolute is not None else (None, None)
     dt, dy = tube_size(tr, yr, tol, nominal=nominal, dt_abs=dt_abs, dy_abs=dy_abs)
     inside_span = (tt >= tr[0]) & (tt <= tr[-1])
     n_outside = int(np.count_nonzero(~inside_span))

@@ -10,11 +10,12 @@ This layer knows nothing of compiling or simulating: it depends only on
 :mod:`acausal.errors` (and, for units, :mod:`acausal.data.units`).
 """
 from .component import Component, Model
-from .connectors import Connector, Flange, Frame, Port, RotFlange
-from .declare import Assertion, Discrete, Event, Parameter, Start, Variable, guess
+from .connectors import Connector, Flange, Frame, Port, RealInput, RealOutput, RotFlange
+from .declare import Assertion, Discrete, Event, Parameter, Start, TimeEvent, Variable, guess
 from .experiment import Experiment, Measure, Stop
 from .symbols import Eq, der, time
 
 __all__ = ["Component", "Model", "Connector", "Flange", "RotFlange", "Frame", "Port",
-           "Parameter", "Variable", "Discrete", "Event", "Assertion", "Start", "guess",
+           "RealInput", "RealOutput",
+           "Parameter", "Variable", "Discrete", "Event", "TimeEvent", "Assertion", "Start", "guess",
            "Experiment", "Measure", "Stop", "Eq", "der", "time"]

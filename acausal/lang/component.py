@@ -13,7 +13,7 @@ import numbers
 import sympy as sp
 
 from .connectors import Connector, Port
-from .declare import Declaration, Discrete, Parameter, Start, Variable
+from .declare import Declaration, Discrete, Parameter, Start, Variable, check_nominal
 from ..errors import ModelError, ParameterError
 
 
@@ -41,6 +41,19 @@ def _check_start(value, label, unit):
                              "number", variable=label)
 
 
+def _binding(value, label):
+    """An input's binding: a number or a sympy expression (of time and
+    parameters), else a ParameterError."""
+    try:
+        expr = sp.sympify(value, strict=True)
+    except (sp.SympifyError, TypeError):
+        expr = None
+    if isinstance(value, bool) or not isinstance(expr, sp.Basic):
+        raise ParameterError(f"input {label} can be bound to a number or a sympy expression "
+                             f"of time and parameters, got {value!r}", variable=label)
+    return expr
+
+
 class Component:
     """Base of every component and model. Keyword arguments set parameter
     values (numbers, or sympy expressions of other parameters) and start
@@ -54,6 +67,8 @@ class Component:
         object.__setattr__(self, "_ports", {})
         object.__setattr__(self, "_values", {})
         object.__setattr__(self, "_starts", {})
+        object.__setattr__(self, "_bindings", {})
+        object.__setattr__(self, "_nominals", {})
         for name, d in self.declarations().items():
             if isinstance(d, Parameter):
                 self._values[name] = d.default
@@ -75,16 +90,27 @@ class Component:
         return _collect(type(self), Connector)
 
     def set(self, **kw):
-        """Set parameter values and start values; checks bounds."""
+        """Set parameter values and start values; checks bounds. A value
+        given for an input connector (``Position(s_ref=0.1*sin(2*pi*time))``) binds
+        that input to the expression, as a Modelica modifier does: it is
+        then set by it instead of by a connection."""
         decls = self.declarations()
         for key, value in kw.items():
             d = decls.get(key)
+            if d is None and getattr(self.connectors().get(key), "causality", None) == "input":
+                self._bindings[key] = _binding(value, f"{self.path or type(self).__name__}.{key}")
+                continue
             if d is None:
                 valid = ", ".join(n for n, x in decls.items() if not isinstance(x, Discrete))
                 raise ParameterError(
                     f"{type(self).__name__} {self.path or '(top)'} has no parameter or "
                     f"variable {key!r}; it has: {valid}", component=self.path, variable=key)
             if isinstance(d, Parameter):
+                if d.final:
+                    raise ParameterError(
+                        f"{type(self).__name__} {self.path or ''}: parameter {key!r} is "
+                        f"computed ({d.desc}); set the parameters it is computed from",
+                        component=self.path, variable=key)
                 self._values[key] = d.check(value, self.path or type(self).__name__)
             elif isinstance(d, Variable):
                 start = value if isinstance(value, Start) else Start(value, True)
@@ -95,9 +121,56 @@ class Component:
                                      component=self.path, variable=key)
         return self
 
+    def with_nominal(self, **values):
+        """Set the nominal values of variables of this instance (Modelica's
+        ``inertia(w(nominal=1e-3))``): ``Inertia(J=2).with_nominal(w=1e-3)``.
+        Returns the component."""
+        decls = self.declarations()
+        for key, value in values.items():
+            if not isinstance(decls.get(key), Variable):
+                raise ParameterError(f"with_nominal: {type(self).__name__} "
+                                     f"{self.path or '(top)'} has no variable {key!r}",
+                                     component=self.path, variable=key)
+            self._nominals[key] = check_nominal(value, f"{self.path or type(self).__name__}."
+                                                f"{key}")
+        return self
+
+    def nominal(self, name):
+        """The nominal value of variable ``name`` (None when not given)."""
+        if name in self._nominals:
+            return self._nominals[name]
+        return getattr(self.declarations().get(name), "nominal", None)
+
     def value(self, name):
-        """The value given to a parameter (number, expression or choice)."""
-        return self._values[name]
+        """The value given to a parameter (number, expression or choice).
+        A parameter left at a default that is a function of the component
+        (``Parameter(lambda c: ..., ...)``: a derived parameter, or one
+        taken from an :meth:`outer` component) is that function's value now;
+        the compiler asks when it flattens the model, when every path is
+        final."""
+        v = self._values[name]
+        if callable(v) and not isinstance(v, sp.Basic):
+            v = v(self)
+        return v
+
+    def outer(self, kind):
+        """The component of class ``kind`` that an enclosing model declares,
+        as Modelica's ``inner``/``outer``: the nearest one (among this
+        component's siblings, then its parent's siblings, ...), or None when
+        no enclosing model has one. Two in one model is a
+        :class:`~acausal.errors.ModelError` (which one is meant?)."""
+        node = self._parent
+        while node is not None:
+            hits = [c for c in node._children.values() if isinstance(c, kind) and c is not self]
+            if len(hits) > 1:
+                raise ModelError(
+                    f"{node.path or 'the model'} has {len(hits)} {kind.__name__} components "
+                    f"({', '.join(c.path for c in hits)}); {self.path} needs exactly one",
+                    component=self.path)
+            if hits:
+                return hits[0]
+            node = node._parent
+        return None
 
     def start(self, name):
         return self._starts[name]
@@ -118,12 +191,17 @@ class Component:
         port = self._ports.get(name)
         if port is None:
             ctype = self.connectors()[name]
-            port = self._ports[name] = Port(self, name, ctype)
+            port = self._ports[name] = ctype.make_port(self, name)
         return port
 
     # -- behaviour (overridden by subclasses) --------------------------------
     def equations(self):
         """Equations of this class only (sympy ``Eq`` or expressions = 0)."""
+        return []
+
+    def initial_equations(self):
+        """Equations of this class that hold at the start only (Modelica's
+        ``initial equation``, e.g. a filter starting at its input)."""
         return []
 
     def events(self):
@@ -255,11 +333,11 @@ class Model(Component):
         self._values[name] = p.check(default, self.path)
         return self.symbol(name)
 
-    def variable(self, name, start=0.0, unit=None, desc="", fixed=False):
+    def variable(self, name, start=0.0, unit=None, desc="", fixed=False, nominal=None):
         """Declare a variable of this model; returns its symbol."""
         if isinstance(start, Start):
             start, fixed = start.value, start.fixed
-        v = Variable(start, unit, desc, fixed=fixed)
+        v = Variable(start, unit, desc, fixed=fixed, nominal=nominal)
         v.name = name
         self._extra[name] = v
         self._starts[name] = v.start

@@ -69,6 +69,18 @@ Mapping to the 1-D flanges (through the adaptors of
   prismatic's ``Flange`` its stroke along the axis, so that 1-D springs,
   dampers, friction, stops and drives act across the joint (the 1-D
   ``Fixed`` on that side stands for the joint's frame_a).
+
+Causal signals (:class:`RealInput`, :class:`RealOutput`)
+--------------------------------------------------------
+A signal connector is one real variable and no through part (MSL's
+``Blocks.Interfaces.RealInput``/``RealOutput``): the connector *is* the
+variable, named by the connector's path (``clutch.f_normalized``), and a
+component uses it in its equations as it uses a symbol
+(``Eq(self.f, self.f_max * self.f_normalized)``). ``connect(out, in1, in2)``
+makes every input equal to the one output of its node; a node with two
+outputs, or an input that is in no node with an output, is an error naming
+them (``clutch.f_normalized: input not connected``). An unconnected output
+is allowed (nobody reads it).
 """
 import sympy as sp
 
@@ -93,6 +105,10 @@ class Connector:
         self.desc = desc
         self.optional = optional
         self.name = None
+
+    def make_port(self, owner, name):
+        """The :class:`Port` of this connector on component ``owner``."""
+        return Port(owner, name, self)
 
     @classmethod
     def pairs(cls):
@@ -144,6 +160,42 @@ class Frame(Connector):
     domain = "planar"
 
 
+class RealSignal(Connector):
+    """A causal signal connector: one real variable (unit ``unit``), no
+    through part. Use :class:`RealInput` or :class:`RealOutput`. A signal
+    given no unit is dimensionless for display but not checked (Modelica's
+    ``unit = ""``, as a declaration without one: :mod:`acausal.compiler.units`),
+    so a block's plain output may feed a force's input in N."""
+
+    domain = "signal"
+    causality = None     # "input" or "output"
+
+    def __init__(self, desc="", unit=None):
+        super().__init__(desc)
+        self.unit_declared = unit is not None
+        self.unit = "1" if unit is None else unit
+
+    @classmethod
+    def pairs(cls):
+        """No across/through pairs: a signal is its own variable."""
+        return ()
+
+    def make_port(self, owner, name):
+        return SignalPort(owner, name, self)
+
+
+class RealInput(RealSignal):
+    """Input signal (MSL ``RealInput``): set by the output it is connected to."""
+
+    causality = "input"
+
+
+class RealOutput(RealSignal):
+    """Output signal (MSL ``RealOutput``): set by its component's equations."""
+
+    causality = "output"
+
+
 class Port:
     """A connector on one component instance. ``port.s`` / ``port.f`` (or the
     names of its type) are the sympy symbols of its two variables."""
@@ -191,3 +243,67 @@ class Port:
 
     def __repr__(self):
         return f"<{type(self.ctype).__name__} {self.path}>"
+
+
+def _sym(x):
+    return x.symbol if isinstance(x, SignalPort) else x
+
+
+class SignalPort(Port):
+    """A signal connector on one component instance. It stands for its
+    variable (the sympy symbol named by its path, :attr:`symbol`) wherever
+    an expression is built: ``2 * port``, ``sp.sin(port)``, ``Eq(y, port)``."""
+
+    @property
+    def symbol(self):
+        return sp.Symbol(self.path)
+
+    @property
+    def causality(self):
+        return self.ctype.causality
+
+    def pairs(self):
+        return []
+
+    def _sympy_(self):
+        return self.symbol
+
+    def __getattr__(self, item):
+        raise AttributeError(f"signal connector {self.__dict__.get('name')} has no "
+                             f"variable {item!r}: it is its own variable")
+
+    def __neg__(self):
+        return -self.symbol
+
+    def __pos__(self):
+        return self.symbol
+
+    def __add__(self, o):
+        return self.symbol + _sym(o)
+
+    def __radd__(self, o):
+        return _sym(o) + self.symbol
+
+    def __sub__(self, o):
+        return self.symbol - _sym(o)
+
+    def __rsub__(self, o):
+        return _sym(o) - self.symbol
+
+    def __mul__(self, o):
+        return self.symbol * _sym(o)
+
+    def __rmul__(self, o):
+        return _sym(o) * self.symbol
+
+    def __truediv__(self, o):
+        return self.symbol / _sym(o)
+
+    def __rtruediv__(self, o):
+        return _sym(o) / self.symbol
+
+    def __pow__(self, o):
+        return self.symbol ** _sym(o)
+
+    def __rpow__(self, o):
+        return _sym(o) ** self.symbol

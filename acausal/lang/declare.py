@@ -41,13 +41,23 @@ class Parameter(Declaration):
     ``max_open`` make a bound strict). A ``structural`` parameter (a choice of
     law, a flag) is baked into the generated code: changing it recompiles.
     Its value is read as a plain Python value, not a symbol.
+
+    ``default`` may be a function of the component, evaluated when the
+    model is flattened (:meth:`acausal.lang.Component.value`): a derived
+    parameter (a body's mass from its dimensions and density) or one taken
+    from an enclosing component (a body's gravity from the world's,
+    :meth:`acausal.lang.Component.outer`). Its value is then an expression
+    of other parameters, which a run cannot set on its own. ``final``: a
+    derived parameter that cannot be given a value (Modelica's ``final``).
     """
 
     kind = "parameter"
 
     def __init__(self, default, unit=None, desc="", *, min=None, max=None,
-                 min_open=False, max_open=False, structural=False, choices=None):
+                 min_open=False, max_open=False, structural=False, choices=None,
+                 final=False):
         super().__init__(unit, desc)
+        self.final = final
         self.default = default
         self.min, self.max = min, max
         self.min_open, self.max_open = min_open, max_open
@@ -117,13 +127,35 @@ def guess(value):
 
 
 class Variable(Declaration):
-    """A time-varying unknown. ``start`` is a guess unless ``fixed``."""
+    """A time-varying unknown. ``start`` is a guess unless ``fixed``.
+
+    ``nominal`` (Modelica's attribute, in the variable's unit): its order
+    of magnitude. The integrator's absolute tolerance on it is then
+    ``rtol * |nominal|`` (the Modelica Specification's recommendation,
+    section 4.8.7: tolerance ``rtol*(|nominal| + |x|)``; OpenModelica's
+    rule), instead of the run's ``atol``: a 1e-3-scale angle or velocity is
+    integrated to the relative accuracy asked, and a kilonewton force is
+    not held to 1e-8 N. ``Component.with_nominal(w=1e-3)`` sets it on one
+    instance."""
 
     kind = "variable"
 
-    def __init__(self, start=0.0, unit=None, desc="", *, fixed=False):
+    def __init__(self, start=0.0, unit=None, desc="", *, fixed=False, nominal=None):
         super().__init__(unit, desc)
         self.start = Start(start, fixed)
+        self.nominal = check_nominal(nominal, desc)
+
+
+def check_nominal(value, where):
+    """``value`` as a positive finite float (None stays None), else a
+    ParameterError naming ``where``."""
+    if value is None:
+        return None
+    ok = isinstance(value, numbers.Real) and not isinstance(value, bool)
+    if not ok or not math.isfinite(float(value)) or float(value) == 0.0:
+        raise ParameterError(f"nominal value of {where} must be a non-zero finite number, "
+                             f"got {value!r}", variable=str(where))
+    return abs(float(value))
 
 
 class Discrete(Declaration):
@@ -165,6 +197,32 @@ class Event:
         self.terminal = terminal
         self.recheck = recheck
         self.observer = observer
+        self.log = log
+        self.owner = None  # set by flattening: the component path
+
+
+class TimeEvent:
+    r"""Events at instants known without integrating (a table's breakpoints,
+    a clock), which a component returns from ``events()`` beside its
+    :class:`Event`\ s. The integrator stops exactly at each one (IDA's stop
+    time, not a root search) and the hybrid loop runs ``action``.
+
+    ``next_time(state)``: the first instant of this event strictly after
+    ``state.t`` [s] (``math.inf`` for none); it may read parameters and
+    discrete values (``state[symbol]``), not variables.
+    ``action(state)``: sets the discrete values (``state[d] = v``) for the
+    interval that begins at ``state.t``; it runs at the start of a run (to
+    set them for the first interval; variables cannot be read there) and
+    at each of this event's instants (recorded in ``res.events`` under
+    ``name`` unless ``log=False``).
+    """
+
+    def __init__(self, name, next_time, action, *, log=True):
+        if not callable(next_time) or not callable(action):
+            raise ModelError(f"time event {name}: next_time and action must be functions")
+        self.name = name
+        self.next_time = next_time
+        self.action = action
         self.log = log
         self.owner = None  # set by flattening: the component path
 

@@ -1,29 +1,21 @@
-"""Levers and transformers between rotation and translation, and gears.
+"""Levers: transformers between rotation and translation.
 
-All are massless, rigid and power conserving, with their pivot/support on
-the fixed frame (like Modelica's IdealGear with a grounded support): put the
-mass or inertia of a lever in an :class:`~acausal.mechanics.rotational.Inertia`
-or :class:`~acausal.mechanics.translational.Mass` on one of its flanges.
+All are massless, rigid and power conserving, with their pivot on the fixed
+frame (like Modelica's IdealGear with a grounded support). ``IdealGear``
+lives in :mod:`acausal.mechanics.rotational` (with MSL's support flange) and
+is importable from here as before. Put the mass or inertia of a lever in an
+:class:`~acausal.mechanics.rotational.Inertia` or
+:class:`~acausal.mechanics.translational.Mass` on one of its flanges.
 Sign convention: :mod:`acausal.connectors`.
 """
 from sympy import cos, sin
 
 from acausal.lang import Component, Eq, Flange, Parameter, RotFlange, Variable
 
-from acausal.errors import ParameterError
+from .partials import NonZeroParameter
+from .rotational.components import IdealGear   # MSL's place; kept importable from here
 
 __all__ = ["IdealLever", "TwoArmLever", "IdealGear"]
-
-
-class NonZeroParameter(Parameter):
-    """A parameter that may have either sign but not be zero (an arm, a
-    ratio): zero would make the transformer degenerate."""
-
-    def check_bounds(self, v, label):
-        super().check_bounds(v, label)
-        if v == 0:
-            raise ParameterError(f"parameter {label} = 0 [{self.unit}] must be non-zero "
-                                 f"({self.desc})")
 
 
 class IdealLever(Component):
@@ -88,22 +80,3 @@ class TwoArmLever(Component):
         return [Eq(self.flange_a.s, self.a * k),
                 Eq(self.flange_b.s, self.b * k),
                 Eq(self.a * dk * self.flange_a.f + self.b * dk * self.flange_b.f, 0)]
-
-
-class IdealGear(Component):
-    """Ideal gear on a fixed support: ``flange_a.phi = ratio * flange_b.phi``,
-    ``ratio * flange_a.tau + flange_b.tau = 0`` (power conserving, as
-    Modelica's IdealGear). An inertia ``J_b`` on ``flange_b`` is felt on
-    ``flange_a`` as ``J_b / ratio^2``. A negative ratio reverses the sense.
-
-    Parameters: ``ratio`` [1] transmission ratio flange_a.phi/flange_b.phi
-    (non-zero). Connectors: ``flange_a``, ``flange_b``.
-    """
-
-    flange_a = RotFlange("driving flange")
-    flange_b = RotFlange("driven flange")
-    ratio = NonZeroParameter(1.0, "1", "transmission ratio flange_a.phi / flange_b.phi")
-
-    def equations(self):
-        return [Eq(self.flange_a.phi, self.ratio * self.flange_b.phi),
-                Eq(self.ratio * self.flange_a.tau + self.flange_b.tau, 0)]

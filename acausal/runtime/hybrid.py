@@ -5,7 +5,8 @@ component's event action changes discrete values (a contact mode, a stick/
 slip mode), the algebraic unknowns and derivatives are recomputed
 consistently, events flagged ``recheck`` are iterated to a fixed point, and
 integration restarts (the hybrid DAE scheme of Barton and Pantelides 1994,
-"Modeling of combined discrete/continuous processes", AIChE J. 40). Output:
+"Modeling of combined discrete/continuous processes", AIChE J. 40). Time
+events (:mod:`.timeevents`) end a segment exactly at their instant. Output:
 requested times, plus both sides of every event. A burst of events in a tiny
 window stops the run with a :class:`ChatteringError` naming the component.
 
@@ -23,19 +24,47 @@ from typing import NamedTuple
 import numpy as np
 
 from .backends import BACKENDS, BackendError, make_solver
-from ..errors import ChatteringError, LimitError, ModelError, SolverError, UsageError
+from ..errors import ChatteringError, Interrupted, LimitError, ModelError, OutputGridError, \
+    SolverError, UsageError
 from .events import EventState
-from .initialize import ask_components, initial_point, suspect_parameters
+from .initialize import ask_components, initial_point, reinitialize, suspect_parameters
+from .nominal import nominal_atol
 from .observer import Point, RunObserver
 from .result import Rows
+from .timeevents import TimeSchedule
 
 CHATTER_COUNT = 100     # this many firings of one event (root) ...
 CHATTER_SPAN = 1e-9     # ... within this fraction of the time span is chattering
 MAX_ITER = 20           # event iterations at one instant
 DEFAULT_BACKEND = "sundae"
+SAME_INSTANT = 256 * np.finfo(float).eps   # (relative) times closer than this are one
 MAX_ROWS = 1_000_000    # stored output rows, by default (each 8 bytes per unknown, twice)
 WINDOW_S = 0.25         # wall time per integration window when watched [s]
 PROGRESS_DELAY_S = 2.0  # a progress bar shows once a run has lasted this long [s]
+ROW_FACTOR = 3          # memory of a stored row: its arrays, the result's copy, the CSV
+
+
+class _StopRequest:
+    """A request to stop the running simulations now, keeping their rows
+    (the command line's Ctrl-C and SIGTERM handler, a memory watchdog):
+    :func:`request_stop` sets ``reason``; each run checks it between solver
+    calls and, through its wrapped residual or the compiled backend's
+    guard, inside them. ``active``: runs in progress in this process;
+    ``armed``: a handler may request a stop (the command line's), so runs
+    check for it inside their solver calls too."""
+    reason = None
+    active = 0
+    armed = False
+
+
+STOP = _StopRequest()
+
+
+def request_stop(reason):
+    """Ask the running simulation(s) to stop with their partial result;
+    False when none is running (the caller then interrupts as it would)."""
+    STOP.reason = reason
+    return STOP.active > 0
 
 
 @dataclass(frozen=True)
@@ -55,6 +84,7 @@ class RunOptions:
     max_total_steps: object = None
     progress: bool = False
     linsolver: str = "auto"
+    max_memory: object = None
 
     @classmethod
     def of(cls, options):
@@ -143,6 +173,22 @@ class _Run:
         self.observer.on_rows(self, len(self.T[-1]))
         self.rows += len(self.T[-1])
 
+    def trim(self, n):
+        """Keep only the first ``n`` stored rows (at least the first)."""
+        n = max(int(n), 1)
+        if self.rows <= n:
+            return
+        kept = 0
+        for k, block in enumerate(self.T):
+            if kept + len(block) >= n:
+                m = n - kept
+                for blocks in (self.T, self.Y, self.YP, self.D):
+                    blocks[k] = blocks[k][:m]
+                    del blocks[k + 1:]
+                break
+            kept += len(block)
+        self.rows = n
+
     def callbacks(self, d):
         """Mode ``d``'s callbacks of the integrated model (:meth:`serve`)."""
         return self.serve(self.cm, d)
@@ -185,13 +231,15 @@ def _concat(blocks, width):
     return np.concatenate(blocks) if blocks else np.zeros((0, width))
 
 
-class _Start(NamedTuple):
-    """The consistent start of a run, after the event iteration at ``t0``."""
+class _State(NamedTuple):
+    """Where the loop is: the point ``(t, y, y')``, the discrete values ``d``
+    and their callbacks ``cb``, and whether a terminal event fired."""
+    t: float
     y: np.ndarray
     yp: np.ndarray
     d: list
     cb: object
-    stop: bool      # a terminal event fired
+    stop: bool
 
 
 def simulate(cm, t_end=1.0, t0=0.0, params=None, sensitivities=None, **options):
@@ -233,7 +281,14 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, sensitivities=None, **options):
     stderr, shown once a run has lasted 2 s (it does not change the
     solution). With a wall or step limit the time span is integrated in
     windows of about a quarter of a second of wall time each (see
-    :class:`_Watch`).
+    :class:`_Watch`). ``max_memory`` (bytes): the stored rows are also
+    capped so that they fit in it (about :data:`ROW_FACTOR` x 8 bytes per
+    stored number); a requested output grid that does not fit is refused
+    before the run. A stop requested by :func:`request_stop` (the command
+    line's Ctrl-C and SIGTERM) ends the run like a limit, with an
+    :class:`~acausal.errors.Interrupted` error holding the partial result.
+    Every limit keeps the rows computed up to the stop, also when it falls
+    inside one solver call (the solver's own steps, ``output_step=0``).
 
     ``linsolver``: IDA's linear solver, see
     :meth:`acausal.runtime.model.CompiledModel.linear_solver` (``"auto"``
@@ -246,21 +301,26 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, sensitivities=None, **options):
     d(body.x)/d(spring.c) at every ``res.t``,
     ``res.event_sensitivity("spring.c")`` the derivatives of the event times."""
     wall0 = _time.perf_counter()
-    settings = RunOptions.of(options)
-    backend = _backend(settings.backend)
-    run, start = _start(cm, (t0, t_end), params, settings, backend, sensitivities)
-    _check_output_size(cm, t0, t_end, settings.output_step, settings.output_times,
-                       settings.max_rows)
-    tout = _output_times(t0, t_end, settings.output_step, settings.output_times)
-    run.record(t0, start.y, start.yp, start.d)
-    watch = _Watch(run, wall0, settings)
+    s = RunOptions.of(options)
+    _check_times(t0, t_end, s.rtol, s.atol, s.max_rows, s.max_wall, s.max_total_steps,
+                 s.max_memory)
+    _check_output_size(cm, t0, t_end, s.output_step, s.output_times, s.max_rows, s.max_memory)
+    run, state = _start(cm, (t0, t_end), params, s, _backend(s.backend), sensitivities)
+    tout = _output_times(t0, t_end, s.output_step, s.output_times)
+    run.record(t0, state.y, state.yp, state.d)
+    max_rows = _row_cap(cm, s.max_rows, s.max_memory)
+    watch = _Watch(run, wall0, max_rows, s.max_wall, s.max_total_steps, s.progress)
+    STOP.active += 1
     try:
-        _integrate(run, watch, start, tout, settings.output_step == 0)
+        _integrate(run, watch, state, tout, s.output_step == 0)
     except SolverError as exc:
         exc.result = exc.result or run.result("failed", str(exc))
         exc.result.stats["wall_s"] = _time.perf_counter() - wall0
         raise
     finally:
+        STOP.active -= 1
+        if STOP.active == 0:
+            STOP.reason = None     # the request is answered
         watch.close()
     res = run.result()
     res.stats["wall_s"] = _time.perf_counter() - wall0
@@ -279,37 +339,56 @@ def _observer(cm, sensitivities):
 
 
 def _start(cm, span, params, settings, backend, sensitivities):
-    """The run and its consistent start (:class:`_Start`), after the event
-    iteration at ``t0``."""
+    """The run and where its loop starts (:class:`_State`): the consistent
+    point at ``t0``, after the event iteration there."""
     params, starts = cm.split_overrides(params)
     p = cm.param_vector(params)
     d = cm.discrete_start()
-    atol = atol_vector(cm, settings.atol, settings.atol_algebraic)
+    atol = nominal_atol(cm, atol_vector(cm, settings.atol, settings.atol_algebraic),
+                        settings.rtol, settings.atol)
     observer = _observer(cm, sensitivities)
     model, atol = observer.system(cm, atol, p)
     opts = dict(rtol=settings.rtol, atol=atol, max_step=settings.max_step or 0.0,
                 max_num_steps=settings.max_steps, linsolver=settings.linsolver)
+    t0 = span[0]
     run = _Run(model, p, span, opts, backend, observer)
+    run.schedule = TimeSchedule(cm, p, *span)
+    d, _ = run.schedule.update(t0, d, start=True)   # the time switches' values at t0
     cb = run.serve(cm, d)
-    y, yp = initial_point(cm, p, d, cb, span[0], starts)
-    y, yp, d, cb = observer.on_start(run, Point(span[0], y, yp), d, cb, starts)
+    y, yp = initial_point(cm, p, d, cb, t0, starts)
+    y, yp, d, cb = observer.on_start(run, Point(t0, y, yp), d, cb, starts)
     run.cb_d = list(d)
-    return run, _Start(*_event_iteration(run, cb, span[0], y, yp, d))
+    return run, _State(t0, *_event_iteration(run, cb, t0, y, yp, d))
 
 
-def _integrate(run, watch, start, tout, every_step):
+def _integrate(run, watch, state, tout, every_step, t_stop=None):
     """The hybrid loop: segments between events (each ends at a terminal
-    root, the end or a window of the watch), observer roots, event actions
-    with re-initialisation and event iteration; output is recorded in ``run``."""
-    y, yp, d, cb, stop = start
-    t, t_end = run.t0, run.t_end
-    while not stop and t < t_end:
-        tspan = _tspan(t, tout, t_end, watch.horizon(t))
+    root, a time event, the end or a window of the watch), observer roots,
+    event actions with re-initialisation and event iteration; output is
+    recorded in ``run``. It ends at ``t_stop`` (default: the run's end) or at
+    a terminal event, and returns the :class:`_State` it reached."""
+    t, y, yp, d, cb, stop = state
+    t_end = run.t_end if t_stop is None else t_stop
+    while not stop and t < t_end - SAME_INSTANT * max(abs(t), abs(t_end)):
+        if not run.schedule.empty():
+            y, yp, d, cb, stop = _time_events(run, cb, Point(t, y, yp), d)
+            if stop:
+                break
+        tspan = _tspan(t, tout, t_end, watch.horizon(t), run.schedule.next(t, d))
         seg = watch.solve(run.solver(), watch.wrap(cb, tspan), d, tspan, y, yp,
                           every_step=every_step)
         run.nfev += seg.nfev
         run.njev += seg.njev
         run.steps += seg.steps
+        if watch.stopping:     # a limit or a stop request inside the call: keep its rows
+            st = np.asarray(seg.t, float)
+            keep = (st > float(run.T[-1][-1])) & np.r_[False, np.diff(st) > 0]
+            if watch.stopping == "rows" and watch.max_rows is not None:
+                keep[np.cumsum(keep) > max(int(watch.max_rows) - run.rows, 0)] = False
+            if keep.any():
+                run.record(np.asarray(seg.t)[keep], np.asarray(seg.y)[keep],
+                           np.asarray(seg.yp)[keep], d)
+            raise watch._error(watch.stopping, float(run.T[-1][-1]))
         if len(seg.t) > 1:
             run.record(seg.t[1:], seg.y[1:], seg.yp[1:], d)
         if seg.status < 0:
@@ -329,6 +408,100 @@ def _integrate(run, watch, start, tout, every_step):
         y, yp, d, cb, stop = _handle(run, cb, Point(t, y, yp), d, fired)
         if list(d) != d_before:
             run.record(t, y, yp, d)
+    return _State(t, y, yp, d, cb, stop)
+
+
+
+class Stepper:
+    """The hybrid loop advanced on demand, one interval at a time (a
+    co-simulation's doStep, :mod:`acausal.interop.fmu`).
+
+    ``Stepper(cm, params, t0, **options)`` initialises at ``t0`` exactly as
+    :func:`simulate` does (the consistent start, then the event iteration);
+    ``options`` are :func:`simulate`'s ``t_end`` (the end of the whole run,
+    which sizes the chattering guard), ``rtol``, ``atol``, ``atol_algebraic``,
+    ``max_step``, ``max_steps``, ``backend``, ``linsolver`` and
+    ``output_step``. :meth:`advance` integrates to a later time across every
+    event on the way (each interval starts the integrator afresh, as an event
+    does); :meth:`set_parameters` changes free parameters between intervals
+    (the states are kept, the algebraic unknowns and derivatives
+    re-initialised, then the event iteration runs). ``keep=True`` keeps every
+    output row on :meth:`result` (on the ``output_step`` grid, 0: every
+    solver step), for measures of the run so far; else only the last point.
+    ``stopped`` is True once a terminal event fired; ``t, y, yp, d`` is the
+    point reached."""
+
+    OPTIONS = dict(t_end=1.0, rtol=1e-6, atol=1e-8, atol_algebraic=None, max_step=None,
+                   max_steps=100000, backend=None, linsolver="auto", output_step=None)
+
+    def __init__(self, cm, params=None, t0=0.0, keep=False, **options):
+        unknown = sorted(set(options) - set(self.OPTIONS))
+        if unknown:
+            raise UsageError(f"Stepper: unknown option {unknown[0]!r}; options: "
+                             + ", ".join(self.OPTIONS))
+        o = {**self.OPTIONS, **options}
+        wall0 = _time.perf_counter()
+        self.cm, self.keep, self.t_end = cm, keep, float(o["t_end"])
+        self.output_step = o["output_step"] if keep else None
+        settings = RunOptions.of({k: v for k, v in o.items()
+                                  if k not in ("t_end", "output_step")})
+        run, state = _start(cm, (t0, self.t_end), params, settings, _backend(o["backend"]),
+                            None)
+        _, y, yp, d, cb, stop = state
+        self.run, self.cb, self.stopped = run, cb, stop
+        self.t, self.y, self.yp, self.d = float(t0), y, yp, list(d)
+        self.grid = (_output_times(t0, self.t_end, self.output_step, None)
+                     if keep and self.output_step != 0 else np.zeros(0))
+        run.record(t0, y, yp, d)
+        self.watch = _Watch(run, wall0, None, None, None, False)
+
+    def advance(self, t_to):
+        """Integrate from :attr:`t` to ``t_to`` (or to a terminal event before
+        it: then :attr:`stopped`). A solver failure raises its SolverError."""
+        t_to = float(t_to)
+        if self.stopped or not t_to > self.t:
+            return
+        if not self.keep:   # only the last point is kept
+            run = self.run
+            for rows in (run.T, run.Y, run.YP, run.D):
+                rows[:] = [rows[-1][-1:]]
+        tout = self.grid[(self.grid > self.t) & (self.grid < t_to)]
+        tout = np.append(tout, t_to)
+        state = _State(self.t, self.y, self.yp, self.d, self.cb, False)
+        t, y, yp, d, cb, stop = _integrate(self.run, self.watch, state, tout,
+                                           self.output_step == 0, t_stop=t_to)
+        self.t, self.y, self.yp, self.d, self.cb = float(t), y, yp, list(d), cb
+        self.stopped = bool(stop)
+
+    def set_parameters(self, values):
+        """Set free parameters (name -> value, checked against their bounds)
+        at the current time; a change re-initialises the algebraic unknowns
+        and derivatives (the states are kept) and runs the event iteration."""
+        cm, run = self.cm, self.run
+        p = run.p.copy()
+        for name, value in values.items():
+            i = cm.param_index(name)
+            p[i] = cm.param_vector({name: value})[i]
+        if np.array_equal(p, run.p):
+            return
+        run.p[:] = p
+        run._served.clear()
+        run._solver = None   # a new segment solver takes the new values
+        cb = run.callbacks(self.d)
+        run.cb_d = list(self.d)
+        y, yp = reinitialize(cm, cb, self.t, self.y, self.yp)
+        y, yp, d, cb, stop = _event_iteration(run, cb, self.t, y, yp, self.d)
+        self.y, self.yp, self.d, self.cb = y, yp, list(d), cb
+        self.stopped = self.stopped or bool(stop)
+        run.record(self.t, y, yp, d)
+
+    def observed(self):
+        """The values of ``cm.var_names`` at the current point."""
+        return np.asarray(self.cb.observe(self.t, self.y, self.yp), dtype=float)
+
+    def result(self):
+        """The :class:`Result` of the run so far (see ``keep``)."""
+        return self.run.result("stopped" if self.stopped else "ok")
 
 
 # ---------------------------------------------------------------------------
@@ -346,25 +519,80 @@ def _output_count(t0, t_end, output_step, output_times):
     return (t_end - t0) / step + 1
 
 
-def _check_output_size(cm, t0, t_end, output_step, output_times, max_rows):
-    """Refuse, before allocating it, an output grid of more than ``max_rows`` rows."""
+def _count(n):
+    """A count as '1,000,001' (exact below 1e9), else '5e+13'."""
+    return f"{n:,.0f}" if n < 1e9 else f"{n:.3g}"
+
+
+def _row_bytes(cm):
+    """Bytes one stored output row takes, all copies counted (:data:`ROW_FACTOR`)."""
+    return ROW_FACTOR * 8 * (2 * len(cm.dae.y) + len(cm.discretes) + 1)
+
+
+def _row_cap(cm, max_rows, max_memory):
+    """``max_rows``, lowered so that the stored rows fit in ``max_memory``."""
+    if max_memory is None:
+        return max_rows
+    cap = max(2, int(max_memory // _row_bytes(cm)))
+    return cap if max_rows is None else min(max_rows, cap)
+
+
+def _check_times(t0, t_end, rtol, atol, max_rows, max_wall, max_total_steps, max_memory):
+    """The run's times, tolerances and limits are numbers in range (a
+    UsageError naming the one that is not; -1 or nan reached IDA and
+    numpy as tracebacks)."""
+    def bad(name, value, what):
+        raise UsageError(f"{name} = {value!r}: must be {what}", variable=name)
+    for name, value in (("t0", t0), ("t_end", t_end)):
+        if not isinstance(value, (int, float, np.floating, np.integer)) or \
+                not np.isfinite(value):
+            bad(name, value, "a finite number")
+    if not t_end > t0:
+        bad("t_end", t_end, f"after t0 = {t0:g} s")
+    if not (isinstance(rtol, (int, float, np.floating)) and 0 < rtol < 1):
+        bad("rtol", rtol, "a number between 0 and 1")
+    atols = list(atol.values()) if isinstance(atol, dict) else \
+        np.ravel(np.asarray(atol, dtype=float)).tolist() if not isinstance(atol, str) else [atol]
+    if not all(isinstance(a, (int, float)) and np.isfinite(a) and a > 0 for a in atols):
+        bad("atol", atol, "a finite number > 0")
+    for name, value in (("max_rows", max_rows), ("max_wall", max_wall),
+                        ("max_total_steps", max_total_steps), ("max_memory", max_memory)):
+        if value is not None and not (np.isfinite(value) and value > 0):
+            bad(name, value, "a number > 0 (or None: no limit)")
+
+
+def _check_output_size(cm, t0, t_end, output_step, output_times, max_rows, max_memory=None):
+    """Refuse, before allocating it, an output grid of more than ``max_rows``
+    rows, or of more than ``max_memory`` bytes."""
     n = _output_count(t0, t_end, output_step, output_times)
+    need = n * _row_bytes(cm)
+    grid = ("the output times" if output_times is not None else
+            f"the output grid (every {output_step or (t_end - t0) / 500:g} s from {t0:g} "
+            f"to {t_end:g} s)")
     if max_rows is not None and n > max_rows:
-        gb = n * 8 * (2 * len(cm.dae.y) + len(cm.discretes) + 1) / 1e9
-        grid = ("the output times" if output_times is not None else
-                f"the output grid (every {output_step or (t_end - t0) / 500:g} s from {t0:g} "
-                f"to {t_end:g} s)")
-        raise LimitError(
-            f"{grid} has {n:.3g} rows (~{gb:.3g} GB), more than max_rows = {max_rows:g}: "
-            "choose a larger output step, output_step=0 (the solver's own steps), a shorter "
-            "t_end, or raise max_rows (--max-rows)", t=t0)
+        raise OutputGridError(
+            f"{grid} has {_count(n)} rows (~{need / 1e9:.3g} GB), more than max_rows = "
+            f"{_count(max_rows)}: choose a larger output step, output_step=0 (the solver's own "
+            "steps), a shorter t_end, or raise max_rows (--max-rows)", t=t0)
+    if max_memory is not None and need > max_memory:
+        raise OutputGridError(
+            f"{grid} has {_count(n)} rows, which need about {need / 1e9:.3g} GB, more than the "
+            f"memory limit {max_memory / 1e9:.3g} GB: choose a larger output step, a shorter "
+            "t_end, or raise the limit (--max-memory)", t=t0)
 
 
-def _tspan(t, tout, t_end, horizon):
+def _tspan(t, tout, t_end, horizon, t_event=np.inf):
     """Times of the next solver call: ``t``, then the output times after it,
     up to ``t_end`` (which ends the span), or up to ``horizon`` when a watch
-    cuts the run into windows (at least one output time)."""
-    later = tout[tout > t]
+    cuts the run into windows (at least one output time), or up to the
+    next time event ``t_event`` (which then ends the span: the solver
+    stops exactly there)."""
+    # an output time closer to t than IDA can step (it refuses a tout within
+    # 100 unit round-offs of t: an output 1 ulp after a time event) is t
+    after = t + SAME_INSTANT * max(abs(t), abs(t_end))
+    if t_event < t_end and (horizon is None or t_event <= horizon):
+        return np.concatenate([[t], tout[(tout > after) & (tout < t_event)], [t_event]])
+    later = tout[tout > after]
     if horizon is not None and horizon < t_end:
         cut = later[later <= horizon]
         if len(cut) == 0:
@@ -374,84 +602,140 @@ def _tspan(t, tout, t_end, horizon):
                            else np.append(later, t_end)])
 
 
-class _HardStop(Exception):
-    """Raised from inside the residual when a limit is far exceeded."""
-
-
 class _Watch:
     """The limits and the progress bar of one run.
 
-    Between two solver calls: the stored rows, the wall time and the steps
-    are checked (:meth:`check`), the progress bar moves. With a wall or step
-    limit the span is cut into windows (:meth:`horizon`)
-    sized to take about ``WINDOW_S`` of wall time each (every window
-    restarts IDA, like an event). Inside a solver call the residual is
-    wrapped (:meth:`wrap`): a call that runs far past a limit (or stores
-    every step past ``max_rows``) is stopped; the rows of that call are lost,
-    the earlier ones kept."""
+    Between two solver calls: the stored rows, the wall time, the steps and
+    a stop request (:data:`STOP`) are checked (:meth:`check`), the progress
+    bar moves. With a wall or step limit the span is cut into windows
+    (:meth:`horizon`) sized to take about ``WINDOW_S`` of wall time each
+    (every window restarts IDA, like an event). Inside a solver call the
+    residual is wrapped (:meth:`wrap`; the compiled backend calls
+    :meth:`guard` each time its output buffer fills): a call that runs far
+    past a limit, stores every step past ``max_rows``, or meets a stop
+    request, is ended (``stopping`` says why) and the rows it computed
+    until then are kept: the Python residual then returns NaN, so that IDA
+    gives up at its last accepted step and returns what it has (scikit-sundae
+    loses a call's rows when the residual raises), and the compiled
+    backend's guard returns True."""
 
-    def __init__(self, run, wall0, settings):
+    def __init__(self, run, wall0, max_rows, max_wall, max_total_steps, progress):
         self.run, self.wall0 = run, wall0
-        self.max_rows, self.max_wall = settings.max_rows, settings.max_wall
-        self.max_steps = settings.max_total_steps
-        self.windowed = self.max_wall is not None or self.max_steps is not None
+        self.max_rows, self.max_wall, self.max_steps = max_rows, max_wall, max_total_steps
+        self.windowed = max_wall is not None or max_total_steps is not None
         self.span = run.t_end - run.t0
         self.dt = self.span * 1e-4   # grows by up to 8x a window
-        self.bar = _progress_bar(self.span) if settings.progress else None
+        self.bar = _progress_bar(self.span) if progress else None
         self.t_call = None
         self.counter = None
         self.every_step = False
+        self.stopping = None
 
     def horizon(self, t):
         return t + self.dt if self.windowed else None
 
     def wrap(self, cb, tspan):
         """``cb`` with its residual checking the limits and moving the
-        progress bar every 64 calls (when limits are set, a bar is shown or
-        the call stores every step, as a two-point ``tspan`` does; else
-        ``cb`` itself)."""
+        progress bar every 64 calls (when limits are set, a bar is shown,
+        a stop may be requested or the call stores every step, as a
+        two-point ``tspan`` does; else ``cb`` itself); once the call is
+        to stop, the residual is NaN and the Jacobian is not evaluated."""
         res, count, calls = cb.res, cb.count, [0]
         self.counter = count
-        if not self.windowed and self.bar is None and len(tspan) != 2:
+        if not self.windowed and self.bar is None and len(tspan) != 2 and not STOP.armed:
             return cb
 
         def checked(t, y, yp, r):
+            if self.stopping:
+                r[:] = np.nan
+                return
             calls[0] += 1
             if calls[0] % 64 == 0:
-                self._hard(count[0])
+                self.stopping = self._hard(count[0])
                 self._show(t)
+                if self.stopping:
+                    self._mute()   # IDA's message about the failure it is led into
+                    r[:] = np.nan
+                    return
             res(t, y, yp, r)
-        return cb._replace(res=checked)
+
+        def jacobian(fn):
+            def jac(*args):
+                if not self.stopping:
+                    fn(*args)
+            return jac
+        return cb._replace(res=checked, jac=jacobian(cb.jac), jac_csc=jacobian(cb.jac_csc))
+
+    def _mute(self):
+        """Send what C code prints (SUNDIALS writes its error lines to
+        stdout) to /dev/null until the call returns."""
+        self._saved_fds = []
+        try:
+            sys.stdout.flush()
+            sys.stderr.flush()
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            for fd in (1, 2):
+                self._saved_fds.append((fd, os.dup(fd)))
+                os.dup2(devnull, fd)
+            os.close(devnull)
+        except (OSError, ValueError):
+            self._unmute()
+
+    def _unmute(self):
+        saved, self._saved_fds = getattr(self, "_saved_fds", []), []
+        if saved:
+            try:
+                import ctypes
+                ctypes.CDLL(None).fflush(None)   # C stdio buffers, into /dev/null
+            except (OSError, TypeError, AttributeError):
+                pass
+        for fd, copy in saved:
+            os.dup2(copy, fd)
+            os.close(copy)
 
     def _show(self, t):
         if self.bar is not None and t - self.run.t0 > self.bar.n:
             self.bar.update(t - self.run.t0 - self.bar.n)
 
     def _hard(self, steps_now):
+        """Why the current solver call must end now, or None: a stop
+        request; a limit exceeded (far exceeded when windows will stop the
+        run at their end; exactly when the call stores every step, which
+        no window cuts)."""
+        if STOP.reason:
+            return "interrupt"
         steps = self.run.steps + steps_now
         wall = _time.perf_counter() - self.wall0
-        if self.max_wall is not None and wall > 1.25 * self.max_wall + 1.0:
-            raise _HardStop("wall")
-        if self.max_steps is not None and steps > 1.25 * self.max_steps + 1000:
-            raise _HardStop("steps")
+        exact = self.every_step
+        if self.max_wall is not None and wall > (
+                self.max_wall if exact else 1.25 * self.max_wall + 1.0):
+            return "wall"
+        if self.max_steps is not None and steps > (
+                self.max_steps if exact else 1.25 * self.max_steps + 1000):
+            return "steps"
         if (self.every_step and self.max_rows is not None
                 and self.run.rows + steps_now > self.max_rows):
-            raise _HardStop("rows")  # every step is stored (a two-point span)
+            return "rows"   # every step is stored (a two-point span)
+        return None
+
+    def guard(self, steps_now):
+        """The compiled backend's check, each time its output buffer fills:
+        True to end the call (its rows are kept)."""
+        self.stopping = self.stopping or self._hard(steps_now)
+        return bool(self.stopping)
 
     def solve(self, solver, cb, d, tspan, y, yp, every_step):
         """One segment of ``solver`` (:mod:`acausal.runtime.backends`) over ``tspan``;
         a limit far exceeded inside it (seen by the wrapped residual of a
-        Python backend) stops the run."""
+        Python backend, or the compiled backend's guard) or a stop request
+        ends the call early, with ``stopping`` set."""
         self.t_call = _time.perf_counter()
         self.every_step = len(tspan) == 2
-        solver.guard = self._hard     # (a compiled backend's check, per output buffer)
+        solver.guard = self.guard
         try:
             return solver.solve(cb, d, float(tspan[0]), y, yp, tspan[1:], every_step)
-        except _HardStop as exc:
-            self.run.steps += self.counter[0]
-            self.counter[0] = 0
-            raise self._error(str(exc), float(tspan[0])) from None
         finally:
+            self._unmute()
             # no cycle solver -> watch -> run -> solver: the run's IDA handle
             # goes back to the backend's pool as soon as the run is dropped
             solver.guard = None
@@ -465,6 +749,8 @@ class _Watch:
         if self.bar is not None:
             self._show(t)
             self.bar.set_postfix(steps=run.steps, events=len(run.events), refresh=False)
+        if STOP.reason:
+            raise self._error("interrupt", t)
         if self.max_rows is not None and run.rows > self.max_rows:
             raise self._error("rows", t)
         if self.max_wall is not None and now - self.wall0 > self.max_wall:
@@ -476,16 +762,21 @@ class _Watch:
         run = self.run
         what = {"rows": ("more than max_rows = {:g} stored output rows", self.max_rows),
                 "wall": ("the wall-time limit max_wall = {:g} s", self.max_wall),
-                "steps": ("the step limit max_total_steps = {:g}", self.max_steps)}[which]
+                "steps": ("the step limit max_total_steps = {:g}", self.max_steps),
+                "interrupt": ("{}", STOP.reason)}[which]
         what = what[0].format(what[1])
+        if which == "rows" and self.max_rows is not None:
+            run.trim(int(self.max_rows))
         t_last = float(run.T[-1][-1]) if run.T else t
-        why = (_dominant(run) if which != "rows" else "an output step, a shorter t_end or a "
-               "larger max_rows (--max-rows) stores less")
+        why = (_dominant(run) if which not in ("rows", "interrupt") else
+               "an output step, a shorter t_end or a larger max_rows (--max-rows) stores less"
+               if which == "rows" else "the result up to there is kept")
         msg = (f"stopped at t = {t_last:.6g} s of {run.t_end:g} s by {what} "
                f"({run.steps} steps, {len(run.events)} events, "
                f"{_time.perf_counter() - self.wall0:.3g} s): {why}")
-        return LimitError(msg, t=t_last, component=_dominant_owner(run),
-                          result=run.result("stopped", msg))
+        cls = Interrupted if which == "interrupt" else LimitError
+        return cls(msg, t=t_last, component=_dominant_owner(run),
+                   result=run.result("stopped", msg))
 
     def close(self):
         if self.bar is not None:
@@ -526,7 +817,8 @@ def _backend(name):
 
 
 # ---------------------------------------------------------------------------
-# Events: observer roots, the events that end a segment, the event iteration
+# Events: observer roots, the events that end a segment, time events, the
+# event iteration
 # ---------------------------------------------------------------------------
 
 
@@ -601,6 +893,27 @@ def _handle(run, cb, point, d, fired):
     return y, yp, d, cb, stop
 
 
+def _time_events(run, cb, point, d):
+    """The time events due at ``point`` (:mod:`acausal.runtime.timeevents`):
+    the switches set to their values after its time, the due time events'
+    actions run and logged; a changed mode is re-initialised and iterated
+    like any event's, and recorded after the row before it."""
+    t, y, yp = point
+    obs = cb.observe(t, y, yp)
+    d_new, fired = run.schedule.update(t, d, obs)
+    if fired:
+        run.observer.on_event(run, point, d, fired, "time")
+    for ev in {ev.name: ev for ev in fired}.values():   # one entry per name and instant
+        _log_event(run, t, ev, ev)
+    stop = False
+    if list(d_new) != list(d):
+        d, cb, y, yp = run.observer.on_mode_change(run, [], point, list(d), d_new, obs)
+        y, yp, d, cb, stop = _event_iteration(run, cb, t, y, yp, d)
+        run.record(t, y, yp, d)
+    run.observer.on_instant_end(run)
+    return y, yp, d, cb, stop
+
+
 def _event_iteration(run, cb, t, y, yp, d):
     """Fire ``recheck`` events whose condition is violated at this instant."""
     cm = run.cm
@@ -632,16 +945,17 @@ def _event_iteration(run, cb, t, y, yp, d):
                           + ", ".join(sorted({cm.events[i].owner for i in checks})), t=t)
 
 
-def _log_event(run, t, ev, i):
-    """Record event ``ev`` (index ``i``) in ``res.events`` (telling the
-    observer), unless it is bookkeeping (``Event(log=False)``); a
-    ChatteringError when this same event (one root of one component) has
-    fired CHATTER_COUNT times within CHATTER_SPAN of the run's span: its mode
-    logic toggles without time advancing (Zeno). Many different roots firing
-    at one instant (199 contacts of a Newton's cradle closing at t = 0) are
-    not chattering: each fires once."""
+def _log_event(run, t, ev, key):
+    """Record event ``ev`` in ``res.events`` (telling the observer: ``key``
+    is its index in ``cm.events``, or the time event itself), unless it is
+    bookkeeping (``Event(log=False)``); a ChatteringError when this same
+    event (one root of one component) has fired CHATTER_COUNT times within
+    CHATTER_SPAN of the run's span: its mode logic toggles without time
+    advancing (Zeno). Many different roots firing at one instant (199
+    contacts of a Newton's cradle closing at t = 0) are not chattering: each
+    fires once."""
     if ev.log:
-        run.observer.on_log(run, len(run.events), i)
+        run.observer.on_log(run, len(run.events), key)
         run.events.append((t, ev.name))
     run.event_log.append((t, ev.owner))
     times = run.firings.get((ev.owner, ev.name))
@@ -688,7 +1002,8 @@ def _failure(run, cm, sol, cb):
         extra += ("; " + ", ".join(f"parameter {nm} = {v:g} [{u}] is far from its default "
                                    f"{dv:g}" for nm, v, dv, u in suspect)
                   + ": check its value and unit")
-    message = f"IDA failed at t = {t:.9g} s{where}: {r.message}{extra}"
+    who = "IDA failed" if cm.dae.n_states else "solving the equations (no states) failed"
+    message = f"{who} at t = {t:.9g} s{where}: {r.message}{extra}"
     result = run.result("failed", r.message)
     hint = ask_components(cm.model, "solver_failure", [comp] if comp else [], message, t,
                           result)

@@ -108,6 +108,16 @@ class _InitialSystem:
 def _solve_initial(cm, p, d, cb, t0, starts=None):
     """initial_point without the diagnosis of its failure."""
     sys_ = _InitialSystem(cm, p, d, cb, t0, starts)
+    if sys_.n == 0:   # every unknown explicit: only the fixed starts to check
+        full = sys_.residual(sys_.z0)
+        try:
+            _check(cm, full, np.zeros((len(full), 0)), sys_.z0, sys_.fixed, 0)
+        except InitializationError as exc:
+            raise InitializationError(
+                f"{exc}; the model has no states (every motion is prescribed by supports "
+                "and sources), so a fixed start must agree with the prescribed motion",
+                component=exc.component, variable=exc.variable) from None
+        return np.zeros(0), np.zeros(0)
     z0 = sys_.z0
     guess_rows, z, checked = _guesses_and_newton(cm, cb, t0, sys_, starts)
     if not checked:

@@ -18,7 +18,11 @@ The order of the calls in a run::
 ``on_event`` comes before the actions of the events it names, with
 ``kind``: ``"observer"`` (observer events located inside a segment; their
 actions run, then ``on_actions``), ``"instant"`` (the events that ended a
-segment), ``"recheck"`` (events of the event iteration at the same instant).
+segment), ``"time"`` (time events and switches due at the start of a
+segment, :mod:`.timeevents`), ``"recheck"`` (events of the event iteration
+at the same instant). The stored rows may be cut to their first ``n``
+after the fact (``run.trim``, a row limit): an observer keeping rows of its
+own keeps as many as ``run.T`` has.
 """
 from typing import NamedTuple
 
@@ -51,11 +55,13 @@ class RunObserver:
         """``count`` output rows were stored (``run.T[-1]`` ...)."""
 
     def on_event(self, run, point, d, fired, kind):
-        """Events ``fired`` (indices into ``cm.events``) are about to act at
-        ``point`` in mode ``d``; ``kind`` as in the module doc."""
+        """Events ``fired`` (indices into ``cm.events``; for ``kind`` "time"
+        the time events themselves) are about to act at ``point`` in mode
+        ``d``; ``kind`` as in the module doc."""
 
-    def on_log(self, run, k, i):
-        """Event ``i`` is logged as ``run.events[k]`` (about to be appended)."""
+    def on_log(self, run, k, key):
+        """Event ``key`` (as ``on_event`` named it) is logged as
+        ``run.events[k]`` (about to be appended)."""
 
     def on_actions(self, run, events, point, d_before, observed):
         """Observer ``events``' actions ran at ``point`` (discrete values

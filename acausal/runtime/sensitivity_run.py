@@ -78,9 +78,15 @@ class SensitivityObserver(RunObserver):
     def on_event(self, run, point, d, fired, kind):
         """The event-time sensitivities of ``fired`` (kept for :meth:`on_log`):
         those of the events a segment located (``"observer"``, ``"instant"``;
-        the instant's is the first's), or the instant's own (``"recheck"``:
-        the event iteration fires at the instant)."""
-        if kind == "recheck":
+        the instant's is the first's), a time event's (``"time"``: the
+        derivative of its instant,
+        :meth:`acausal.runtime.timeevents.TimeSchedule.time_sensitivity`,
+        also the instant's), or the instant's own (``"recheck"``: the event
+        iteration fires at the instant)."""
+        if kind == "time":
+            self.dtau[:] = run.schedule.time_sensitivity(point.t, d, self.sm.pidx)
+            self.pending = {ev: self.dtau.copy() for ev in fired}
+        elif kind == "recheck":
             # NOTE: the instant's array itself, not a copy, as the loop has
             # always passed it: such an event's entry in the result is the
             # array's value when the result is made, zero after every instant
@@ -91,8 +97,8 @@ class SensitivityObserver(RunObserver):
         else:
             self.pending = self.event_times(point, d, fired, current=kind == "instant")
 
-    def on_log(self, run, k, i):
-        self.noted[k] = np.asarray(self.pending[i], float)
+    def on_log(self, run, k, key):
+        self.noted[k] = np.asarray(self.pending[key], float)
 
     def on_actions(self, run, events, point, d_before, observed):
         """Observer events' actions ran: the sensitivities of the discrete
@@ -113,7 +119,9 @@ class SensitivityObserver(RunObserver):
         sm = self.sm
         T, Y, YP, D = rows
         nd = len(sm.base.disc_syms)
-        SD = np.concatenate(self.SD) if self.SD else np.zeros((0, self.sd_all.size))
+        # the rows the run kept (a limit may have trimmed them: run.trim)
+        kept = [sd[:len(t)] for sd, t in zip(self.SD, run.T)]
+        SD = np.concatenate(kept) if kept else np.zeros((0, self.sd_all.size))
         E = np.full((len(run.events), sm.m), np.nan)
         for k, v in self.noted.items():
             if k < len(run.events):
@@ -158,7 +166,8 @@ class SensitivityObserver(RunObserver):
 
     def rates(self, cb, t, Y, YP):
         """``YP`` with y' of every algebraic slot of the augmented system
-        (callbacks ``cb``), as the initialisation's algebraic rates give it: ``J x = -(F_t + F_y(states) y'_states)`` for x = (y' of the
+        (callbacks ``cb``), as the initialisation's algebraic rates give it:
+        ``J x = -(F_t + F_y(states) y'_states)`` for x = (y' of the
         algebraic slots, y'' of the states), solved by blocks with the base
         model's matrix ``J0``
         (:meth:`acausal.runtime.sensitivity.SensitivityModel.block_solve`). The

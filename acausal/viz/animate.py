@@ -4,7 +4,8 @@ animation (GIF with Pillow, MP4 where ffmpeg exists), with matplotlib.
 What is drawn comes from the model's planar components (their frame
 positions in the result; :mod:`acausal.connectors` for the frame):
 
-* ``FixedTranslation`` (a rigid link): a thick line frame_a -> frame_b;
+* ``FixedTranslation`` (a rigid link) and the two-frame bodies
+  (``BodyShape``, ``BodyBox``, ``BodyCylinder``): a thick line frame_a -> frame_b;
 * ``Body``: a disc at its centre of mass with a tick along its x axis;
 * ``Revolute``: a small ring at the pin; ``Prismatic``: its guide line and a
   square block at frame_b; ``Fixed``: a triangle (ground);
@@ -34,8 +35,10 @@ class Item:
 
 
 def _kinds():
-    from ..mechanics.planar import forces, joints, parts
-    return [(parts.FixedTranslation, "link"), (parts.Body, "body"), (joints.Revolute, "pin"),
+    from ..mechanics.planar import bodies, forces, joints, parts
+    return [(parts.FixedTranslation, "link"), (parts.FixedRotation, "link"),
+            (bodies.BodyShape, "link"),
+            (parts.Body, "body"), (joints.Revolute, "pin"),
             (joints.Prismatic, "slider"), (parts.Fixed, "ground"),
             (forces.Spring, "force"), (forces.Damper, "force"), (forces.SpringDamper, "force")]
 

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from acausal.data.tube import TubeResult, tube_bounds, tube_compare, tube_size
+from acausal.errors import UsageError
 
 TOL = 1e-3
 GRID = np.linspace(0.0, 1.0, 100001)          # a fine test grid (1e-5 s)
@@ -221,9 +222,9 @@ def test_points_outside_the_reference_span_are_counted_not_checked():
 
 
 def test_reference_time_must_not_decrease():
-    with pytest.raises(ValueError, match="decreases at point 2"):
+    with pytest.raises(UsageError, match="decreases at point 2"):
         tube_compare([0.0, 0.5, 0.4, 1.0], [0, 1, 2, 3], [0.0, 1.0], [0.0, 3.0])
-    with pytest.raises(ValueError, match="values 2"):
+    with pytest.raises(UsageError, match="values 2"):
         tube_compare([0.0, 0.5, 1.0], [0, 1], [0.0, 1.0], [0.0, 3.0])
 
 

@@ -1,93 +1,156 @@
-"""Rotational sensors. Sign convention: :mod:`acausal.lang.connectors`."""
+"""Rotational sensors (MSL ``Rotational.Sensors``): ideal, they take no
+torque (absolute and relative sensors) or pass it through unchanged
+(torque, power and multi sensors). The measured values are ``RealOutput``
+signals where MSL has them, named as in MSL, and are read from a result
+under the same names (``res["ang.phi"]``). Sign convention:
+:mod:`acausal.lang.connectors`.
 
-from acausal.lang import Component, Eq, RotFlange, Variable, der
+One deliberate difference from MSL: a torque sensor's ``tau`` is the
+torque at ``flange_b`` (the sign of a
+:class:`~.components.TorsionSpring`'s ``tau`` in the same place); MSL's
+``tau`` is ``flange_a.tau``, the opposite sign. ``power`` is MSL's: the
+power entering at ``flange_a``.
+"""
 
+from acausal.lang import Eq, Variable, der
+from acausal.lang.connectors import RealOutput
 
-from ..partials import (PartialRotAbsoluteSensor, PartialRotRelativeSensor)
+from ..partials import PartialRotAbsoluteSensor, PartialRotFlowSensor, PartialRotRelativeSensor
 
-__all__ = ["AngleSensor", "SpeedSensor", "AccSensor", "TorqueSensor", "RelAngleSensor", "RelSpeedSensor"]
+__all__ = ["AngleSensor", "SpeedSensor", "AccSensor", "TorqueSensor", "PowerSensor",
+           "MultiSensor", "RelAngleSensor", "RelSpeedSensor", "RelAccSensor"]
 
 
 class AngleSensor(PartialRotAbsoluteSensor):
-    """Measures the absolute angle: ``phi = flange.phi`` (takes no torque).
+    """Measures the absolute angle (MSL ``AngleSensor``): ``phi =
+    flange.phi`` (takes no torque).
 
-    States: ``phi`` [rad]. Connectors: ``flange``.
+    Connectors: ``flange``, ``phi`` [rad] (RealOutput).
     """
 
-    phi = Variable(0.0, "rad", "measured absolute angle")
+    phi = RealOutput("absolute angle of the flange", "rad")
 
     def equations(self):
         return [Eq(self.phi, self.flange.phi)]
 
 
 class SpeedSensor(PartialRotAbsoluteSensor):
-    """Measures the absolute angular velocity: ``w = der(flange.phi)``.
+    """Measures the absolute angular velocity (MSL ``SpeedSensor``): ``w =
+    der(flange.phi)``.
 
-    States: ``w`` [rad/s]. Connectors: ``flange``.
+    Connectors: ``flange``, ``w`` [rad/s] (RealOutput).
     """
 
-    w = Variable(0.0, "rad/s", "measured absolute angular velocity")
+    w = RealOutput("absolute angular velocity of the flange", "rad/s")
 
     def equations(self):
         return [Eq(self.w, der(self.flange.phi))]
 
 
 class AccSensor(PartialRotAbsoluteSensor):
-    """Measures the absolute angular acceleration: ``a = der(der(flange.phi))``.
+    """Measures the absolute angular acceleration (MSL ``AccSensor``):
+    ``w = der(flange.phi)``, ``a = der(w)``.
 
-    States: ``w`` [rad/s], ``a`` [rad/s^2]. Connectors: ``flange``.
+    States: ``w`` [rad/s]. Connectors: ``flange``, ``a`` [rad/s2]
+    (RealOutput).
     """
 
-    w = Variable(0.0, "rad/s", "absolute angular velocity")
-    a = Variable(0.0, "rad/s^2", "measured absolute angular acceleration")
+    w = Variable(0.0, "rad/s", "absolute angular velocity of the flange")
+    a = RealOutput("absolute angular acceleration of the flange", "rad/s2")
 
     def equations(self):
         return [Eq(self.w, der(self.flange.phi)), Eq(self.a, der(self.w))]
 
 
-class TorqueSensor(Component):
+class TorqueSensor(PartialRotFlowSensor):
     """Measures the torque transmitted between its two flanges, which it
-    joins rigidly: ``flange_a.phi = flange_b.phi``,
-    ``flange_a.tau + flange_b.tau = 0``, ``tau = flange_b.tau`` — the same
-    sign as a :class:`TorsionSpring`'s ``tau`` in the same place.
-    (Modelica's and MTK's TorqueSensor report ``flange_a.tau``, the opposite
-    sign.)
+    joins rigidly (MSL ``TorqueSensor``): ``tau = flange_b.tau``, the same
+    sign as a :class:`~.components.TorsionSpring`'s ``tau`` in the same
+    place (MSL's ``tau`` is ``flange_a.tau``, the opposite sign).
 
-    States: ``tau`` [N*m]. Connectors: ``flange_a``, ``flange_b``.
+    Connectors: ``flange_a``, ``flange_b``, ``tau`` [N*m] (RealOutput).
     """
 
-    flange_a = RotFlange("left flange")
-    flange_b = RotFlange("right flange")
-    tau = Variable(0.0, "N*m", "transmitted torque (as a spring's tau)")
+    tau = RealOutput("transmitted torque flange_b.tau (as a spring's tau)", "N*m")
 
     def equations(self):
-        return [Eq(self.flange_a.phi, self.flange_b.phi),
-                Eq(self.flange_a.tau + self.flange_b.tau, 0),
-                Eq(self.tau, self.flange_b.tau)]
+        return [Eq(self.tau, self.flange_b.tau)]
+
+
+class PowerSensor(PartialRotFlowSensor):
+    """Measures the power transmitted between its two flanges (MSL
+    ``PowerSensor``): ``power = flange_a.tau * der(flange_a.phi)``, the
+    power entering at ``flange_a``.
+
+    Connectors: ``flange_a``, ``flange_b``, ``power`` [W] (RealOutput).
+    """
+
+    power = RealOutput("power entering at flange_a, flange_a.tau * der(flange_a.phi)", "W")
+
+    def equations(self):
+        return [Eq(self.power, self.flange_a.tau * der(self.flange_a.phi))]
+
+
+class MultiSensor(PartialRotFlowSensor):
+    """Measures torque, angular velocity and power at once (MSL
+    ``MultiSensor``): ``tau = flange_b.tau`` (as :class:`TorqueSensor`),
+    ``w = der(flange_a.phi)``, ``power = flange_a.tau * w`` (MSL's: the
+    power entering at ``flange_a``; ``power = -tau * w``).
+
+    Connectors: ``flange_a``, ``flange_b``, ``tau`` [N*m], ``w`` [rad/s],
+    ``power`` [W] (RealOutputs).
+    """
+
+    tau = RealOutput("transmitted torque flange_b.tau (as a spring's tau)", "N*m")
+    w = RealOutput("absolute angular velocity of the flanges", "rad/s")
+    power = RealOutput("power entering at flange_a, flange_a.tau * w", "W")
+
+    def equations(self):
+        return [Eq(self.tau, self.flange_b.tau), Eq(self.w, der(self.flange_a.phi)),
+                Eq(self.power, self.flange_a.tau * self.w)]
 
 
 class RelAngleSensor(PartialRotRelativeSensor):
-    """Measures ``phi_rel = flange_b.phi - flange_a.phi`` (takes no torque).
+    """Measures ``phi_rel = flange_b.phi - flange_a.phi`` (MSL
+    ``RelAngleSensor``; takes no torque).
 
-    States: ``phi_rel`` [rad]. Connectors: ``flange_a``, ``flange_b``.
+    Connectors: ``flange_a``, ``flange_b``, ``phi_rel`` [rad] (RealOutput).
     """
 
-    phi_rel = Variable(0.0, "rad", "measured relative angle flange_b.phi - flange_a.phi")
+    phi_rel = RealOutput("relative angle flange_b.phi - flange_a.phi", "rad")
 
     def equations(self):
         return [Eq(self.phi_rel, self.flange_b.phi - self.flange_a.phi)]
 
 
 class RelSpeedSensor(PartialRotRelativeSensor):
-    """Measures ``w_rel = der(flange_b.phi - flange_a.phi)`` (takes no torque).
+    """Measures ``w_rel = der(phi_rel)`` (MSL ``RelSpeedSensor``; takes no
+    torque).
 
-    States: ``phi_rel`` [rad], ``w_rel`` [rad/s]. Connectors: ``flange_a``,
-    ``flange_b``.
+    States: ``phi_rel`` [rad]. Connectors: ``flange_a``, ``flange_b``,
+    ``w_rel`` [rad/s] (RealOutput).
     """
 
     phi_rel = Variable(0.0, "rad", "relative angle flange_b.phi - flange_a.phi")
-    w_rel = Variable(0.0, "rad/s", "measured relative angular velocity")
+    w_rel = RealOutput("relative angular velocity der(phi_rel)", "rad/s")
 
     def equations(self):
         return [Eq(self.phi_rel, self.flange_b.phi - self.flange_a.phi),
                 Eq(self.w_rel, der(self.phi_rel))]
+
+
+class RelAccSensor(PartialRotRelativeSensor):
+    """Measures ``a_rel = der(w_rel)``, ``w_rel = der(phi_rel)`` (MSL
+    ``RelAccSensor``; takes no torque).
+
+    States: ``phi_rel`` [rad], ``w_rel`` [rad/s]. Connectors: ``flange_a``,
+    ``flange_b``, ``a_rel`` [rad/s2] (RealOutput).
+    """
+
+    phi_rel = Variable(0.0, "rad", "relative angle flange_b.phi - flange_a.phi")
+    w_rel = Variable(0.0, "rad/s", "relative angular velocity der(phi_rel)")
+    a_rel = RealOutput("relative angular acceleration der(w_rel)", "rad/s2")
+
+    def equations(self):
+        return [Eq(self.phi_rel, self.flange_b.phi - self.flange_a.phi),
+                Eq(self.w_rel, der(self.phi_rel)), Eq(self.a_rel, der(self.w_rel))]

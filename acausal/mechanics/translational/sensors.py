@@ -1,92 +1,156 @@
-"""Translational sensors. Sign convention: :mod:`acausal.lang.connectors`."""
+"""Translational sensors (MSL ``Translational.Sensors``): ideal, they take
+no force (absolute and relative sensors) or pass it through unchanged
+(force, power and multi sensors). The measured values are ``RealOutput``
+signals where MSL has them (``connect(sensor.v, block.u)``), named as in
+MSL, and are read from a result under the same names (``res["ps.s"]``).
+Sign convention: :mod:`acausal.lang.connectors`.
 
-from acausal.lang import Component, Eq, Flange, Variable, der
+One deliberate difference from MSL: a force sensor's ``f`` is the force
+at ``flange_b`` (tension positive, as a :class:`~.components.Spring`'s
+``f`` in the same place); MSL's ``f`` is ``flange_a.f``, the opposite
+sign. ``power`` is MSL's: the power entering at ``flange_a``.
+"""
 
+from acausal.lang import Eq, Variable, der
+from acausal.lang.connectors import RealOutput
 
-from ..partials import (PartialAbsoluteSensor, PartialRelativeSensor)
+from ..partials import PartialAbsoluteSensor, PartialFlowSensor, PartialRelativeSensor
 
-__all__ = ["PositionSensor", "SpeedSensor", "AccSensor", "ForceSensor", "RelPositionSensor", "RelSpeedSensor"]
+__all__ = ["PositionSensor", "SpeedSensor", "AccSensor", "ForceSensor", "PowerSensor",
+           "MultiSensor", "RelPositionSensor", "RelSpeedSensor", "RelAccSensor"]
 
 
 class PositionSensor(PartialAbsoluteSensor):
-    """Measures the absolute position: ``s = flange.s`` (takes no force).
+    """Measures the absolute position (MSL ``PositionSensor``): ``s =
+    flange.s`` (takes no force).
 
-    States: ``s`` [m]. Connectors: ``flange``.
+    Connectors: ``flange``, ``s`` [m] (RealOutput).
     """
 
-    s = Variable(0.0, "m", "measured absolute position")
+    s = RealOutput("absolute position of the flange", "m")
 
     def equations(self):
         return [Eq(self.s, self.flange.s)]
 
 
 class SpeedSensor(PartialAbsoluteSensor):
-    """Measures the absolute velocity: ``v = der(flange.s)``.
+    """Measures the absolute velocity (MSL ``SpeedSensor``): ``v =
+    der(flange.s)``.
 
-    States: ``v`` [m/s]. Connectors: ``flange``.
+    Connectors: ``flange``, ``v`` [m/s] (RealOutput).
     """
 
-    v = Variable(0.0, "m/s", "measured absolute velocity")
+    v = RealOutput("absolute velocity of the flange", "m/s")
 
     def equations(self):
         return [Eq(self.v, der(self.flange.s))]
 
 
 class AccSensor(PartialAbsoluteSensor):
-    """Measures the absolute acceleration: ``a = der(der(flange.s))``.
+    """Measures the absolute acceleration (MSL ``AccSensor``): ``v =
+    der(flange.s)``, ``a = der(v)``.
 
-    States: ``v`` [m/s], ``a`` [m/s^2]. Connectors: ``flange``.
+    States: ``v`` [m/s]. Connectors: ``flange``, ``a`` [m/s2] (RealOutput).
     """
 
-    v = Variable(0.0, "m/s", "absolute velocity")
-    a = Variable(0.0, "m/s^2", "measured absolute acceleration")
+    v = Variable(0.0, "m/s", "absolute velocity of the flange")
+    a = RealOutput("absolute acceleration of the flange", "m/s2")
 
     def equations(self):
         return [Eq(self.v, der(self.flange.s)), Eq(self.a, der(self.v))]
 
 
-class ForceSensor(Component):
+class ForceSensor(PartialFlowSensor):
     """Measures the force transmitted between its two flanges, which it
-    joins rigidly: ``flange_a.s = flange_b.s``, ``flange_a.f + flange_b.f = 0``,
-    ``f = flange_b.f`` — tension positive, the same sign as a
-    :class:`Spring`'s ``f`` in the same place. (Modelica's and MTK's
-    ForceSensor report ``flange_a.f``, the opposite sign.)
+    joins rigidly (MSL ``ForceSensor``): ``f = flange_b.f``, tension
+    positive, the same sign as a :class:`~.components.Spring`'s ``f`` in the
+    same place (MSL's ``f`` is ``flange_a.f = -flange_b.f``, the opposite
+    sign).
 
-    States: ``f`` [N]. Connectors: ``flange_a``, ``flange_b``.
+    Connectors: ``flange_a``, ``flange_b``, ``f`` [N] (RealOutput).
     """
 
-    flange_a = Flange("left flange")
-    flange_b = Flange("right flange")
-    f = Variable(0.0, "N", "transmitted force (tension positive)")
+    f = RealOutput("transmitted force flange_b.f (tension positive)", "N")
 
     def equations(self):
-        return [Eq(self.flange_a.s, self.flange_b.s),
-                Eq(self.flange_a.f + self.flange_b.f, 0),
-                Eq(self.f, self.flange_b.f)]
+        return [Eq(self.f, self.flange_b.f)]
+
+
+class PowerSensor(PartialFlowSensor):
+    """Measures the power transmitted between its two flanges (MSL
+    ``PowerSensor``): ``power = flange_a.f * der(flange_a.s)``, the power
+    entering at ``flange_a`` (positive when it flows from the flange_a side
+    to the flange_b side).
+
+    Connectors: ``flange_a``, ``flange_b``, ``power`` [W] (RealOutput).
+    """
+
+    power = RealOutput("power entering at flange_a, flange_a.f * der(flange_a.s)", "W")
+
+    def equations(self):
+        return [Eq(self.power, self.flange_a.f * der(self.flange_a.s))]
+
+
+class MultiSensor(PartialFlowSensor):
+    """Measures force, velocity and power at once (MSL ``MultiSensor``):
+    ``f = flange_b.f`` (tension positive, as :class:`ForceSensor`),
+    ``v = der(flange_a.s)``, ``power = flange_a.f * v`` (MSL's: the power
+    entering at ``flange_a``; ``power = -f * v``).
+
+    Connectors: ``flange_a``, ``flange_b``, ``f`` [N], ``v`` [m/s],
+    ``power`` [W] (RealOutputs).
+    """
+
+    f = RealOutput("transmitted force flange_b.f (tension positive)", "N")
+    v = RealOutput("absolute velocity of the flanges", "m/s")
+    power = RealOutput("power entering at flange_a, flange_a.f * v", "W")
+
+    def equations(self):
+        return [Eq(self.f, self.flange_b.f), Eq(self.v, der(self.flange_a.s)),
+                Eq(self.power, self.flange_a.f * self.v)]
 
 
 class RelPositionSensor(PartialRelativeSensor):
-    """Measures ``s_rel = flange_b.s - flange_a.s`` (takes no force).
+    """Measures ``s_rel = flange_b.s - flange_a.s`` (MSL
+    ``RelPositionSensor``; takes no force).
 
-    States: ``s_rel`` [m]. Connectors: ``flange_a``, ``flange_b``.
+    Connectors: ``flange_a``, ``flange_b``, ``s_rel`` [m] (RealOutput).
     """
 
-    s_rel = Variable(0.0, "m", "measured relative position flange_b.s - flange_a.s")
+    s_rel = RealOutput("relative position flange_b.s - flange_a.s", "m")
 
     def equations(self):
         return [Eq(self.s_rel, self.flange_b.s - self.flange_a.s)]
 
 
 class RelSpeedSensor(PartialRelativeSensor):
-    """Measures ``v_rel = der(flange_b.s - flange_a.s)`` (takes no force).
+    """Measures ``v_rel = der(s_rel)`` (MSL ``RelSpeedSensor``; takes no
+    force).
 
-    States: ``s_rel`` [m], ``v_rel`` [m/s]. Connectors: ``flange_a``,
-    ``flange_b``.
+    States: ``s_rel`` [m]. Connectors: ``flange_a``, ``flange_b``,
+    ``v_rel`` [m/s] (RealOutput).
     """
 
     s_rel = Variable(0.0, "m", "relative position flange_b.s - flange_a.s")
-    v_rel = Variable(0.0, "m/s", "measured relative velocity")
+    v_rel = RealOutput("relative velocity der(s_rel)", "m/s")
 
     def equations(self):
         return [Eq(self.s_rel, self.flange_b.s - self.flange_a.s),
                 Eq(self.v_rel, der(self.s_rel))]
+
+
+class RelAccSensor(PartialRelativeSensor):
+    """Measures ``a_rel = der(v_rel)``, ``v_rel = der(s_rel)`` (MSL
+    ``RelAccSensor``; takes no force).
+
+    States: ``s_rel`` [m], ``v_rel`` [m/s]. Connectors: ``flange_a``,
+    ``flange_b``, ``a_rel`` [m/s2] (RealOutput).
+    """
+
+    s_rel = Variable(0.0, "m", "relative position flange_b.s - flange_a.s")
+    v_rel = Variable(0.0, "m/s", "relative velocity der(s_rel)")
+    a_rel = RealOutput("relative acceleration der(v_rel)", "m/s2")
+
+    def equations(self):
+        return [Eq(self.s_rel, self.flange_b.s - self.flange_a.s),
+                Eq(self.v_rel, der(self.s_rel)), Eq(self.a_rel, der(self.v_rel))]

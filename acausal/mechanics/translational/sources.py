@@ -1,21 +1,51 @@
-"""Translational sources (force, torque and motion inputs). Sign convention: :mod:`acausal.lang.connectors`."""
-from sympy import Basic, SympifyError, sympify
+"""Translational sources (MSL ``Translational.Sources``): forces given as
+signals, laws or speed-dependent characteristics, and prescribed motion.
+Sign convention: :mod:`acausal.lang.connectors`."""
 
-from acausal.lang import Component, Eq, Flange, Variable
+import sympy as sp
+from sympy import Piecewise
 
-from acausal.errors import ParameterError
+from acausal.lang import Eq, Flange, Parameter, time
 
-from ..partials import (PartialCompliant, PartialSource)
+from .kinematic import Accelerate, Move, Position, Speed  # noqa: F401 (MSL's Sources)
+from ..partials import (PartialCompliant, PartialElementaryOneFlangeAndSupport2, PartialForce,
+                        PartialSource, SourceValue)
 
-__all__ = ["Force", "RelativeForce", "Position"]
+__all__ = ["Force", "Force2", "RelativeForce", "ConstantForce", "SignForce",
+           "QuadraticSpeedDependentForce", "LinearSpeedDependentForce", "ForceStep", "Position",
+           "Speed", "Accelerate", "Move"]
+
+REGULARIZATIONS = ("Exp", "Sine", "Linear", "CoSine")
 
 
-class Force(PartialSource):
-    """A force ``f`` applied on ``flange`` along +s, reacting on the fixed
-    frame: ``flange.f = -f`` (so a mass on that flange gets ``m*a = f``).
+def regularized_sign(x, x0, reg):
+    """MSL's ``Blocks.Types.Regularization`` of ``sign(x)`` below ``x0``
+    (a sympy expression, continuous in ``x``; no events)::
 
-    ``f`` is given as one of (see :class:`acausal.mechanics.partials.PartialSource`)::
+        Exp:    2 / (1 + exp(-x / (0.01 x0))) - 1
+        Sine:   sign(x) if |x| >= x0 else sin(pi/2 x/x0)
+        Linear: sign(x) if |x| >= x0 else x/x0
+        CoSine: sign(x) if |x| >= x0 else sign(x) (1 - cos(pi/2 x/x0))
+    """
+    if reg == "Exp":
+        return 2 / (1 + sp.exp(-x / (sp.Rational(1, 100) * x0))) - 1
+    sgn = Piecewise((1, x >= 0), (-1, True))     # sign(x) without a DiracDelta derivative
+    inside = {"Sine": sp.sin(sp.pi / 2 * x / x0),
+              "Linear": x / x0,
+              "CoSine": sgn * (1 - sp.cos(sp.pi / 2 * x / x0))}[reg]
+    return Piecewise((1, x >= x0), (-1, x <= -x0), (inside, True))
 
+
+class Force(PartialSource, PartialElementaryOneFlangeAndSupport2):
+    """A force ``f`` applied on ``flange`` along +s, reacting on the support
+    (MSL ``Force``): ``flange.f = -f`` (so a mass on that flange gets
+    ``m*a = f``); with ``useSupport=True`` the ``support`` flange takes
+    ``+f``, otherwise the reaction goes to the ground.
+
+    ``f`` is MSL's input signal, or a law (see
+    :class:`acausal.mechanics.partials.PartialSource`)::
+
+        Force()                                   # input: connect(sine.y, force.f)
         Force(f=100.0)                            # constant; run-time parameter f_const
         Force(f=200.0 * sympy.sin(50 * time))     # expression of acausal.time (and parameters)
         Force(f=lambda s: k0 * (g0 - s))          # function of the flange position s
@@ -27,20 +57,49 @@ class Force(PartialSource):
     (``params={"force.f_const": 200}``); an expression's numbers are fixed
     (use ``model.parameter(...)`` symbols in it to sweep them).
 
-    Parameters: ``f_const`` [N] (only when ``f`` is a number). States: ``f``
-    [N] the applied force. Connectors: ``flange``.
+    Parameters: ``f_const`` [N] (only when ``f`` is a number),
+    ``useSupport`` (structural). States: ``f`` [N] the applied force, ``s``
+    [m] flange position relative to the support. Connectors: ``flange``,
+    ``f`` (RealInput, when no law is given), ``support`` (with useSupport).
     """
 
-    quantity = ("f", "N", "applied force along +s")
+    quantity = ("f", "N", "driving force along +s")
     across_name = "position"
-    flange = Flange("flange the force acts on")
-    f = Variable(0.0, "N", "applied force along +s")
+    f = SourceValue(0.0, "N", "driving force along +s (= -flange.f)")
 
-    def __init__(self, f=0.0, **kw):
+    def __init__(self, f=None, **kw):
         super().__init__(f, **kw)
 
     def equations(self):
         return [Eq(self.f, self.law(self.flange.s)), Eq(self.flange.f, -self.f)]
+
+
+class Force2(PartialSource):
+    """A force ``f`` between two flanges (MSL ``Force2``): ``flange_a.f =
+    f``, ``flange_b.f = -f``: a positive ``f`` pushes ``flange_b``'s body
+    along +s and ``flange_a``'s along -s (drives them apart).
+
+    ``f`` is MSL's input signal (``Force2()``, ``connect(sine.y,
+    force.f)``) or a law as for :class:`Force`, of the relative position
+    ``flange_b.s - flange_a.s`` (and its rate).
+
+    Parameters: ``f_const`` [N] (only when ``f`` is a number). States:
+    ``f`` [N]. Connectors: ``flange_a``, ``flange_b``, ``f`` (RealInput,
+    when no law is given).
+    """
+
+    quantity = ("f", "N", "force pushing the flanges apart")
+    across_name = "relative position flange_b.s - flange_a.s"
+    flange_a = Flange("left flange (pushed along -s by a positive f)")
+    flange_b = Flange("right flange (pushed along +s by a positive f)")
+    f = SourceValue(0.0, "N", "force pushing the flanges apart")
+
+    def __init__(self, f=None, **kw):
+        super().__init__(f, **kw)
+
+    def equations(self):
+        return [Eq(self.f, self.law(self.flange_b.s - self.flange_a.s)),
+                Eq(self.flange_a.f, self.f), Eq(self.flange_b.f, -self.f)]
 
 
 class RelativeForce(PartialSource, PartialCompliant):
@@ -69,31 +128,113 @@ class RelativeForce(PartialSource, PartialCompliant):
         return [Eq(self.f, self.law(self.s_rel))]
 
 
-class Position(Component):
-    """Prescribed motion: ``flange.s = s_ref`` with ``s_ref`` a sympy
-    expression of ``acausal.time`` (and parameters), smooth enough to be
-    differentiated twice (the index reduction differentiates it to drive a
-    mass). The flange takes whatever force that motion needs.
+class ConstantForce(PartialForce):
+    """A constant force, independent of speed (MSL ``ConstantForce``): the
+    body on the flange receives ``f_constant`` along +s (``f = flange.f =
+    -f_constant``).
 
-    Parameters: none (``s`` is fixed at construction). States: ``s`` [m].
-    Connectors: ``flange``.
+    Parameters: ``f_constant`` [N] nominal force (negative: a load against
+    positive motion), ``useSupport`` (structural). States: ``f`` [N] (=
+    -f_constant), ``s`` [m], ``v`` [m/s]. Connectors: ``flange``,
+    ``support`` (with useSupport).
     """
 
-    diagnosis_site = "driver"   # what acausal.diagnose may extend here
-
-    flange = Flange("driven flange")
-    s = Variable(0.0, "m", "prescribed position")
-
-    def __init__(self, s, **kw):
-        super().__init__(**kw)
-        try:
-            expr = sympify(s, strict=True)
-        except SympifyError:
-            expr = None
-        if not isinstance(expr, Basic) or isinstance(s, bool):
-            raise ParameterError(f"Position.s must be a number or a sympy expression of "
-                                 f"time, got {s!r}")
-        object.__setattr__(self, "_ref", expr)
+    f_constant = Parameter(0.0, "N", "nominal force (if negative, a load in the positive "
+                           "direction of motion)")
 
     def equations(self):
-        return [Eq(self.s, self._ref), Eq(self.flange.s, self.s)]
+        return [Eq(self.f, -self.f_constant)]
+
+
+class SignForce(PartialForce):
+    """A constant force that changes sign with the speed (MSL
+    ``SignForce``): the body receives ``f_nominal * sign(v)``, regularised
+    below ``v0`` (``f = -f_nominal * regularized_sign(v, v0, reg)``, see
+    :func:`regularized_sign`), ``v`` relative to the support.
+
+    Parameters: ``f_nominal`` [N] nominal force (negative: a load),
+    ``v0`` [m/s] regularisation below v0 (> 0), ``reg`` (structural: "Exp",
+    "Sine", "Linear", "CoSine"; MSL's default "Exp"), ``useSupport``
+    (structural). States: ``f`` [N], ``s`` [m], ``v`` [m/s]. Connectors:
+    ``flange``, ``support`` (with useSupport).
+    """
+
+    f_nominal = Parameter(0.0, "N", "nominal force (if negative, force is acting as load)")
+    v0 = Parameter(0.1, "m/s", "regularization below v0", min=0.0, min_open=True)
+    reg = Parameter("Exp", "1", "type of regularization", structural=True,
+                    choices=REGULARIZATIONS)
+
+    def equations(self):
+        return [Eq(self.f, -self.f_nominal * regularized_sign(self.v, self.v0, self.reg))]
+
+
+class QuadraticSpeedDependentForce(PartialForce):
+    """A force growing with the square of the speed (MSL
+    ``QuadraticSpeedDependentForce``), ``v`` relative to the support; the
+    body receives::
+
+        ForceDirection=True:   f_nominal * (v/v_nominal)^2              (same sign both ways)
+        ForceDirection=False:  f_nominal * (v/v_nominal) * |v/v_nominal| (a drag when f_nominal < 0)
+
+    Parameters: ``f_nominal`` [N] nominal force (negative: a load),
+    ``v_nominal`` [m/s] nominal speed (> 0), ``ForceDirection``
+    (structural), ``useSupport`` (structural). States: ``f`` [N] (=
+    flange.f), ``s`` [m], ``v`` [m/s]. Connectors: ``flange``, ``support``
+    (with useSupport).
+    """
+
+    f_nominal = Parameter(0.0, "N", "nominal force (if negative, force is acting as load in "
+                          "positive direction of motion)")
+    v_nominal = Parameter(1.0, "m/s", "nominal speed", min=0.0, min_open=True)
+    ForceDirection = Parameter(True, "1", "same direction of force in both directions of "
+                               "motion", structural=True, choices=(True, False))
+
+    def equations(self):
+        r = self.v / self.v_nominal
+        shape = r ** 2 if self.ForceDirection else r * sp.Abs(r)
+        return [Eq(self.f, -self.f_nominal * shape)]
+
+
+class LinearSpeedDependentForce(PartialForce):
+    """A force proportional to the speed (MSL ``LinearSpeedDependentForce``),
+    ``v`` relative to the support; the body receives ``f_nominal *
+    |v/v_nominal|`` (``ForceDirection=True``) or ``f_nominal *
+    v/v_nominal`` (False).
+
+    Parameters: ``f_nominal`` [N], ``v_nominal`` [m/s] (> 0),
+    ``ForceDirection`` (structural), ``useSupport`` (structural). States:
+    ``f`` [N], ``s`` [m], ``v`` [m/s]. Connectors: ``flange``, ``support``
+    (with useSupport).
+    """
+
+    f_nominal = Parameter(0.0, "N", "nominal force (if negative, force is acting as load in "
+                          "positive direction of motion)")
+    v_nominal = Parameter(1.0, "m/s", "nominal speed", min=0.0, min_open=True)
+    ForceDirection = Parameter(True, "1", "same direction of force in both directions of "
+                               "motion", structural=True, choices=(True, False))
+
+    def equations(self):
+        r = self.v / self.v_nominal
+        return [Eq(self.f, -self.f_nominal * (sp.Abs(r) if self.ForceDirection else r))]
+
+
+class ForceStep(PartialForce):
+    """A force step in time (MSL ``ForceStep``): the body receives
+    ``offsetForce`` before ``startTime`` and ``offsetForce + stepForce``
+    from then on (``f = -offsetForce - (0 if time < startTime else
+    stepForce)``; the step is a time event).
+
+    Parameters: ``stepForce`` [N] height of the step (negative: a load),
+    ``offsetForce`` [N] offset, ``startTime`` [s], ``useSupport``
+    (structural). States: ``f`` [N], ``s`` [m], ``v`` [m/s]. Connectors:
+    ``flange``, ``support`` (with useSupport).
+    """
+
+    stepForce = Parameter(1.0, "N", "height of force step (if negative, force is acting as "
+                          "load)")
+    offsetForce = Parameter(0.0, "N", "offset of force")
+    startTime = Parameter(0.0, "s", "force = offset for time < startTime")
+
+    def equations(self):
+        step = Piecewise((0, time < self.startTime), (self.stepForce, True))
+        return [Eq(self.f, -self.offsetForce - step)]

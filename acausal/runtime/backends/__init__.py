@@ -86,7 +86,8 @@ class SegmentSolver:
     fallback = None   # why another backend runs in place of the one asked for
     # guard(steps): called by a backend that does not call the Python residual
     # (compiled) whenever its output buffer fills, with the steps of the call
-    # so far; raises to stop a call that runs far past the run's limits
+    # so far; returns True to end the call (past a limit, or a stop request),
+    # the segment then being the rows computed so far
     guard = None
 
     def solve(self, cb, d, t, y, yp, tout, every_step):
@@ -110,7 +111,11 @@ class BackendError(AcausalError):
 def make_solver(name, cm, p, opts):
     """A :class:`SegmentSolver` of backend ``name`` for model ``cm`` with
     parameter vector ``p`` and options ``opts`` (rtol, atol, max_step,
-    max_num_steps)."""
+    max_num_steps). A model with no states gets an
+    :class:`~acausal.runtime.backends.algebraic.AlgebraicSolver` on that
+    backend's callbacks (there is nothing for IDA to integrate)."""
+    if cm.dae.n_states == 0:
+        return _stateless(name, cm, p, opts)
     if name in (None, "sundae"):
         from .sundae import SundaeSolver
         return SundaeSolver(cm, p, opts)
@@ -123,6 +128,26 @@ def make_solver(name, cm, p, opts):
             solver = SundaeSolver(cm, p, opts)
             solver.fallback = f"compiled backend unavailable: {exc}"
             return solver
+    raise BackendError(f"unknown backend {name!r}; choose one of: {', '.join(BACKENDS)}")
+
+
+def _stateless(name, cm, p, opts):
+    from .algebraic import AlgebraicSolver
+    if name == "compiled":
+        from .compiled import Unavailable, c_callbacks, library
+        try:
+            library(cm)
+        except Unavailable as exc:
+            solver = AlgebraicSolver(cm, p, opts, "sundae",
+                                     lambda model, q, d: model.callbacks(q, d))
+            solver.fallback = f"compiled backend unavailable: {exc}"
+            return solver
+
+        def serve(model, q, d):
+            return c_callbacks(library(model), model, q, d, lambda: model.callbacks(q, d))
+        return AlgebraicSolver(cm, p, opts, "compiled", serve)
+    if name in (None, "sundae"):
+        return AlgebraicSolver(cm, p, opts, "sundae", lambda model, q, d: model.callbacks(q, d))
     raise BackendError(f"unknown backend {name!r}; choose one of: {', '.join(BACKENDS)}")
 
 
