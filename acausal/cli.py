@@ -1,5 +1,5 @@
 """The ``acausal`` command: simulate, animate, variables, linearize, calibrate, sweep,
-diagnose, fmu.
+tolerance, diagnose, fmu.
 
 Exit codes: 0 success, 2 a model or input error (an AcausalError, a bad
 option value, a budget that refuses the work before it starts: one readable
@@ -234,7 +234,7 @@ def main(ctx, global_backend):
 # for the command on a first run, 2.9 against 3.4 once built).
 # diagnose's fits also take it when called from Python (acausal/diagnose/
 # problem.py FIT_BACKEND, measured in docs/diagnosis.md).
-MANY_RUNS = {"calibrate", "sweep", "diagnose"}
+MANY_RUNS = {"calibrate", "sweep", "diagnose", "tolerance"}
 
 
 def _set_backend(ctx, name):
@@ -538,12 +538,37 @@ def variables(file):
     states = {s.name for s in cm.dae.y[:cm.dae.n_states]}
     for name in cm.var_names:
         info = cm.flat.variables[name]
+        if info.internal:
+            continue
         st = info.start
         kind = "state" if name in states else ""
         start = f"start {st.value}{' (fixed)' if st.fixed else ''}"
         click.echo(f"  {name:32s} [{info.unit}] {info.desc}; {start} {kind}")
     for d in cm.discretes:
+        if d.internal:
+            continue
         click.echo(f"  {d.symbol.name:32s} [{d.unit}] {d.desc}; discrete, start {d.start.value}")
+
+
+@main.command()
+@click.argument("file", type=click.Path(dir_okay=False))
+@click.option("--json", "as_json", is_flag=True, help="print one JSON object")
+def check(file, as_json):
+    """Check a model file: compile it and list its states, time events and
+    unconnected connectors (no error: their force/torque is zero)."""
+    from .compiler.check import check_model
+    from .modelfile import compile_file
+    try:
+        mf, cm = compile_file(file)
+        report = check_model(None, compiled=cm)
+    except AcausalError as exc:
+        _fail(exc)
+    if as_json:
+        click.echo(json.dumps(dict(file=str(file), **report.as_dict())))
+        return
+    click.echo(f"checked {file}:")
+    for line in report.lines():
+        click.echo(f"  {line}")
 
 
 @main.command()
@@ -565,7 +590,7 @@ def variables(file):
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object")
 def linearize(file, at, inputs, outputs, sets, out, as_json):
     """Linearise a model file: A, B, C, D and the eigenvalues of A."""
-    from .analysis import linearize as lin_
+    from .analysis import RunSettings, linearize as lin_
     from .modelfile import compile_file
     try:
         params = _parse_sets(sets)
@@ -573,7 +598,7 @@ def linearize(file, at, inputs, outputs, sets, out, as_json):
         point = _parse_at(at)
         lin = lin_(cm, at=point, inputs=inputs, outputs=outputs, params=params,
                    t=mf.experiment.t0 if not isinstance(point, float) else None,
-                   rtol=mf.experiment.rtol, atol=mf.experiment.atol)
+                   run=RunSettings(rtol=mf.experiment.rtol, atol=mf.experiment.atol))
         if out:
             lin.save(out)
     except (AcausalError, click.BadParameter) as exc:
@@ -911,6 +936,113 @@ def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max
         _fail(exc)
     failed = sum(1 for r in rows if r.get("status") != "ok")
     click.echo(f"{len(rows)} points, {failed} failed; results in {out}")
+
+
+@main.command()
+@click.argument("file", type=click.Path(dir_okay=False))
+@click.option("--spec", required=True, type=click.Path(dir_okay=False),
+              help="CSV of the toleranced parameters: name, normal|uniform, a, b, unit per "
+                   "line (normal: mean, std; uniform: low, high; b as p% is relative to a; "
+                   "a as 'nominal' is the model's value)")
+@click.option("-n", "n", type=COUNT, default=1024, show_default=True,
+              help="sets drawn (sobol: the base sample N, a power of 2; it runs N (d + 2) "
+                   "simulations for d parameters)")
+@click.option("--sampling", type=click.Choice(["lhs", "sobol"]), default="lhs", show_default=True,
+              help="Latin hypercube (variance shares: correlation ratios, regression) or "
+                   "Sobol' in Saltelli's design (first-order and total Sobol' indices)")
+@click.option("--seed", type=int, default=0, show_default=True, help="the sampling's seed")
+@click.option("--measure", "measures", multiple=True, metavar="M1,M2,...",
+              help="measures to study (default: every measure of the model file)")
+@click.option("--out", type=click.Path(dir_okay=False), default="tolerance.csv",
+              show_default=True, help="one row per set; finished chunks are checkpointed in "
+              "OUT.partial/, so running the same command again after a kill resumes")
+@click.option("--plot", "plot_prefix", metavar="PREFIX",
+              help="write PREFIX_<measure>_hist.png and PREFIX_<measure>_tornado.png")
+@click.option("--json", "json_path", type=click.Path(dir_okay=False),
+              help="write the summary as JSON")
+@click.option("--scheduler", help="Dask scheduler address (default: local processes)")
+@click.option("--workers", type=COUNT, help="local worker processes (default: all cores)")
+@click.option("--chunk", type=COUNT, default=64, show_default=True,
+              help="sets per task (each task is one batched run, journaled when it ends)")
+@click.option("--max-points", type=COUNT, default=MAX_POINTS, show_default=True,
+              help="most simulations: a larger study is refused before anything runs")
+@click.option("--max-wall", type=POSITIVE, metavar="SECONDS",
+              help="stop after this wall time, keeping the finished chunks")
+@click.option("--max-memory", callback=_size, metavar="SIZE", help=MAX_MEMORY_HELP)
+@click.option("--no-progress", is_flag=True)
+def tolerance(file, spec, n, sampling, seed, measures, out, plot_prefix, json_path, scheduler,
+              workers, chunk, max_points, max_wall, max_memory, no_progress):
+    """A tolerance (Monte-Carlo) study: how the measures spread when the
+    parameters spread as the spec says; their mean, standard deviation,
+    percentiles and each parameter's share of the variance. Budgets as
+    sweep's: the number of simulations (--max-points) and their memory are
+    checked before anything runs."""
+    from .budget import PROCESS_BYTES, Watchdog, check_estimate
+    from .budget import max_memory as memory_limit
+    from .infra.executor import default_workers, open_executor, terminate_on_sigterm
+    from .modelfile import compile_file, show_measure
+    from .studies import tolerance as tol
+    try:
+        with _quiet_warnings():
+            for path, option in ((out, "--out"), (json_path, "--json")):
+                _check_output(path, option, create=True)
+            if plot_prefix:
+                _check_output(plot_prefix + "_hist.png", "--plot", plot=True, create=True)
+            tol.check_n(n, sampling)
+            mf, cm = compile_file(file)
+            dists = tol.parse_spec(spec, cm)
+            measures = _csv_list(",".join(measures)) or list(mf.measures)
+            if not measures:
+                raise UsageError(f"{file}: the model file defines no measures to study")
+            for m in measures:
+                if m not in mf.measures:
+                    raise click.BadParameter(f"--measure {m!r}: the model file defines "
+                                             f"{sorted(mf.measures)}")
+            runs = n * (len(dists) + 2) if sampling == "sobol" else n
+            if runs > max_points:
+                raise _budget_error(f"the study needs {runs:,} simulations, more than the limit "
+                                    f"of {max_points:,} (--max-points): a smaller -n, or raise "
+                                    "--max-points")
+            limit = memory_limit(max_memory)
+            n_workers = workers or (default_workers() if scheduler is None else 1)
+            main_need = PROCESS_BYTES + runs * (400 + SWEEP_POINT_BYTES * (
+                len(dists) + len(measures) + 3))
+            check_estimate(main_need + n_workers * PROCESS_BYTES, limit,
+                           f"a tolerance study of {runs:,} simulations on {n_workers} workers",
+                           "draw fewer sets")
+            per_worker = (limit - main_need) / max(n_workers, 1) - PROCESS_BYTES
+            with terminate_on_sigterm(), _resumable(out + ".partial"), \
+                    Watchdog(limit, max_wall, "the tolerance study"), \
+                    open_executor(scheduler, workers) as ex:
+                res = tol.run_tolerance(os.path.abspath(file), dists, n, executor=ex,
+                                        measures=measures, sampling=sampling, seed=seed,
+                                        out_csv=out, chunk=chunk, progress=not no_progress,
+                                        max_memory=max(per_worker, 50e6), backend=None,
+                                        on_resume=_say_resumed("sets"))
+            display = {m: _display(mf, m) for m in measures}
+            if plot_prefix:
+                tol.plot_histograms(res, plot_prefix, display)
+                tol.plot_tornado(res, plot_prefix, display)
+            if json_path:
+                with open(json_path, "w", encoding="utf-8") as f:
+                    json.dump(tol.summary_json(res), f, indent=1)
+    except tol.SpecError as exc:                # one line per bad row of the spec
+        for line in exc.lines:
+            click.echo(f"acausal: error: {_one_line(line)}", err=True)
+        sys.exit(2)
+    except (AcausalError, click.BadParameter) as exc:
+        _fail(exc)
+    for line in tol.report_lines(res, lambda m, v: show_measure(mf, m, v)):
+        click.echo(line)
+    click.echo(f"results in {out} ({res.wall_s:.1f} s)")
+
+
+def _display(mf, name):
+    """(factor from SI, display unit) of a measure ((1, '') without a unit)."""
+    fn = mf.measures.get(name)
+    if getattr(fn, "unit", None):
+        return fn.shown(1.0)
+    return 1.0, mf.measure_unit(name) or ""
 
 
 def _budget_error(message):

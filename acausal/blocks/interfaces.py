@@ -42,9 +42,12 @@ class SignalSource(SO):
     """A signal source (MSL ``SignalSource``): ``y = offset + (a law of time
     that is zero before startTime)``; a leaf adds that law.
 
-    Parameters: ``offset`` [1] added to the output, ``startTime`` [s] when
-    the law starts. Connectors: ``y`` (RealOutput).
+    Parameters: ``offset`` (the output's unit) added to the output,
+    ``startTime`` [s] when the law starts. Connectors: ``y`` (RealOutput).
+    Signal values (offset, height, amplitude, k) carry the unit of the
+    signal, which is not declared (MSL's plain ``Real`` signals): the unit
+    check leaves them out.
     """
 
-    offset = Parameter(0.0, "1", "offset added to the output signal")
+    offset = Parameter(0.0, None, "offset added to the output signal (the output's unit)")
     startTime = Parameter(0.0, "s", "output = offset for time < startTime")

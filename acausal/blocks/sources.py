@@ -8,6 +8,11 @@ stops exactly there and restarts after it (:mod:`acausal.compiler.timeevents`,
 written with ``Piecewise`` in ``time``; the compiler turns their relations
 into those events, so a source is its parameters and its law.
 
+Signal values (``k``, ``height``, ``amplitude``, ``outMax``, ``offset``)
+are in the unit of the signal, which MSL's plain ``Real`` signals leave
+undeclared: they are not unit-checked (``acausal.compiler.units``); times
+are in s, frequencies in Hz, phases in rad.
+
 The table (:class:`CombiTimeTable`) is in :mod:`acausal.blocks.tables`.
 """
 import sympy as sp
@@ -31,10 +36,10 @@ def _after_start(self, law):
 class Constant(SO):
     """Constant output (MSL ``Constant``): ``y = k``.
 
-    Parameters: ``k`` [1] the output value. Connectors: ``y`` (RealOutput).
+    Parameters: ``k`` the output value. Connectors: ``y`` (RealOutput).
     """
 
-    k = Parameter(1.0, "1", "constant output value")
+    k = Parameter(1.0, None, "constant output value")
 
     def equations(self):
         return [Eq(self.y, self.k)]
@@ -44,11 +49,11 @@ class Step(SignalSource):
     """Step (MSL ``Step``): ``y = offset + (0 if time < startTime else
     height)``; a time event at ``startTime``.
 
-    Parameters: ``height`` [1], ``offset`` [1], ``startTime`` [s].
+    Parameters: ``height``, ``offset``, ``startTime`` [s].
     Connectors: ``y`` (RealOutput).
     """
 
-    height = Parameter(1.0, "1", "height of the step")
+    height = Parameter(1.0, None, "height of the step")
 
     def equations(self):
         return [Eq(self.y, _after_start(self, self.height))]
@@ -59,11 +64,11 @@ class Ramp(SignalSource):
     linearly by ``height`` over ``duration``, then ``offset + height``;
     time events at both kinks (``duration = 0`` gives a step).
 
-    Parameters: ``height`` [1], ``duration`` [s] (>= 0), ``offset`` [1],
+    Parameters: ``height``, ``duration`` [s] (>= 0), ``offset``,
     ``startTime`` [s]. Connectors: ``y`` (RealOutput).
     """
 
-    height = Parameter(1.0, "1", "height of the ramp")
+    height = Parameter(1.0, None, "height of the ramp")
     duration = Parameter(2.0, "s", "duration of the ramp (0 gives a step)", min=0.0)
 
     def equations(self):
@@ -76,11 +81,11 @@ class Sine(SignalSource):
     """Sine (MSL ``Sine``): ``y = offset + amplitude*sin(2*pi*f*(time -
     startTime) + phase)`` from ``startTime`` on (``offset`` before it).
 
-    Parameters: ``amplitude`` [1], ``f`` [Hz], ``phase`` [rad], ``offset``
+    Parameters: ``amplitude``, ``f`` [Hz], ``phase`` [rad], ``offset``
     [1], ``startTime`` [s]. Connectors: ``y`` (RealOutput).
     """
 
-    amplitude = Parameter(1.0, "1", "amplitude of the sine wave")
+    amplitude = Parameter(1.0, None, "amplitude of the sine wave")
     f = Parameter(1.0, "Hz", "frequency of the sine wave")
     phase = Parameter(0.0, "rad", "phase of the sine wave")
 
@@ -93,11 +98,11 @@ class Cosine(SignalSource):
     """Cosine (MSL ``Cosine``): ``y = offset + amplitude*cos(2*pi*f*(time -
     startTime) + phase)`` from ``startTime`` on (``offset`` before it).
 
-    Parameters: ``amplitude`` [1], ``f`` [Hz], ``phase`` [rad], ``offset``
+    Parameters: ``amplitude``, ``f`` [Hz], ``phase`` [rad], ``offset``
     [1], ``startTime`` [s]. Connectors: ``y`` (RealOutput).
     """
 
-    amplitude = Parameter(1.0, "1", "amplitude of the cosine wave")
+    amplitude = Parameter(1.0, None, "amplitude of the cosine wave")
     f = Parameter(1.0, "Hz", "frequency of the cosine wave")
     phase = Parameter(0.0, "rad", "phase of the cosine wave")
 
@@ -111,11 +116,11 @@ class ExpSine(SignalSource):
     amplitude*exp(-damping*(time - startTime))*sin(2*pi*f*(time - startTime)
     + phase)`` from ``startTime`` on (``offset`` before it).
 
-    Parameters: ``amplitude`` [1], ``f`` [Hz], ``phase`` [rad], ``damping``
-    [1/s], ``offset`` [1], ``startTime`` [s]. Connectors: ``y`` (RealOutput).
+    Parameters: ``amplitude``, ``f`` [Hz], ``phase`` [rad], ``damping``
+    [1/s], ``offset``, ``startTime`` [s]. Connectors: ``y`` (RealOutput).
     """
 
-    amplitude = Parameter(1.0, "1", "amplitude of the sine wave")
+    amplitude = Parameter(1.0, None, "amplitude of the sine wave")
     f = Parameter(2.0, "Hz", "frequency of the sine wave")
     phase = Parameter(0.0, "rad", "phase of the sine wave")
     damping = Parameter(1.0, "1/s", "damping coefficient of the sine wave")
@@ -132,15 +137,15 @@ class Exponentials(SignalSource):
     ``startTime``, ``outMax*(1 - exp(-(time - startTime)/riseTimeConst))``
     for ``riseTime``, then that value decaying with ``fallTimeConst``.
 
-    Parameters: ``outMax`` [1], ``riseTime`` [s] (>= 0), ``riseTimeConst``
+    Parameters: ``outMax``, ``riseTime`` [s] (>= 0), ``riseTimeConst``
     [s] (> 0), ``fallTimeConst`` [s] (> 0; default ``riseTimeConst``),
-    ``offset`` [1], ``startTime`` [s]. Connectors: ``y`` (RealOutput).
+    ``offset``, ``startTime`` [s]. Connectors: ``y`` (RealOutput).
     ``fallTimeConst`` not given takes the value given to ``riseTimeConst``
     (MSL binds it; here changing ``riseTimeConst`` at run time does not
     change it).
     """
 
-    outMax = Parameter(1.0, "1", "height of the output for an infinite riseTime")
+    outMax = Parameter(1.0, None, "height of the output for an infinite riseTime")
     riseTime = Parameter(0.5, "s", "rise time", min=0.0)
     riseTimeConst = Parameter(0.1, "s", "rise time constant", min=_SMALL)
     fallTimeConst = Parameter(0.1, "s", "fall time constant (default riseTimeConst)",
@@ -196,12 +201,12 @@ class Pulse(_Periodic):
     percent of each period from ``startTime`` on, else 0, plus ``offset``;
     time events at every edge, one period after the other.
 
-    Parameters: ``amplitude`` [1], ``width`` [%] (0 < width <= 100),
+    Parameters: ``amplitude``, ``width`` [%] (0 < width <= 100),
     ``period`` [s], ``nperiod`` [1] (structural; < 0 infinitely many),
-    ``offset`` [1], ``startTime`` [s]. Connectors: ``y`` (RealOutput).
+    ``offset``, ``startTime`` [s]. Connectors: ``y`` (RealOutput).
     """
 
-    amplitude = Parameter(1.0, "1", "amplitude of the pulse")
+    amplitude = Parameter(1.0, None, "amplitude of the pulse")
     width = Parameter(50.0, "%", "width of the pulse in % of the period", min=_SMALL,
                       max=100.0)
 
@@ -217,11 +222,11 @@ class SawTooth(_Periodic):
     """Saw tooth (MSL ``SawTooth``): ``amplitude*(time - T_start)/period``
     within each period from ``startTime`` on, plus ``offset``.
 
-    Parameters: ``amplitude`` [1], ``period`` [s], ``nperiod`` [1]
-    (structural), ``offset`` [1], ``startTime`` [s]. Connectors: ``y``.
+    Parameters: ``amplitude``, ``period`` [s], ``nperiod`` [1]
+    (structural), ``offset``, ``startTime`` [s]. Connectors: ``y``.
     """
 
-    amplitude = Parameter(1.0, "1", "amplitude of the saw tooth")
+    amplitude = Parameter(1.0, None, "amplitude of the saw tooth")
 
     def equations(self):
         return [Eq(self.y, self._periodic(
@@ -233,12 +238,12 @@ class Trapezoid(_Periodic):
     ``amplitude`` in ``rising``, holding for ``width``, falling in
     ``falling``, then 0; plus ``offset``.
 
-    Parameters: ``amplitude`` [1], ``rising``, ``width``, ``falling`` [s]
-    (>= 0), ``period`` [s], ``nperiod`` [1] (structural), ``offset`` [1],
+    Parameters: ``amplitude``, ``rising``, ``width``, ``falling`` [s]
+    (>= 0), ``period`` [s], ``nperiod`` [1] (structural), ``offset``,
     ``startTime`` [s]. Connectors: ``y`` (RealOutput).
     """
 
-    amplitude = Parameter(1.0, "1", "amplitude of the trapezoid")
+    amplitude = Parameter(1.0, None, "amplitude of the trapezoid")
     rising = Parameter(0.0, "s", "rising duration", min=0.0)
     width = Parameter(0.5, "s", "width duration", min=0.0)
     falling = Parameter(0.0, "s", "falling duration", min=0.0)

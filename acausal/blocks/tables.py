@@ -159,10 +159,10 @@ class CombiTimeTable(Component):
         for i, c in enumerate(cols, start=1):
             what = header[c - 1] if header is not None else f"column {c}"
             self._outputs[f"y{i}"] = _named(RealOutput(f"interpolated {what}"), f"y{i}")
-            self._declare(Parameter(offsets[i - 1], "1", f"offset of output y{i}"),
+            self._declare(Parameter(offsets[i - 1], None, f"offset of output y{i}"),
                           f"offset_{i}", offsets[i - 1])
-            self._declare(Discrete(0.0, "1", f"value of y{i} at T_k (table)"), f"c0_{i}")
-            self._declare(Discrete(0.0, "1", f"slope of y{i} per table time unit"), f"c1_{i}")
+            self._declare(Discrete(0.0, None, f"value of y{i} at T_k (table)"), f"c0_{i}")
+            self._declare(Discrete(0.0, None, f"slope of y{i} per table time unit"), f"c1_{i}")
 
     # -- construction helpers ----------------------------------------------------
     @staticmethod
@@ -302,9 +302,10 @@ class CombiTimeTable(Component):
         if n == 1:
             c0, c1, tk = Y[0], np.zeros(Y.shape[1]), T[0]
         elif k < 0 or k >= n - 1:
-            if self.extrapolation == "NoExtrapolation" and (k < 0 or t > tb[-1] + tol):
+            if self.extrapolation == "NoExtrapolation":
+                # (right limit: at the last row the run is about to leave the table)
                 raise ModelError(
-                    f"{self.path}: time {state.t:.9g} s is outside the table's range "
+                    f"{self.path}: at time {state.t:.9g} s the run leaves the table's range "
                     f"[{tb[0]:.9g}, {tb[-1]:.9g}] s (extrapolation='NoExtrapolation')",
                     component=self.path)
             a, b = (0, 1) if k < 0 else (n - 2, n - 1)

@@ -36,8 +36,9 @@ class VarInfo:
     desc: str
     owner: str
     port: bool = False     # a connector variable
-    internal: bool = False  # made by the compiler (a time switch), not declared
     unit_declared: bool = True   # False: no unit was given (not checked)
+    internal: bool = False  # made by the compiler (a time switch), not declared
+    nominal: float = None   # Modelica's nominal value (scales the absolute tolerance)
 
 
 @dataclass
@@ -88,7 +89,8 @@ def flatten(model):
         _relocate_values(flat, comp, known)
     for comp in comps:
         _equations(flat, comp, known)
-    _connections(flat, model, comps)
+    bound = _bindings(flat, comps, known)
+    _connections(flat, model, comps, bound)
     flat.time_switches = find_time_switches(flat)
     return flat
 
@@ -102,7 +104,8 @@ def _declare(flat, comp):
             flat.params[sym.name] = ParamInfo(sym, comp.value(name), d, path)
         elif isinstance(d, Variable):
             flat.variables[sym.name] = VarInfo(sym, comp.start(name), d.unit, d.desc, path,
-                                               unit_declared=d.unit_declared)
+                                               unit_declared=d.unit_declared,
+                                               nominal=comp.nominal(name))
         elif isinstance(d, Discrete):
             flat.discretes[sym.name] = VarInfo(sym, Start(d.start, True), d.unit, d.desc, path,
                                                unit_declared=d.unit_declared)
@@ -184,6 +187,8 @@ def _equations(flat, comp, known):
                     f"{s.name!r}, which is not a variable or parameter of the model",
                     component=path, variable=s.name)
         flat.equations.append(Equation(expr, path, f"equation {i + 1} ({type(comp).__name__})"))
+    for k, eq in enumerate(comp.gather("initial_equations")):
+        _initial_equation(flat, comp, known, k, eq)
     for ev in comp.gather("events"):
         ev.owner = path
         if isinstance(ev, TimeEvent):
@@ -197,11 +202,46 @@ def _equations(flat, comp, known):
         flat.assertions.append(a)
 
 
+def _initial_equation(flat, comp, known, k, eq):
+    """An initial equation ``lhs = rhs`` (Modelica's ``initial equation``):
+    a variable ``<path>._initial<k>`` = lhs - rhs at every time, with the
+    fixed start 0, so the initialisation imposes it at the start only."""
+    path = comp.path
+    expr = eq.lhs - eq.rhs if isinstance(eq, sp.Equality) else sp.sympify(eq)
+    expr = relocate(expr, comp, known)
+    sym = sp.Symbol(f"{path}._initial{k}" if path else f"_initial{k}")
+    flat.variables[sym.name] = VarInfo(sym, Start(0.0, True), "1",
+                                       f"initial equation {k + 1}: {expr} = 0 at the start",
+                                       path, unit_declared=False, internal=True)
+    known.add(sym.name)
+    flat.equations.append(Equation(sym - expr, path,
+                                   f"initial equation {k + 1} ({type(comp).__name__})"))
+
+
+def _bindings(flat, comps, known):
+    """Equations of the inputs bound to expressions (``Position(s_ref=...)``);
+    returns the paths of those inputs."""
+    bound = set()
+    for comp in comps:
+        for name, expr in comp._bindings.items():
+            port = comp.port(name)
+            expr = relocate(expr, comp, known, comp._parent or comp)
+            for s in expr.free_symbols:
+                if s != time and base_and_order(s)[0].name not in known:
+                    raise ModelError(f"input {port.path} is bound to {expr}, which uses "
+                                     f"{s.name!r}: not a variable or parameter of the model",
+                                     component=comp.path, variable=s.name)
+            flat.equations.append(Equation(port.symbol - expr, comp.path,
+                                           f"binding of input {name}"))
+            bound.add(port.path)
+    return bound
+
+
 def _known_names(flat):
     return set(flat.params) | set(flat.variables) | set(flat.discretes)
 
 
-def _connections(flat, model, comps):
+def _connections(flat, model, comps, bound=frozenset()):
     parent = {}
 
     def find(p):
@@ -241,7 +281,7 @@ def _connections(flat, model, comps):
     for members in sets.values():
         members.sort(key=lambda p: p.path)
         if isinstance(members[0], SignalPort):
-            dangling += _signal_node(flat, members)
+            dangling += _signal_node(flat, members, bound)
             continue
         if len(members) == 1:
             # Modelica's rule: an unconnected connector's through variables
@@ -270,20 +310,26 @@ def _connections(flat, model, comps):
         raise ConnectionError_(msg, component=dangling[0])
 
 
-def _signal_node(flat, members):
+def _signal_node(flat, members, bound):
     """Equations of a node of signal connectors: every input equals the one
-    output. Returns the inputs of a node without an output (not connected)."""
-    outputs = [p for p in members if p.causality == "output"]
-    inputs = [p for p in members if p.causality == "input"]
-    if len(outputs) > 1:
-        raise ConnectionError_(
-            f"outputs {outputs[0].path} and {outputs[1].path} are connected to each other: "
-            "a signal has one source (connect an output to inputs only)",
-            component=outputs[1].path)
-    if not outputs:
+    source of the node (its output, or an input bound to an expression).
+    Returns the inputs of a node without a source (not connected)."""
+    sources = [p for p in members if p.causality == "output" or p.path in bound]
+    inputs = [p for p in members if p not in sources]
+    if len(sources) > 1:
+        a, b = sources[:2]
+        if a.path in bound or b.path in bound:
+            what = [f"input {p.path} (bound to an expression)" if p.path in bound
+                    else f"output {p.path}" for p in (a, b)]
+            msg = f"{what[0]} and {what[1]} are connected to each other"
+        else:
+            msg = f"outputs {a.path} and {b.path} are connected to each other"
+        raise ConnectionError_(msg + ": a signal has one source (connect an output to inputs "
+                               "only)", component=b.path)
+    if not sources:
         return [p.path for p in inputs]
-    out = outputs[0].symbol
+    src = sources[0].symbol
     where = "connect(" + ", ".join(p.path for p in members) + ")"
     for p in inputs:
-        flat.equations.append(Equation(p.symbol - out, where, "connection (input = output)"))
+        flat.equations.append(Equation(p.symbol - src, where, "connection (input = output)"))
     return []

@@ -215,10 +215,29 @@ def dummy_derivatives(g, values, prefer_state):
     state nor an equation. Such a selection is detected by counting and the
     selection is redone without the preference.
     """
-    dummies = _select_dummies(g, values, prefer_state)
+    dummies = _integrable(g, _select_dummies(g, values, prefer_state))
     if not _consistent(g, dummies):
-        dummies = _select_dummies(g, values, lambda s: False)
+        dummies = _integrable(g, _select_dummies(g, values, lambda s: False))
     return dummies
+
+
+def _integrable(g, dummies):
+    """``dummies`` without the derivatives of variables that no equation
+    holds undifferentiated. Such a variable (a position whose velocity
+    alone is prescribed, ``der(s) = v_ref(t)``) is only known by
+    integrating its derivative: it must stay a state, whereas the
+    selection, when the equation that gives the derivative was itself
+    differentiated, makes that derivative a dummy and leaves the variable
+    with no equation at all."""
+    used = set()
+    for inc in g.inc:
+        used |= inc
+    out = set(dummies)
+    for j in sorted(dummies):
+        low = g.vint.get(j)
+        if low is not None and low not in used and low not in out:
+            out.discard(j)
+    return out
 
 
 def _consistent(g, dummies):

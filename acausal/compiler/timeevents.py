@@ -129,7 +129,7 @@ class _Finder:
         sw = self.switches.get(key)
         if sw is None:
             a, b = _affine(g)
-            sw = self._new("floor", g, a, b, owner, f"floor({g})")
+            sw = self._new("floor", g, a, b, owner, f"each time {g} reaches an integer")
             self.switches[key] = sw
         return sw.symbol
 
@@ -138,7 +138,8 @@ class _Finder:
         sw = self.switches.get(key)
         if sw is None:
             a, b = _affine(g)
-            sw = self._new("relation", g, a, b, owner, str(orig))
+            text = f"time = {-b / a}" if a is not None else f"where {g} = 0 ({orig})"
+            sw = self._new("relation", g, a, b, owner, text)
             self.switches[key] = sw
             if a is None:
                 self.events.append(_root_event(sw))

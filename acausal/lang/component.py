@@ -13,7 +13,7 @@ import numbers
 import sympy as sp
 
 from .connectors import Connector, Port
-from .declare import Declaration, Discrete, Parameter, Start, Variable
+from .declare import Declaration, Discrete, Parameter, Start, Variable, check_nominal
 from ..errors import ModelError, ParameterError
 
 
@@ -41,6 +41,19 @@ def _check_start(value, label, unit):
                              "number", variable=label)
 
 
+def _binding(value, label):
+    """An input's binding: a number or a sympy expression (of time and
+    parameters), else a ParameterError."""
+    try:
+        expr = sp.sympify(value, strict=True)
+    except (sp.SympifyError, TypeError):
+        expr = None
+    if isinstance(value, bool) or not isinstance(expr, sp.Basic):
+        raise ParameterError(f"input {label} can be bound to a number or a sympy expression "
+                             f"of time and parameters, got {value!r}", variable=label)
+    return expr
+
+
 class Component:
     """Base of every component and model. Keyword arguments set parameter
     values (numbers, or sympy expressions of other parameters) and start
@@ -54,6 +67,8 @@ class Component:
         object.__setattr__(self, "_ports", {})
         object.__setattr__(self, "_values", {})
         object.__setattr__(self, "_starts", {})
+        object.__setattr__(self, "_bindings", {})
+        object.__setattr__(self, "_nominals", {})
         for name, d in self.declarations().items():
             if isinstance(d, Parameter):
                 self._values[name] = d.default
@@ -75,10 +90,16 @@ class Component:
         return _collect(type(self), Connector)
 
     def set(self, **kw):
-        """Set parameter values and start values; checks bounds."""
+        """Set parameter values and start values; checks bounds. A value
+        given for an input connector (``Position(s_ref=0.1*sin(2*pi*time))``) binds
+        that input to the expression, as a Modelica modifier does: it is
+        then set by it instead of by a connection."""
         decls = self.declarations()
         for key, value in kw.items():
             d = decls.get(key)
+            if d is None and getattr(self.connectors().get(key), "causality", None) == "input":
+                self._bindings[key] = _binding(value, f"{self.path or type(self).__name__}.{key}")
+                continue
             if d is None:
                 valid = ", ".join(n for n, x in decls.items() if not isinstance(x, Discrete))
                 raise ParameterError(
@@ -99,6 +120,26 @@ class Component:
                 raise ParameterError(f"{key!r} of {self.path} is discrete; it cannot be set",
                                      component=self.path, variable=key)
         return self
+
+    def with_nominal(self, **values):
+        """Set the nominal values of variables of this instance (Modelica's
+        ``inertia(w(nominal=1e-3))``): ``Inertia(J=2).with_nominal(w=1e-3)``.
+        Returns the component."""
+        decls = self.declarations()
+        for key, value in values.items():
+            if not isinstance(decls.get(key), Variable):
+                raise ParameterError(f"with_nominal: {type(self).__name__} "
+                                     f"{self.path or '(top)'} has no variable {key!r}",
+                                     component=self.path, variable=key)
+            self._nominals[key] = check_nominal(value, f"{self.path or type(self).__name__}."
+                                                f"{key}")
+        return self
+
+    def nominal(self, name):
+        """The nominal value of variable ``name`` (None when not given)."""
+        if name in self._nominals:
+            return self._nominals[name]
+        return getattr(self.declarations().get(name), "nominal", None)
 
     def value(self, name):
         """The value given to a parameter (number, expression or choice).
@@ -156,6 +197,11 @@ class Component:
     # -- behaviour (overridden by subclasses) --------------------------------
     def equations(self):
         """Equations of this class only (sympy ``Eq`` or expressions = 0)."""
+        return []
+
+    def initial_equations(self):
+        """Equations of this class that hold at the start only (Modelica's
+        ``initial equation``, e.g. a filter starting at its input)."""
         return []
 
     def events(self):
@@ -287,11 +333,11 @@ class Model(Component):
         self._values[name] = p.check(default, self.path)
         return self.symbol(name)
 
-    def variable(self, name, start=0.0, unit=None, desc="", fixed=False):
+    def variable(self, name, start=0.0, unit=None, desc="", fixed=False, nominal=None):
         """Declare a variable of this model; returns its symbol."""
         if isinstance(start, Start):
             start, fixed = start.value, start.fixed
-        v = Variable(start, unit, desc, fixed=fixed)
+        v = Variable(start, unit, desc, fixed=fixed, nominal=nominal)
         v.name = name
         self._extra[name] = v
         self._starts[name] = v.start

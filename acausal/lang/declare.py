@@ -127,13 +127,35 @@ def guess(value):
 
 
 class Variable(Declaration):
-    """A time-varying unknown. ``start`` is a guess unless ``fixed``."""
+    """A time-varying unknown. ``start`` is a guess unless ``fixed``.
+
+    ``nominal`` (Modelica's attribute, in the variable's unit): its order
+    of magnitude. The integrator's absolute tolerance on it is then
+    ``rtol * |nominal|`` (the Modelica Specification's recommendation,
+    section 4.8.7: tolerance ``rtol*(|nominal| + |x|)``; OpenModelica's
+    rule), instead of the run's ``atol``: a 1e-3-scale angle or velocity is
+    integrated to the relative accuracy asked, and a kilonewton force is
+    not held to 1e-8 N. ``Component.with_nominal(w=1e-3)`` sets it on one
+    instance."""
 
     kind = "variable"
 
-    def __init__(self, start=0.0, unit=None, desc="", *, fixed=False):
+    def __init__(self, start=0.0, unit=None, desc="", *, fixed=False, nominal=None):
         super().__init__(unit, desc)
         self.start = Start(start, fixed)
+        self.nominal = check_nominal(nominal, desc)
+
+
+def check_nominal(value, where):
+    """``value`` as a positive finite float (None stays None), else a
+    ParameterError naming ``where``."""
+    if value is None:
+        return None
+    ok = isinstance(value, numbers.Real) and not isinstance(value, bool)
+    if not ok or not math.isfinite(float(value)) or float(value) == 0.0:
+        raise ParameterError(f"nominal value of {where} must be a non-zero finite number, "
+                             f"got {value!r}", variable=str(where))
+    return abs(float(value))
 
 
 class Discrete(Declaration):

@@ -61,11 +61,56 @@ def base_and_order(sym):
     return sym, k
 
 
+class KnownDerivatives(sp.Function):
+    """``KnownDerivatives(x, dx, ddx, ...)`` is ``x`` whose time derivatives
+    are given: d/dt of it is ``KnownDerivatives(dx, ddx, ...)`` (the index
+    reduction does not differentiate ``x``), and with one argument left it
+    is that argument. Modelica's ``derivative`` annotation, as MSL's Move
+    uses it (position, velocity and acceleration as three inputs). Its
+    value, and its partial derivatives (those of ``x``), are ``x``'s."""
+
+    nargs = None
+
+    @classmethod
+    def eval(cls, *args):
+        if len(args) == 1:
+            return args[0]
+        return None
+
+    def fdiff(self, argindex=1):
+        return sp.S.One if argindex == 1 else sp.S.Zero
+
+    def shifted(self):
+        """The time derivative: the same with the first argument dropped."""
+        return KnownDerivatives(*self.args[1:])
+
+    def _eval_derivative(self, s):
+        return sp.diff(self.args[0], s)
+
+    def _print_value(self, printer, *args, **kw):
+        return printer._print(self.args[0])
+
+    _ccode = _pythoncode = _lambdacode = _numpycode = _mpmathcode = _print_value
+
+
 def total_derivative(expr, is_variable):
     """d/dt of ``expr``: the chain rule over every symbol for which
     ``is_variable(symbol)`` is true; other symbols (parameters, discrete
-    values) are constant between events."""
+    values) are constant between events. A :class:`KnownDerivatives`
+    contributes its given derivative."""
+    known = {}
+    if expr.has(KnownDerivatives):
+        for k, node in enumerate(ordered_atoms(expr, KnownDerivatives)):
+            known[sp.Dummy(f"known{k}")] = node
+        expr = expr.xreplace({node: z for z, node in known.items()})
     terms = [diff(expr, time)] if expr.has(time) else []
     terms += [diff(expr, s) * der(s) for s in ordered(expr.free_symbols)
-              if s != time and is_variable(s)]
-    return sp.Add(*terms)
+              if s != time and s not in known and is_variable(s)]
+    terms += [diff(expr, z) * node.shifted() for z, node in known.items()]
+    out = sp.Add(*terms)
+    return out.xreplace(known) if known else out
+
+
+def ordered_atoms(expr, kind):
+    """The sub-expressions of type ``kind`` of ``expr``, in a fixed order."""
+    return sorted(expr.atoms(kind), key=sp.srepr)

@@ -3,11 +3,12 @@ component is only its parameters and its law (Modelica's PartialCompliant /
 PartialRigid). Sign convention: see :mod:`acausal.connectors`."""
 import inspect
 import numbers
+import sys
 
 import sympy as sp
 
 from acausal.lang import Component, Eq, Flange, Parameter, RotFlange, Variable, der
-from acausal.lang.connectors import RealInput, RealOutput
+from acausal.lang.connectors import RealInput
 
 from acausal.errors import ModelError, ParameterError
 
@@ -154,11 +155,30 @@ class PartialCompliantWithRelativeStates(PartialCompliant):
     value may be given to ``s_rel`` and ``v_rel``
     (``SpringDamper(s_rel=0.5, v_rel=0)``).
 
-    States: ``s_rel`` [m], ``v_rel`` [m/s], ``f`` [N]. Connectors:
-    ``flange_a``, ``flange_b``.
+    ``s_nominal`` is MSL's scale of ``s_rel``: given explicitly, it is
+    ``s_rel``'s nominal value (absolute tolerance ``rtol * s_nominal``;
+    read when the model is compiled); left at its default (MSL's 1e-4 m)
+    it sets none, so models written before keep their tolerances.
+
+    Parameters: ``s_nominal`` [m] (> 0). States: ``s_rel`` [m], ``v_rel``
+    [m/s], ``f`` [N]. Connectors: ``flange_a``, ``flange_b``.
     """
 
+    s_nominal = Parameter(1e-4, "m", "nominal value of s_rel (used for scaling)", min=0.0,
+                          min_open=True)
     v_rel = Variable(0.0, "m/s", "relative velocity der(s_rel)")
+
+    def set(self, **kw):
+        out = super().set(**kw)
+        if "s_nominal" in kw:
+            self.__dict__.setdefault("_scales_given", set()).add("s_nominal")
+        return out
+
+    def nominal(self, name):
+        given = super().nominal(name)
+        if name == "s_rel" and given is None:
+            return _nominal_parameter(self, "s_nominal")
+        return given
 
     def equations(self):
         return [Eq(self.v_rel, der(self.s_rel))]
@@ -168,21 +188,52 @@ class PartialRotCompliantWithRelativeStates(PartialRotCompliant):
     """:class:`PartialRotCompliant` plus the relative angular velocity
     ``w_rel = der(phi_rel)`` (MSL ``PartialCompliantWithRelativeStates``).
 
-    Parameters: ``phi_nominal`` [rad] MSL's scale of ``phi_rel``, accepted
-    so that MSL models port unchanged (the solver's tolerances do not use it
-    yet). States: ``phi_rel`` [rad], ``w_rel`` [rad/s], ``tau`` [N*m].
-    Connectors: ``flange_a``, ``flange_b``.
+    ``phi_nominal`` is MSL's scale of ``phi_rel``: given explicitly, it is
+    ``phi_rel``'s nominal value (the solver's absolute tolerance on it is
+    then ``rtol * phi_nominal``; read when the model is compiled). Left at
+    its default (MSL's 1e-4), it sets no nominal, so models written before
+    keep their tolerances. ``with_nominal(phi_rel=...)`` wins over it.
+
+    Parameters: ``phi_nominal`` [rad] (>= 0). States: ``phi_rel`` [rad],
+    ``w_rel`` [rad/s], ``tau`` [N*m]. Connectors: ``flange_a``,
+    ``flange_b``.
     """
 
-    phi_nominal = Parameter(1e-4, "rad", "nominal value of phi_rel (MSL's scaling)", min=0.0)
+    phi_nominal = Parameter(1e-4, "rad", "nominal value of phi_rel (used for scaling)",
+                            min=0.0)
     w_rel = Variable(0.0, "rad/s", "relative angular velocity der(phi_rel)")
+
+    def set(self, **kw):
+        out = super().set(**kw)
+        if "phi_nominal" in kw:
+            self.__dict__.setdefault("_scales_given", set()).add("phi_nominal")
+        return out
+
+    def nominal(self, name):
+        given = super().nominal(name)
+        if name == "phi_rel" and given is None:
+            return _nominal_parameter(self, "phi_nominal")
+        return given
 
     def equations(self):
         return [Eq(self.w_rel, der(self.phi_rel))]
 
 
+def _nominal_parameter(comp, name):
+    """The nominal value a scale parameter such as MSL's ``phi_nominal``
+    gives: its value when it was set explicitly to a number, MSL's 1 when
+    that number is below machine epsilon, else None."""
+    if name not in comp.__dict__.get("_scales_given", ()):
+        return None
+    value = comp.value(name)
+    if isinstance(value, sp.Basic) and not value.is_number:
+        return None
+    value = float(value)
+    return value if value >= sys.float_info.epsilon else 1.0
+
+
 # -- support flanges (MSL's useSupport) ------------------------------------------
-def _declared(ctype, name, desc):
+def declared_connector(ctype, name, desc):
     """A connector declaration named ``name`` outside a class body."""
     decl = ctype(desc)
     decl.name = name
@@ -207,10 +258,6 @@ class PartialConditionalConnectors(Component):
             if self._values.get(flag):
                 out[name] = decl
         return out
-
-    def enabled(self, name):
-        """True when the conditional connector ``name`` exists."""
-        return bool(self._values.get(self._conditional[name][0]))
 
     def port(self, name):
         cond = self._conditional.get(name)
@@ -237,7 +284,7 @@ class _WithSupport(PartialConditionalConnectors):
 
     useSupport = Parameter(False, "1", "true: a support flange (housing); false: grounded",
                            structural=True, choices=(False, True))
-    _conditional = {"support": ("useSupport", _declared(Flange, "support",
+    _conditional = {"support": ("useSupport", declared_connector(Flange, "support",
                                                         "support/housing of the component"))}
 
     def support_across(self):
@@ -253,7 +300,7 @@ class _WithSupport(PartialConditionalConnectors):
         return []
 
 
-_ROT_SUPPORT = {"support": ("useSupport", _declared(RotFlange, "support",
+_ROT_SUPPORT = {"support": ("useSupport", declared_connector(RotFlange, "support",
                                                     "support/housing of the component"))}
 
 
@@ -401,9 +448,9 @@ class PartialElementaryRotationalToTranslational(PartialConditionalConnectors):
     useSupportT = Parameter(False, "1", "true: a translational support flange; false: "
                             "grounded", structural=True, choices=(False, True))
     _conditional = {
-        "supportR": ("useSupportR", _declared(RotFlange, "supportR",
+        "supportR": ("useSupportR", declared_connector(RotFlange, "supportR",
                                               "rotational support/housing of the component")),
-        "supportT": ("useSupportT", _declared(Flange, "supportT",
+        "supportT": ("useSupportT", declared_connector(Flange, "supportT",
                                               "translational support/housing of the component")),
     }
 

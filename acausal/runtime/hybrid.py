@@ -21,12 +21,14 @@ from ..errors import ChatteringError, Interrupted, LimitError, OutputGridError, 
 from .events import EventState
 from .initialize import ask_components, initial_point, reinitialize, suspect_parameters
 from .result import Result
+from .nominal import nominal_atol
 from .timeevents import TimeSchedule
 
 CHATTER_COUNT = 100     # this many firings of one event (root) ...
 CHATTER_SPAN = 1e-9     # ... within this fraction of the time span is chattering
 MAX_ITER = 20           # event iterations at one instant
 DEFAULT_BACKEND = "sundae"
+SAME_INSTANT = 256 * np.finfo(float).eps   # (relative) times closer than this are one
 MAX_ROWS = 1_000_000    # stored output rows, by default (each 8 bytes per unknown, twice)
 WINDOW_S = 0.25         # wall time per integration window when watched [s]
 PROGRESS_DELAY_S = 2.0  # a progress bar shows once a run has lasted this long [s]
@@ -290,7 +292,7 @@ def _start(cm, t0, t_end, params, rtol, atol, atol_algebraic, max_step, max_step
     params, starts = cm.split_overrides(params)
     p = cm.param_vector(params)
     d = cm.discrete_start()
-    atol = _atol_vector(cm, atol, atol_algebraic)
+    atol = nominal_atol(cm, _atol_vector(cm, atol, atol_algebraic), rtol, atol)
     model = cm
     if sensitivities:
         from .sensitivity import SensRun, sensitivity_model
@@ -317,7 +319,7 @@ def _integrate(run, watch, cb, t, y, yp, d, stop, tout, output_step, t_stop=None
     It ends at ``t_stop`` (default: the run's end) or at a terminal event,
     and returns the point it reached: (t, y, y', d, callbacks, stop)."""
     t_end = run.t_end if t_stop is None else t_stop
-    while not stop and t < t_end:
+    while not stop and t < t_end - SAME_INSTANT * max(abs(t), abs(t_end)):
         if not run.schedule.empty():
             y, yp, d, cb, stop = _time_events(run, cb, t, y, yp, d)
             if stop:
@@ -534,9 +536,12 @@ def _tspan(t, tout, t_end, horizon, t_event=np.inf):
     cuts the run into windows (at least one output time), or up to the
     next time event ``t_event`` (which then ends the span: the solver
     stops exactly there)."""
+    # an output time closer to t than IDA can step (it refuses a tout within
+    # 100 unit round-offs of t: an output 1 ulp after a time event) is t
+    after = t + SAME_INSTANT * max(abs(t), abs(t_end))
     if t_event < t_end and (horizon is None or t_event <= horizon):
-        return np.concatenate([[t], tout[(tout > t) & (tout < t_event)], [t_event]])
-    later = tout[tout > t]
+        return np.concatenate([[t], tout[(tout > after) & (tout < t_event)], [t_event]])
+    later = tout[tout > after]
     if horizon is not None and horizon < t_end:
         cut = later[later <= horizon]
         if len(cut) == 0:
@@ -959,7 +964,8 @@ def _failure(run, cm, sol, cb):
         extra += ("; " + ", ".join(f"parameter {nm} = {v:g} [{u}] is far from its default "
                                    f"{dv:g}" for nm, v, dv, u in suspect)
                   + ": check its value and unit")
-    message = f"IDA failed at t = {t:.9g} s{where}: {r.message}{extra}"
+    who = "IDA failed" if cm.dae.n_states else "solving the equations (no states) failed"
+    message = f"{who} at t = {t:.9g} s{where}: {r.message}{extra}"
     result = run.result("failed", r.message)
     hint = ask_components(cm.model, "solver_failure", [comp] if comp else [], message, t,
                           result)

@@ -32,8 +32,10 @@ class Result:
     # -- access ----------------------------------------------------------------
     @property
     def names(self):
-        cm = self.model
-        return list(cm.var_names) + [d.symbol.name for d in cm.discretes]
+        cm = self.model   # (not the compiler's time switches and initial equations)
+        flat = cm.flat
+        return [n for n in cm.var_names if not flat.variables[n].internal] + \
+            [d.symbol.name for d in cm.discretes if not d.internal]
 
     def _observed(self):
         if self._obs is None:

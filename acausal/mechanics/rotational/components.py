@@ -5,15 +5,18 @@ from sympy import Piecewise
 
 from acausal.lang import Component, Discrete, Eq, Event, Parameter, RotFlange, Variable, der
 
+from ..contact import PosPow
 from ..partials import (NonZeroParameter, PartialElementaryRotationalToTranslational,
                         PartialRotCompliant, PartialRotCompliantWithRelativeStates,
-                        PartialRotElementaryTwoFlangesAndSupport2, PartialRotRigid)
+                        PartialRotElementaryTwoFlangesAndSupport2, PartialRotRelativeSensor,
+                        PartialRotRigid)
 
-__all__ = ["Fixed", "Inertia", "TorsionSpring", "RotationalDamper", "SpringDamper", "Spring",
-           "Damper", "ElastoBacklash", "ElastoBacklash2", "IdealGear", "IdealGearR2T",
-           "IdealRollingWheel"]
+__all__ = ["Fixed", "Inertia", "Disc", "TorsionSpring", "RotationalDamper", "SpringDamper",
+           "Spring", "Damper", "ElastoBacklash", "ElastoBacklash2", "IdealGear", "IdealGearR2T",
+           "IdealRollingWheel", "RelativeStates"]
 
 B_EPS = 1e-10   # MSL's minimum backlash [rad]: below it the backlash elements are linear
+TOUCH_TOL = 1e-12   # [rad] the contact regions switch this far before the gap's edge
 
 
 class Fixed(Component):
@@ -46,6 +49,26 @@ class Inertia(PartialRotRigid):
 
     def equations(self):
         return [Eq(self.J * der(self.w), self.net_torque())]
+
+
+class Disc(Component):
+    """A massless rigid disc whose right flange is turned by a fixed angle
+    from its left one (MSL ``Disc``): ``flange_a.phi = phi - deltaPhi/2``,
+    ``flange_b.phi = phi + deltaPhi/2``, ``flange_a.tau + flange_b.tau = 0``.
+
+    Parameters: ``deltaPhi`` [rad] flange_b.phi - flange_a.phi. States:
+    ``phi`` [rad] the disc's angle. Connectors: ``flange_a``, ``flange_b``.
+    """
+
+    flange_a = RotFlange("left flange (phi - deltaPhi/2)")
+    flange_b = RotFlange("right flange (phi + deltaPhi/2)")
+    deltaPhi = Parameter(0.0, "rad", "fixed rotation of flange_b relative to flange_a")
+    phi = Variable(0.0, "rad", "absolute rotation angle of the disc")
+
+    def equations(self):
+        return [Eq(self.flange_a.phi, self.phi - self.deltaPhi / 2),
+                Eq(self.flange_b.phi, self.phi + self.deltaPhi / 2),
+                Eq(self.flange_a.tau + self.flange_b.tau, 0)]
 
 
 class TorsionSpring(PartialRotCompliant):
@@ -125,7 +148,11 @@ class _PartialBacklash(PartialRotCompliantWithRelativeStates):
     ``+-b/2`` (MSL's events on ``phi_diff > bMax``, ``< bMin``). A backlash
     ``b <= 1e-10`` rad (MSL's ``bEps``) makes the element a plain spring
     and damper, ``tau = tau_c + tau_d`` with ``tau_c = c * phi_diff``, and
-    switches no regions.
+    switches no regions. The events switch ``region`` 1e-12 rad
+    (:data:`TOUCH_TOL`) inside the gap's edge, where the spring torque is
+    still exactly 0 (``tau_c`` is ``c`` times the penetration beyond the
+    edge), so that a run starting exactly at the edge starts in contact
+    (IDA cannot see a root function that starts at zero).
 
     MSL changes the characteristic during initialisation (a monotone line
     inside ``1.5 * b/2``) so that an initialisation that must invert it is
@@ -156,8 +183,9 @@ class _PartialBacklash(PartialRotCompliantWithRelativeStates):
         tau_up, loss_up = self._contact_torque(+1)
         tau_low, loss_low = self._contact_torque(-1)
         return [
-            Eq(self.tau_c, Piecewise((self.c * diff, linear), (self.c * (diff - half), up),
-                                     (self.c * (diff + half), low), (0, True))),
+            Eq(self.tau_c, Piecewise((self.c * diff, linear),
+                                     (self.c * PosPow(diff - half, 1), up),
+                                     (-self.c * PosPow(-half - diff, 1), low), (0, True))),
             Eq(self.tau_d, self.d * self.w_rel),
             Eq(self.tau, Piecewise((self.tau_c + self.tau_d, linear), (tau_up, up),
                                    (tau_low, low), (0, True))),
@@ -168,7 +196,7 @@ class _PartialBacklash(PartialRotCompliantWithRelativeStates):
     def events(self):
         p, region = self.path, self.region
         diff = self.phi_rel - self.phi_rel0
-        half = self.b / 2
+        half = self.b / 2 - TOUCH_TOL
         gated = self.b > B_EPS
         free, up, low = Eq(region, 0), Eq(region, 1), Eq(region, -1)
 
@@ -304,6 +332,27 @@ class IdealRollingWheel(PartialElementaryRotationalToTranslational):
     def equations(self):
         return [Eq(self.radius * self.phi_rel(), self.s_rel()),
                 Eq(self.radius * self.flangeT.f + self.flangeR.tau, 0)]
+
+
+class RelativeStates(PartialRotRelativeSensor):
+    """Relative angle, speed and acceleration between two flanges, taking
+    no torque (MSL ``RelativeStates``): ``phi_rel = flange_b.phi -
+    flange_a.phi``, ``w_rel = der(phi_rel)``, ``a_rel = der(w_rel)``. MSL
+    uses it to make ``phi_rel``, ``w_rel`` the states; here fixed start
+    values on them (``RelativeStates(phi_rel=0.1, w_rel=0)``) make the
+    solver keep them as states where it can.
+
+    States: ``phi_rel`` [rad], ``w_rel`` [rad/s], ``a_rel`` [rad/s2].
+    Connectors: ``flange_a``, ``flange_b``.
+    """
+
+    phi_rel = Variable(0.0, "rad", "relative angle flange_b.phi - flange_a.phi")
+    w_rel = Variable(0.0, "rad/s", "relative angular velocity der(phi_rel)")
+    a_rel = Variable(0.0, "rad/s2", "relative angular acceleration der(w_rel)")
+
+    def equations(self):
+        return [Eq(self.phi_rel, self.flange_b.phi - self.flange_a.phi),
+                Eq(self.w_rel, der(self.phi_rel)), Eq(self.a_rel, der(self.w_rel))]
 
 
 # Modelica / ModelingToolkitStandardLibrary names

@@ -11,9 +11,11 @@ from acausal.errors import ParameterError
 from ..partials import (PartialRotCompliant, PartialRotElementaryOneFlangeAndSupport2,
                         PartialSource, PartialTorque, SourceValue)
 from ..translational.sources import REGULARIZATIONS, regularized_sign
+from .kinematic import Accelerate, Move, Position, Speed  # noqa: F401 (MSL's Sources)
 
 __all__ = ["Torque", "Torque2", "RelativeTorque", "ConstantTorque", "SignTorque",
-           "QuadraticSpeedDependentTorque", "LinearSpeedDependentTorque", "TorqueStep", "Angle"]
+           "QuadraticSpeedDependentTorque", "LinearSpeedDependentTorque", "TorqueStep", "Angle",
+           "Position", "Speed", "Accelerate", "Move"]
 
 
 class Torque(PartialSource, PartialRotElementaryOneFlangeAndSupport2):

@@ -3,13 +3,19 @@ convention: :mod:`acausal.lang.connectors`."""
 import sympy as sp
 from sympy import Piecewise
 
-from acausal.lang import Component, Discrete, Eq, Event, Flange, Parameter, Variable, der
+from acausal.lang import Component, Discrete, Eq, Event, Flange, Model, Parameter, Variable, der
+from acausal.lang.connectors import RealInput
 
 from ..contact import PosPow
-from ..partials import (PartialCompliant, PartialCompliantWithRelativeStates, PartialRigid,
-                        PartialRigidBody)
+from ..partials import (PartialCompliant, PartialCompliantWithRelativeStates,
+                        PartialForce, PartialRelativeSensor, PartialRigid,
+                        PartialRigidBody, declared_connector)
+from .sources import REGULARIZATIONS, regularized_sign
 
-__all__ = ["Fixed", "Mass", "Rod", "Spring", "Damper", "SpringDamper", "ElastoGap"]
+__all__ = ["Fixed", "Mass", "Rod", "Spring", "Damper", "SpringDamper", "ElastoGap",
+           "RollingResistance", "Vehicle", "RelativeStates"]
+
+TOUCH_TOL = 1e-12   # [m] the contact flag switches this far before the touching point
 
 
 class Fixed(Component):
@@ -147,6 +153,12 @@ class ElastoGap(PartialCompliantWithRelativeStates):
     ``s_rel0`` (MSL's event on ``s_rel < s_rel0``); the clamping has no
     events (MSL's ``noEvent``). ``lossPower = f_d * v_rel``.
 
+    The events switch ``contact`` at ``s_rel = s_rel0 + 1e-12`` m
+    (:data:`TOUCH_TOL`), where the force is still exactly 0, so that a run
+    starting with the flanges exactly touching starts in contact (IDA
+    cannot see a root function that starts at zero); the force is MSL's
+    law at every position.
+
     Parameters: ``c`` [N/m^n] spring constant (>= 0), ``d`` [N*s/m] damping
     (>= 0), ``s_rel0`` [m] relative position at first touch (MSL's
     unstretched length), ``n`` [1] exponent of the spring force (>= 1).
@@ -178,7 +190,7 @@ class ElastoGap(PartialCompliantWithRelativeStates):
 
     def events(self):
         p, contact = self.path, self.contact
-        gap = self.s_rel0 - self.s_rel          # > 0: in contact
+        gap = self.s_rel0 - self.s_rel + TOUCH_TOL     # > 0: in contact
 
         def close(s):
             s[contact] = 1
@@ -190,3 +202,170 @@ class ElastoGap(PartialCompliantWithRelativeStates):
                       recheck=True),
                 Event(f"{p}.lift", Piecewise((gap, Eq(contact, 1)), (1, True)), -1, open_,
                       recheck=True)]
+
+
+class RelativeStates(PartialRelativeSensor):
+    """Relative position, speed and acceleration between two flanges,
+    taking no force (MSL ``RelativeStates``): ``s_rel = flange_b.s -
+    flange_a.s``, ``v_rel = der(s_rel)``, ``a_rel = der(v_rel)``. MSL uses it
+    to make ``s_rel``, ``v_rel`` the states; here fixed start values on them
+    (``RelativeStates(s_rel=0.1, v_rel=0)``) make the solver keep them as
+    states where it can.
+
+    States: ``s_rel`` [m], ``v_rel`` [m/s], ``a_rel`` [m/s2]. Connectors:
+    ``flange_a``, ``flange_b``.
+    """
+
+    s_rel = Variable(0.0, "m", "relative position flange_b.s - flange_a.s")
+    v_rel = Variable(0.0, "m/s", "relative velocity der(s_rel)")
+    a_rel = Variable(0.0, "m/s2", "relative acceleration der(v_rel)")
+
+    def equations(self):
+        return [Eq(self.s_rel, self.flange_b.s - self.flange_a.s),
+                Eq(self.v_rel, der(self.s_rel)), Eq(self.a_rel, der(self.v_rel))]
+
+
+class RollingResistance(PartialForce):
+    """Rolling resistance of a wheel (MSL ``RollingResistance``): a force
+    against the motion relative to the support, ``Cr * fWeight *
+    cos(atan(inclination))`` in magnitude, its sign regularised below
+    ``v0`` (:func:`~acausal.mechanics.translational.sources.regularized_sign`)::
+
+        f_nominal = -Cr * fWeight * cos(atan(inclination))
+        f         = -f_nominal * regularized_sign(v, v0, reg)   (f = flange.f)
+
+    ``Cr`` is the input ``cr`` with ``useCrInput=True``, else
+    ``CrConstant``; the inclination (tan of the slope angle) is the input
+    ``inclination`` with ``useInclinationInput=True``, else
+    ``inclinationConstant``.
+
+    Parameters: ``fWeight`` [N] wheel load due to gravity, ``CrConstant``
+    [1], ``inclinationConstant`` [1], ``v0`` [m/s] regularisation (> 0),
+    ``reg`` (structural, MSL's default "Exp"), ``useCrInput``,
+    ``useInclinationInput``, ``useSupport`` (structural). States: ``f``
+    [N], ``f_nominal`` [N], ``s`` [m], ``v`` [m/s]. Connectors: ``flange``,
+    ``cr``, ``inclination`` (RealInputs, with their flags), ``support``
+    (with useSupport).
+    """
+
+    fWeight = Parameter(0.0, "N", "wheel load due to gravity")
+    useCrInput = Parameter(False, "1", "enable signal input for Cr", structural=True,
+                           choices=(False, True))
+    CrConstant = Parameter(0.01, "1", "constant rolling resistance coefficient")
+    useInclinationInput = Parameter(False, "1", "enable signal input for inclination",
+                                    structural=True, choices=(False, True))
+    inclinationConstant = Parameter(0.0, "1", "constant inclination = tan(angle)")
+    reg = Parameter("Exp", "1", "type of regularization", structural=True,
+                    choices=REGULARIZATIONS)
+    v0 = Parameter(0.1, "m/s", "regularization below v0", min=0.0, min_open=True)
+    f_nominal = Variable(0.0, "N", "nominal rolling resistance without regularization")
+    _conditional = dict(PartialForce._conditional,
+                        cr=("useCrInput", declared_connector(RealInput, "cr",
+                                                    "rolling resistance coefficient")),
+                        inclination=("useInclinationInput", declared_connector(
+                            RealInput, "inclination", "inclination = tan(angle)")))
+
+    def equations(self):
+        cr = self.port("cr").symbol if self.useCrInput else self.CrConstant
+        incl = (self.port("inclination").symbol if self.useInclinationInput
+                else self.inclinationConstant)
+        return [Eq(self.f_nominal, -cr * self.fWeight * sp.cos(sp.atan(incl))),
+                Eq(self.f, -self.f_nominal * regularized_sign(self.v, self.v0, self.reg))]
+
+
+G_N = 9.80665   # [m/s2] standard gravity (Modelica.Constants.g_n)
+
+
+class Vehicle(Model):
+    """A simple vehicle (MSL ``Vehicle``): a mass driven through a wheel
+    (inertia and ideal rolling wheel) against the driving resistances::
+
+        flangeR -- inertia(J) -- idealRollingWheel(R) -- mass(m) -- flangeT
+                                                          |
+                         fDrag (air, relative to the wind), fRoll (rolling),
+                         fGrav (slope)
+
+    * air drag: ``QuadraticSpeedDependentForce`` with ``f_nominal =
+      -Cd*A*rho/2`` (at 1 m/s), both directions, its support moving with
+      the wind (``windSpeed``, a ``Speed`` source fed by ``vWind`` or
+      ``vWindConstant``);
+    * rolling resistance: :class:`RollingResistance` with ``fWeight = m*g``,
+      linear regularisation below ``vReg``;
+    * slope: a force ``-m*g*sin(atan(inclination))``.
+
+    The vehicle's ``s``, ``v``, ``a`` are the mass's; ``Vehicle(s=0, v=0)``
+    gives them fixed start values (MSL's ``s(fixed=true)``). With ``J = 0``
+    there is no inertia: ``flangeR`` is the wheel's.
+
+    Parameters: ``m`` [kg] total mass (> 0), ``J`` [kg*m^2] drive-train
+    inertia (>= 0), ``R`` [m] wheel radius (> 0), ``A`` [m^2] cross
+    section, ``Cd`` [1] drag coefficient, ``rho`` [kg/m^3] air density,
+    ``g`` [m/s2] gravity, ``vWindConstant`` [m/s], ``CrConstant`` [1],
+    ``vReg`` [m/s] (> 0), ``inclinationConstant`` [1]; ``useWindInput``,
+    ``useCrInput``, ``useInclinationInput`` (structural). States: ``s`` [m],
+    ``v`` [m/s], ``a`` [m/s2]. Connectors: ``flangeT`` (translational),
+    ``flangeR`` (rotational), ``vWind``, ``cr``, ``inclination``
+    (RealInputs, with their flags).
+    """
+
+    def __init__(self, m, J, R, A=1.0, Cd=0.5, rho=1.2, g=G_N, useWindInput=False,
+                 vWindConstant=0.0, useCrInput=False, CrConstant=0.015, vReg=1e-3,
+                 useInclinationInput=False, inclinationConstant=0.0, s=None, v=None):
+        super().__init__()
+        m_ = self.parameter("m", m, "kg", "total mass of vehicle", min=0.0, min_open=True)
+        g_ = self.parameter("g", g, "m/s2", "constant gravity acceleration")
+        J_ = self.parameter("J", J, "kg*m^2", "total rotational inertia of drive train",
+                            min=0.0)
+        R_ = self.parameter("R", R, "m", "wheel radius", min=0.0, min_open=True)
+        A_ = self.parameter("A", A, "m^2", "cross section of vehicle", min=0.0)
+        Cd_ = self.parameter("Cd", Cd, "1", "drag resistance coefficient", min=0.0)
+        rho_ = self.parameter("rho", rho, "kg/m^3", "density of air", min=0.0)
+        self.parameter("vWindConstant", vWindConstant, "m/s", "constant wind velocity")
+        self.parameter("CrConstant", CrConstant, "1", "constant rolling resistance coefficient")
+        self.parameter("vReg", vReg, "m/s", "velocity for regularization around 0", min=0.0,
+                       min_open=True)
+        self.parameter("inclinationConstant", inclinationConstant, "1",
+                       "constant inclination = tan(angle)")
+        from ..rotational.components import IdealRollingWheel, Inertia
+        from .kinematic import Speed
+        from .sources import Force, QuadraticSpeedDependentForce
+
+        starts = {k: val for k, val in (("s", s), ("v", v)) if val is not None}
+        self.mass = Mass(m=m_, **starts)
+        self.idealRollingWheel = IdealRollingWheel(radius=R_)
+        v_ref = 1.0       # MSL's vRef: the drag's reference speed [m/s]
+        self.fDrag = QuadraticSpeedDependentForce(
+            useSupport=True, f_nominal=-Cd_ * A_ * rho_ * v_ref ** 2 / 2, ForceDirection=False,
+            v_nominal=v_ref)
+        self.windSpeed = Speed(**({} if useWindInput
+                                  else {"v_ref": self.symbol("vWindConstant")}))
+        self.fRoll = RollingResistance(
+            fWeight=m_ * g_, useCrInput=useCrInput, CrConstant=self.symbol("CrConstant"),
+            useInclinationInput=useInclinationInput,
+            inclinationConstant=self.symbol("inclinationConstant"), reg="Linear",
+            v0=self.symbol("vReg"))
+        incl = (self.fRoll.inclination if useInclinationInput
+                else self.symbol("inclinationConstant"))
+        self.fGrav = Force(f=-m_ * g_ * sp.sin(sp.atan(sp.sympify(incl))))
+        self.connect(self.idealRollingWheel.flangeT, self.mass.flange_a)
+        self.connect(self.fDrag.support, self.windSpeed.flange)
+        self.connect(self.mass.flange_b, self.fDrag.flange, self.fRoll.flange,
+                     self.fGrav.flange)
+        if isinstance(J, (int, float)) and J == 0:
+            self.flangeR = self.idealRollingWheel.flangeR
+        else:
+            self.inertia = Inertia(J=J_)
+            self.connect(self.inertia.flange_b, self.idealRollingWheel.flangeR)
+            self.flangeR = self.inertia.flange_a
+        self.flangeT = self.mass.flange_b
+        if useWindInput:
+            self.vWind = self.windSpeed.v_ref
+        if useCrInput:
+            self.cr = self.fRoll.cr
+        if useInclinationInput:
+            self.inclination = self.fRoll.inclination
+        for name, unit, desc in (("s", "m", "position of vehicle"),
+                                 ("v", "m/s", "velocity of vehicle"),
+                                 ("a", "m/s2", "acceleration of vehicle")):
+            sym = self.variable(name, 0.0, unit, desc)
+            self.equation(Eq(sym, getattr(self.mass, name)))

@@ -3,17 +3,17 @@ signals, laws or speed-dependent characteristics, and prescribed motion.
 Sign convention: :mod:`acausal.lang.connectors`."""
 
 import sympy as sp
-from sympy import Basic, Piecewise, SympifyError, sympify
+from sympy import Piecewise
 
-from acausal.lang import Component, Eq, Flange, Parameter, Variable, der, time
+from acausal.lang import Eq, Flange, Parameter, time
 
-from acausal.errors import ParameterError
-
+from .kinematic import Accelerate, Move, Position, Speed  # noqa: F401 (MSL's Sources)
 from ..partials import (PartialCompliant, PartialElementaryOneFlangeAndSupport2, PartialForce,
                         PartialSource, SourceValue)
 
 __all__ = ["Force", "Force2", "RelativeForce", "ConstantForce", "SignForce",
-           "QuadraticSpeedDependentForce", "LinearSpeedDependentForce", "ForceStep", "Position"]
+           "QuadraticSpeedDependentForce", "LinearSpeedDependentForce", "ForceStep", "Position",
+           "Speed", "Accelerate", "Move"]
 
 REGULARIZATIONS = ("Exp", "Sine", "Linear", "CoSine")
 
@@ -29,10 +29,11 @@ def regularized_sign(x, x0, reg):
     """
     if reg == "Exp":
         return 2 / (1 + sp.exp(-x / (sp.Rational(1, 100) * x0))) - 1
+    sgn = Piecewise((1, x >= 0), (-1, True))     # sign(x) without a DiracDelta derivative
     inside = {"Sine": sp.sin(sp.pi / 2 * x / x0),
               "Linear": x / x0,
-              "CoSine": sp.sign(x) * (1 - sp.cos(sp.pi / 2 * x / x0))}[reg]
-    return Piecewise((sp.sign(x), sp.Abs(x) >= x0), (inside, True))
+              "CoSine": sgn * (1 - sp.cos(sp.pi / 2 * x / x0))}[reg]
+    return Piecewise((1, x >= x0), (-1, x <= -x0), (inside, True))
 
 
 class Force(PartialSource, PartialElementaryOneFlangeAndSupport2):
@@ -237,33 +238,3 @@ class ForceStep(PartialForce):
     def equations(self):
         step = Piecewise((0, time < self.startTime), (self.stepForce, True))
         return [Eq(self.f, -self.offsetForce - step)]
-
-
-class Position(Component):
-    """Prescribed motion: ``flange.s = s_ref`` with ``s_ref`` a sympy
-    expression of ``acausal.time`` (and parameters), smooth enough to be
-    differentiated twice (the index reduction differentiates it to drive a
-    mass). The flange takes whatever force that motion needs.
-
-    Parameters: none (``s`` is fixed at construction). States: ``s`` [m].
-    Connectors: ``flange``.
-    """
-
-    diagnosis_site = "driver"   # what acausal.diagnose may extend here
-
-    flange = Flange("driven flange")
-    s = Variable(0.0, "m", "prescribed position")
-
-    def __init__(self, s, **kw):
-        super().__init__(**kw)
-        try:
-            expr = sympify(s, strict=True)
-        except SympifyError:
-            expr = None
-        if not isinstance(expr, Basic) or isinstance(s, bool):
-            raise ParameterError(f"Position.s must be a number or a sympy expression of "
-                                 f"time, got {s!r}")
-        object.__setattr__(self, "_ref", expr)
-
-    def equations(self):
-        return [Eq(self.s, self._ref), Eq(self.flange.s, self.s)]

@@ -6,7 +6,7 @@ masses' states, next to a chain that starts at rest.
 Compared with the reference: m1.s, m1.v, m3.s, m3.v, sd1.s_rel,
 sd1.v_rel, sd2.s_rel, sd2.v_rel (tests/msl/test_parts_examples.py).
 """
-from acausal import Experiment, Model, guess
+from acausal import Experiment, Model
 from acausal.mechanics.translational import Fixed, Mass, Spring, SpringDamper
 
 model = Model()
