@@ -1,26 +1,193 @@
 """The ``acausal`` command: simulate, animate, variables, linearize, calibrate, sweep,
-diagnose, fmu.
+tolerance, diagnose, fmu.
 
-Exit codes: 0 success, 2 a model or input error (an AcausalError: one
-readable line on stderr), 3 a solver failure (time and component named).
-Any other exception is a bug: it is not caught, so Python shows its
-traceback and exits with 1.
+Exit codes: 0 success, 2 a model or input error (an AcausalError, a bad
+option value, a budget that refuses the work before it starts: one readable
+line on stderr), 3 a solver failure or a run stopped by a limit (time and
+component named; the partial result is written), 130 an interruption
+(Ctrl-C, SIGTERM: the partial result is written). Any other exception is a
+bug: it is not caught, so Python shows its traceback and exits with 1.
+
+Every option value is checked before anything runs (:class:`_Number`,
+:func:`_check_output`); library warnings (numpy, scipy) do not reach the
+terminal: a command that succeeds ends with one line counting them
+(:func:`_quiet_warnings`), and values far from the model's defaults or
+declared ranges get one warning line each.
 """
 import contextlib
 import json
+import math
 import os
+import signal
 import sys
+import warnings
 
 import click
 import numpy as np
 
-from .errors import AcausalError, SolverError, UsageError
+from .errors import AcausalError, Interrupted, SolverError, UsageError
 
 
 def _fail(exc):
-    code = 3 if isinstance(exc, SolverError) else 2
-    click.echo(f"acausal: error: {exc}", err=True)
+    if isinstance(exc, Interrupted):
+        code = 130
+    elif isinstance(exc, (UsageError, click.BadParameter)):
+        code = 2
+    else:
+        code = 3 if isinstance(exc, SolverError) else 2
+    click.echo(f"acausal: error: {_one_line(str(exc))}", err=True)
     sys.exit(code)
+
+
+def _one_line(text):
+    return " ".join(str(text).split())
+
+
+def _warn(text):
+    click.echo(f"acausal: warning: {_one_line(text)}", err=True)
+
+
+class _Group(click.Group):
+    """The command group, whose usage errors (an unknown option, a value of
+    the wrong type) are one line, like every other error: ``acausal
+    simulate: error: Invalid value for '--t-end': ...`` (exit 2)."""
+
+    def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True,
+             **extra):
+        if not standalone_mode:
+            return super().main(args, prog_name, complete_var, standalone_mode, **extra)
+        try:
+            return super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
+        except click.exceptions.Abort:
+            click.echo("acausal: interrupted", err=True)
+            sys.exit(130)
+        except click.ClickException as exc:
+            ctx = getattr(exc, "ctx", None)
+            where = ctx.command_path if ctx is not None else "acausal"
+            click.echo(f"{where}: error: {_one_line(exc.format_message())} "
+                       f"(see {where} --help)", err=True)
+            sys.exit(exc.exit_code)
+
+
+class _Number(click.ParamType):
+    """A number option checked when it is parsed: ``kind`` "finite", "positive"
+    (finite > 0), "fraction" (0 < x < 1) or "count" (a whole number >= 1,
+    written 1000000, 1e6 or 1_000_000: the messages print counts as 1e6)."""
+
+    def __init__(self, kind):
+        self.kind = kind
+        self.name = {"count": "count"}.get(kind, "number")
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            x = float(value)
+        else:
+            try:
+                x = float(str(value).strip().replace("_", ""))
+            except ValueError:
+                self.fail(f"{value!r} is not a number", param, ctx)
+        if not math.isfinite(x):
+            self.fail(f"{value!r} is not a finite number", param, ctx)
+        if self.kind == "positive" and not x > 0:
+            self.fail(f"{value!r} must be > 0", param, ctx)
+        if self.kind == "fraction" and not 0 < x < 1:
+            self.fail(f"{value!r} must be between 0 and 1", param, ctx)
+        if self.kind == "count":
+            if x != int(x) or x < 1:
+                self.fail(f"{value!r} must be a whole number >= 1", param, ctx)
+            if x > 1e15:
+                self.fail(f"{value!r} is beyond any budget (at most 1e15)", param, ctx)
+            return int(x)
+        return x
+
+
+FINITE, POSITIVE, FRACTION, COUNT = (_Number(k) for k in ("finite", "positive", "fraction",
+                                                           "count"))
+
+
+def _size(ctx, param, value):
+    """``--max-memory``: bytes (``4GB``, ``512MB``, ``2e9``), or None."""
+    if value is None:
+        return None
+    from .budget import parse_size
+    try:
+        return parse_size(value, f"--{param.name.replace('_', '-')}")
+    except UsageError as exc:
+        raise click.BadParameter(str(exc)) from None
+
+
+def _check_output(path, option, *, plot=False, create=False):
+    """Refuse, before anything runs, an output path that cannot be written:
+    its folder missing (unless ``create``: made now) or not writable, the
+    path a folder, or (``plot``) a format matplotlib cannot write. (A
+    missing folder was found after the simulation, with a traceback.)"""
+    if path is None:
+        return
+    path = os.fspath(path)
+    if plot:
+        from matplotlib.backend_bases import FigureCanvasBase
+        formats = FigureCanvasBase.get_supported_filetypes()
+        ext = os.path.splitext(path)[1].lstrip(".").lower()
+        if ext not in formats:
+            raise UsageError(f"{option} {path}: cannot write a figure as "
+                             f"{'.' + ext if ext else 'a file without an extension'}; "
+                             f"use one of {', '.join('.' + f for f in sorted(formats))}")
+    if os.path.isdir(path):
+        raise UsageError(f"{option} {path}: is a folder, not a file")
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        if os.path.exists(folder) or not create:
+            raise UsageError(f"{option} {path}: the folder {os.path.dirname(path) or '.'} "
+                             "does not exist")
+        try:
+            os.makedirs(folder, exist_ok=True)
+        except OSError as exc:
+            raise UsageError(f"{option} {path}: cannot make its folder: "
+                             f"{exc.strerror or exc}") from None
+    if not os.access(folder, os.W_OK) or (os.path.exists(path) and
+                                          not os.access(path, os.W_OK)):
+        raise UsageError(f"{option} {path}: not writable")
+
+
+@contextlib.contextmanager
+def _quiet_warnings():
+    """Library warnings (numpy's overflow, scipy's LinAlgWarning, ...) are
+    kept from the terminal while the block runs (24 lines of LinAlgWarning
+    for a 1e30 stiffness, six RuntimeWarnings before a clean error); a block
+    that ends normally prints one line counting them."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        warnings.simplefilter("ignore", DeprecationWarning)   # (old import paths: not numerical)
+        warnings.simplefilter("ignore", PendingDeprecationWarning)
+        with np.errstate(all="ignore"):
+            yield
+    if caught:
+        kinds = {}
+        for w in caught:
+            kinds.setdefault(w.category.__name__, []).append(w)
+        parts = [f"{len(ws)} {name}" + (f" (first: {_one_line(ws[0].message)[:120]})"
+                                         if name != "DeprecationWarning" else "")
+                 for name, ws in kinds.items()]
+        _warn("the numerical libraries warned during the run, not shown: " + "; ".join(parts))
+
+
+def _far_settings(cm, params):
+    """One warning line per ``--set`` value far from its default (6 decades,
+    the initialisation's own test) or of the other sign: a value in the
+    wrong unit, typically."""
+    from .runtime.initialize import SUSPECT_DECADES
+    for name, value in params.items():
+        try:
+            e = cm.params[cm.param_index(name)]
+        except AcausalError:
+            continue
+        d = e.default
+        if d and value and math.isfinite(value) and (abs(math.log10(abs(value / d))) >= SUSPECT_DECADES or
+                            (value > 0) != (d > 0)):
+            _warn(f"--set {name}={value:g} [{e.unit}] is far from its default {d:g} "
+                  f"[{e.unit}] ({abs(math.log10(abs(value / d))):.1f} decades"
+                  f"{', other sign' if (value > 0) != (d > 0) else ''}): check its value "
+                  "and unit")
 
 
 def _parse_sets(sets):
@@ -39,7 +206,7 @@ def _parse_sets(sets):
     return out
 
 
-@click.group()
+@click.group(cls=_Group)
 @click.version_option(package_name="acausal")
 @click.option("--backend", "global_backend", type=click.Choice(["sundae", "compiled"]),
               help="integrator backend of every simulation of the command, local worker "
@@ -67,7 +234,7 @@ def main(ctx, global_backend):
 # for the command on a first run, 2.9 against 3.4 once built).
 # diagnose's fits also take it when called from Python (acausal/diagnose/
 # problem.py FIT_BACKEND, measured in docs/diagnosis.md).
-MANY_RUNS = {"calibrate", "sweep", "diagnose"}
+MANY_RUNS = {"calibrate", "sweep", "diagnose", "tolerance"}
 
 
 def _set_backend(ctx, name):
@@ -84,58 +251,123 @@ def _set_backend(ctx, name):
     ctx.call_on_close(restore)
 
 
+MAX_MEMORY_HELP = ("memory limit of the command (4GB, 512MB, ...; default $ACAUSAL_MAX_MEMORY, "
+                   "else 4GB or 80% of the machine's memory): estimated before the work "
+                   "starts, watched while it runs")
+
+
 @main.command()
 @click.argument("file", type=click.Path(dir_okay=False))
-@click.option("--t-end", type=float, help="stop time [s] (default: the model file's)")
+@click.option("--t-end", type=FINITE, help="stop time [s] (default: the model file's)")
 @click.option("--set", "sets", multiple=True, metavar="PATH=VALUE",
               help="override a parameter, e.g. --set contact.K=6.25e8")
 @click.option("--out", type=click.Path(dir_okay=False), help="write all variables to CSV")
 @click.option("--plot", type=click.Path(dir_okay=False), help="write a figure (PNG, PDF...)")
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object")
-@click.option("--rtol", type=float)
-@click.option("--atol", type=float)
-@click.option("--max-rows", type=int, default=None, metavar="N",
+@click.option("--rtol", type=FRACTION, help="relative tolerance (0 < rtol < 1)")
+@click.option("--atol", type=POSITIVE, help="absolute tolerance (> 0)")
+@click.option("--max-rows", type=COUNT, default=None, metavar="N",
               help="most output rows to store (default 1e6): a larger grid is refused")
-@click.option("--max-wall", type=float, metavar="SECONDS",
+@click.option("--max-wall", type=POSITIVE, metavar="SECONDS",
               help="stop after this wall time, keeping what was computed")
-@click.option("--max-steps", type=int, metavar="N",
+@click.option("--max-steps", type=COUNT, metavar="N",
               help="stop after this many solver steps, keeping what was computed")
+@click.option("--max-memory", callback=_size, metavar="SIZE", help=MAX_MEMORY_HELP)
 @click.option("--progress/--no-progress", default=None,
               help="progress bar on stderr for runs longer than 2 s "
                    "(default: when stderr is a terminal)")
 @click.option("--backend", type=click.Choice(["sundae", "compiled"]),
               help="integrator backend (default: acausal.simulate.DEFAULT_BACKEND)")
 def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, max_rows, max_wall, max_steps,
-             progress, backend):
-    """Simulate a model file."""
+             max_memory, progress, backend):
+    """Simulate a model file. Stopped by a limit, Ctrl-C or SIGTERM, it
+    writes what it computed (--out, --plot, --json) and says where it stopped."""
+    from .budget import max_memory as memory_limit
     from .modelfile import compile_file, measure_values
+    res = error = None
     try:
-        params = _parse_sets(sets)
-        mf, cm = compile_file(file)
-        opts = _simulate_options(mf, dict(t_end=t_end, rtol=rtol, atol=atol, max_rows=max_rows,
-                                          max_wall=max_wall, max_total_steps=max_steps,
-                                          backend=backend),
-                                 progress, dense=bool(out or plot))
-        with _c_stdout_to_stderr() if as_json else contextlib.nullcontext():
-            res, error = _run_keeping_partial(cm, params, opts)
-        measures, missing = measure_values(mf, res) if error is None else ({}, {})
-        if out:
-            res.to_csv(out)
-            if error is not None:
-                click.echo(f"acausal: partial results up to t = {res.t[-1]:.6g} s written to "
-                           f"{out}", err=True)
-        if plot:
-            _plot(mf, res, plot, partial=error is not None)
+        with _interruptible(), _quiet_warnings():
+            _check_output(out, "--out")
+            _check_output(plot, "--plot", plot=True)
+            params = _parse_sets(sets)
+            mf, cm = compile_file(file)
+            cm.param_vector(cm.split_overrides(params)[0])   # names, bounds: errors first
+            _far_settings(cm, params)
+            opts = _simulate_options(mf, dict(t_end=t_end, rtol=rtol, atol=atol,
+                                              max_rows=max_rows, max_wall=max_wall,
+                                              max_total_steps=max_steps, backend=backend),
+                                     progress, dense=bool(out or plot))
+            _check_run_options(opts)
+            opts["max_memory"] = memory_limit(max_memory)
+            with _c_stdout_to_stderr() if as_json else contextlib.nullcontext():
+                res, error = _run_keeping_partial(cm, params, opts)
+            measures, missing = measure_values(mf, res) if error is None else ({}, {})
+            if out:
+                res.to_csv(out)
+                if error is not None:
+                    click.echo(f"acausal: partial results up to t = {res.t[-1]:.6g} s written "
+                               f"to {out}", err=True)
+            if plot:
+                _plot(mf, res, plot, partial=error is not None)
     except (AcausalError, click.BadParameter) as exc:
         if as_json:
             click.echo(json.dumps({"error": _error_dict(exc)}, indent=1))
         _fail(exc)
+    except KeyboardInterrupt:
+        click.echo("acausal: interrupted before the simulation started: nothing computed",
+                   err=True)
+        sys.exit(130)
     if as_json:
         click.echo(json.dumps(_result_dict(mf, res, measures, missing, error), indent=1))
     else:
         _print_run(mf, cm, res, measures, missing)
     if error is not None:
         _fail(error)
+
+
+def _check_run_options(opts):
+    """The run's stop time after its start (the model file's t0), checked
+    before the run (--t-end -1 gave an IndexError, nan a ValueError)."""
+    t0, t_end = opts.get("t0", 0.0), opts.get("t_end")
+    if t_end is not None and not t_end > t0:
+        raise UsageError(f"--t-end {t_end:g}: must be after the start time t0 = {t0:g} s")
+
+
+@contextlib.contextmanager
+def _interruptible():
+    """Ctrl-C, SIGTERM and SIGHUP stop a running simulation with its partial
+    result (:func:`acausal.runtime.hybrid.request_stop`: the run ends at its next
+    check, keeping its rows, and the command writes them); outside a run,
+    or at a second signal, they interrupt at once (KeyboardInterrupt; the
+    process ends within the grace period whatever it is doing)."""
+    from .runtime import hybrid as sim
+    from .infra.executor import exit_soon
+
+    def handler(signum, frame):
+        name = signal.Signals(signum).name
+        if not sim.STOP.reason and sim.request_stop(f"an interruption ({name})"):
+            exit_soon(130, grace=120.0)     # time to write the partial result
+            return
+        exit_soon(130, grace=5.0)
+        raise KeyboardInterrupt(name)
+
+    if not _in_main_thread():
+        yield
+        return
+    names = [n for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n)]
+    old = {n: signal.signal(getattr(signal, n), handler) for n in names}
+    sim.STOP.armed = True
+    try:
+        yield
+    finally:
+        sim.STOP.armed = False
+        for n, h in old.items():
+            signal.signal(getattr(signal, n), h)
+
+
+def _in_main_thread():
+    import threading
+    return threading.current_thread() is threading.main_thread()
 
 
 def _simulate_options(mf, given, progress, dense=False):
@@ -245,26 +477,44 @@ def _plot(mf, res, path, partial=False):
 @click.argument("file", type=click.Path(dir_okay=False))
 @click.option("--out", required=True, type=click.Path(dir_okay=False),
               help="animation file: .gif (Pillow) or .mp4 (needs ffmpeg)")
-@click.option("--t-end", type=float, help="stop time [s] (default: the model file's)")
+@click.option("--t-end", type=FINITE, help="stop time [s] (default: the model file's)")
 @click.option("--set", "sets", multiple=True, metavar="PATH=VALUE",
               help="override a parameter, e.g. --set crank_pin.w=10")
-@click.option("--fps", type=int, default=25, show_default=True)
-@click.option("--frames", type=int, default=150, show_default=True,
+@click.option("--fps", type=COUNT, default=25, show_default=True)
+@click.option("--frames", type=COUNT, default=150, show_default=True,
               help="largest number of frames (evenly spaced in time)")
-def animate(file, out, t_end, sets, fps, frames):
+@click.option("--max-wall", type=POSITIVE, metavar="SECONDS",
+              help="stop the simulation after this wall time (the frames up to there are drawn)")
+@click.option("--max-memory", callback=_size, metavar="SIZE", help=MAX_MEMORY_HELP)
+def animate(file, out, t_end, sets, fps, frames, max_wall, max_memory):
     """Simulate a planar model file and animate its mechanism."""
     from .viz.animate import animate as write_animation
+    from .budget import max_memory as memory_limit
     from .modelfile import compile_file
     try:
-        mf, cm = compile_file(file)
-        opts = mf.experiment.run_options()
-        if t_end is not None:
-            opts["t_end"] = t_end
-        res = cm.simulate(params=_parse_sets(sets), **opts)
-        ks = write_animation(res, out, fps=fps, max_frames=frames,
-                             title=mf.path.rsplit("/", 1)[-1])
+        with _interruptible(), _quiet_warnings():
+            if os.path.splitext(out)[1].lower() not in (".gif", ".mp4"):
+                raise UsageError(f"--out {out}: an animation is written as .gif or .mp4")
+            _check_output(out, "--out")
+            mf, cm = compile_file(file)
+            opts = mf.experiment.run_options()
+            if t_end is not None:
+                opts["t_end"] = t_end
+            _check_run_options(opts)
+            opts.update(max_memory=memory_limit(max_memory),
+                        **({"max_wall": max_wall} if max_wall else {}))
+            res, error = _run_keeping_partial(cm, _parse_sets(sets), opts)
+            ks = write_animation(res, out, fps=fps, max_frames=frames,
+                                 title=mf.path.rsplit("/", 1)[-1])
     except (AcausalError, click.BadParameter) as exc:
         _fail(exc)
+    except KeyboardInterrupt:
+        click.echo("acausal: interrupted before the simulation started: nothing drawn", err=True)
+        sys.exit(130)
+    if error is not None:
+        click.echo(f"wrote {out}: {len(ks)} frames, t = {res.t[0]:g} .. {res.t[-1]:g} s "
+                   "(partial)")
+        _fail(error)
     click.echo(f"wrote {out}: {len(ks)} frames, t = {res.t[0]:g} .. {res.t[-1]:g} s")
 
 
@@ -340,7 +590,7 @@ def check(file, as_json):
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object")
 def linearize(file, at, inputs, outputs, sets, out, as_json):
     """Linearise a model file: A, B, C, D and the eigenvalues of A."""
-    from .analysis import linearize as lin_
+    from .analysis import RunSettings, linearize as lin_
     from .modelfile import compile_file
     try:
         params = _parse_sets(sets)
@@ -348,7 +598,7 @@ def linearize(file, at, inputs, outputs, sets, out, as_json):
         point = _parse_at(at)
         lin = lin_(cm, at=point, inputs=inputs, outputs=outputs, params=params,
                    t=mf.experiment.t0 if not isinstance(point, float) else None,
-                   rtol=mf.experiment.rtol, atol=mf.experiment.atol)
+                   run=RunSettings(rtol=mf.experiment.rtol, atol=mf.experiment.atol))
         if out:
             lin.save(out)
     except (AcausalError, click.BadParameter) as exc:
@@ -401,35 +651,61 @@ def _parse_at(text):
               help="profile-likelihood 95% intervals (lsq): for the parameters whose "
                    "linearised interval is not trustworthy (auto), every one, or none")
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object")
-def calibrate(file, data, fit, method, experiments, profile, as_json):
-    """Fit parameters of a model file to a measured dataset."""
+@click.option("--max-wall", type=POSITIVE, metavar="SECONDS", help="stop after this wall time")
+@click.option("--max-memory", callback=_size, metavar="SIZE", help=MAX_MEMORY_HELP)
+def calibrate(file, data, fit, method, experiments, profile, as_json, max_wall, max_memory):
+    """Fit parameters of a model file to a measured dataset. Warns (one line
+    each) when a condition of the data lies outside the range the model
+    declares, a measured value is far from what the fitted model gives (a
+    unit, a sign), or a fitted value ends at a bound of its range."""
     from .studies import calibrate as cal
+    from .budget import Watchdog
+    from .budget import max_memory as memory_limit
     from .modelfile import compile_file
     try:
-        mf, cm = compile_file(file)
-        ds = cal.model_dataset(file, data)
-        chosen = None
-        if experiments:
-            chosen = "all" if experiments.strip() == "all" else [
-                x.strip() for x in experiments.split(",") if x.strip()]
-        ds, held = cal.split(ds, chosen)
-        items = [x.strip() for x in fit.split(",") if x.strip()]
-        if method == "report":
-            pairs = []
-            for it in items:
-                if ":" not in it:
-                    raise click.BadParameter(f"--fit {it!r}: the report method needs PARAM:MEASURE")
-                p, m = it.split(":", 1)
-                pairs.append((p, m))
-            cal.check_names(cm, [p for p, _ in pairs])
-            out = cal.report_method(file, ds, pairs)
-        else:
-            names = [it.split(":", 1)[0] for it in items]
-            cal.check_names(cm, names)
-            out = cal.least_squares(file, ds, names, profile=profile)
-        out.validation = cal.validate(file, held, out.values)
+        with _quiet_warnings(), _resumable("nothing (a calibration keeps no partial result)"), \
+                Watchdog(memory_limit(max_memory), max_wall, "the calibration"):
+            out, ds, held, mf, cm = _calibrate(cal, compile_file, file, data, fit, method,
+                                               experiments, profile)
     except (AcausalError, click.BadParameter) as exc:
         _fail(exc)
+    _calibration_warnings(mf, cm, ds, held, out)
+    _print_calibration(out, ds, mf, file, data, as_json)
+
+
+def _calibrate(cal, compile_file, file, data, fit, method, experiments, profile):
+    """The calibration's work: (result, dataset fitted, ModelFile, CompiledModel)."""
+    mf, cm = compile_file(file)
+    ds = cal.model_dataset(file, data)
+    _condition_warnings(mf, ds)
+    chosen = None
+    if experiments is not None:
+        chosen = "all" if experiments.strip() == "all" else [
+            x.strip() for x in experiments.split(",") if x.strip()]
+        if chosen == []:
+            raise UsageError("--experiments: the list is empty (give names, or 'all')")
+    ds, held = cal.split(ds, chosen)
+    items = [x.strip() for x in fit.split(",") if x.strip()]
+    if not items:
+        raise UsageError("--fit: no parameter named (give --fit P1,P2)")
+    if method == "report":
+        pairs = []
+        for it in items:
+            if ":" not in it:
+                raise click.BadParameter(f"--fit {it!r}: the report method needs PARAM:MEASURE")
+            p, m = it.split(":", 1)
+            pairs.append((p, m))
+        cal.check_names(cm, [p for p, _ in pairs])
+        out = cal.report_method(file, ds, pairs)
+    else:
+        names = [it.split(":", 1)[0] for it in items]
+        cal.check_names(cm, names)
+        out = cal.least_squares(file, ds, names, profile=profile)
+    out.validation = cal.validate(file, held, out.values)
+    return out, ds, held, mf, cm
+
+
+def _print_calibration(out, ds, mf, file, data, as_json):
     if as_json:
         click.echo(json.dumps(out.to_dict(), indent=1, default=float))
         return
@@ -448,22 +724,103 @@ def calibrate(file, data, fit, method, experiments, profile, as_json):
             click.echo(f"    {name:20s} " + " ".join(f"{x:+.3f}" for x in row))
     click.echo("  residuals (simulated - measured):")
     for exp, sig in out.residuals.items():
-        click.echo(f"    {exp}: " + ", ".join(_residual(k, v) for k, v in sig.items()))
+        click.echo(f"    {exp}: " + ", ".join(_residual(k, v, mf) for k, v in sig.items()))
     if out.validation:
         click.echo("  held back, predicted with these values (simulated - measured):")
         for exp, sig in out.validation.items():
-            click.echo(f"    {exp}: " + ", ".join(_residual(k, v) for k, v in sig.items()))
+            click.echo(f"    {exp}: " + ", ".join(_residual(k, v, mf) for k, v in sig.items()))
 
 
-def _residual(name, value):
-    """'thrt +1.2e-05' for a measure, 'hook.phi rms 3.4e-04 over 40 samples'
-    for a trace, the message for a failed prediction."""
+def _shown_unit(mf, name):
+    """(factor, unit) showing a residual of measure or variable ``name``:
+    a measure's display unit (thrt: 1e3, 'ms'), else its SI unit, else (1, '')."""
+    from .lang.experiment import Measure
+    fn = mf.measures.get(name) if mf is not None else None
+    if isinstance(fn, Measure):
+        factor, unit = fn.shown(1.0)
+        return factor, ("" if unit == "1" else unit)
+    unit = mf.measure_unit(name) if mf is not None else None
+    if unit is None and mf is not None:
+        try:
+            from .modelfile import compile_file
+            unit = compile_file(mf.path)[1].flat.variables[name].unit
+        except (KeyError, AcausalError, OSError):
+            unit = None
+    return 1.0, ("" if unit in (None, "1") else unit)
+
+
+def _residual(name, value, mf=None):
+    """'thrt +0.012 ms' for a measure (in its display unit), 'hook.phi rms
+    3.4e-04 rad over 40 samples' for a trace, the message for a failed prediction."""
     if name == "error":
         return f"{name} {value}"
     v = np.asarray(value, dtype=float)
+    factor, unit = _shown_unit(mf, name)
+    unit = f" {unit}" if unit else ""
     if v.ndim == 0:
-        return f"{name} {float(v):+.4g}"
-    return f"{name} rms {float(np.sqrt(np.mean(v ** 2))):.4g} over {v.size} samples"
+        return f"{name} {factor * float(v):+.4g}{unit}"
+    return (f"{name} rms {factor * float(np.sqrt(np.mean(v ** 2))):.4g}{unit} over "
+            f"{v.size} samples")
+
+
+def _condition_warnings(mf, ds):
+    """One line per experiment condition outside the range the model file
+    declares (``conditions``), with a hint when a unit would explain it."""
+    for name, (low, high, unit) in mf.conditions.items():
+        if low is None or high is None:
+            continue
+        margin = 0.1 * (high - low)
+        out = [(e.name, e.conditions[name]) for e in ds.experiments
+               if name in e.conditions and not low - margin <= e.conditions[name] <= high + margin]
+        if out:
+            vals = [v for _, v in out]
+            which = (f"{out[0][0]}: {name} = {vals[0]:.4g} {unit}" if len(out) == 1 else
+                     f"{len(out)} experiments ({out[0][0]} .. {out[-1][0]}): {name} = "
+                     f"{min(vals):.4g} .. {max(vals):.4g} {unit}")
+            _warn(f"{which} (in SI) outside the range {low:g}..{high:g} {unit} the model "
+                  "declares: check the values and the unit in the data's header")
+
+
+AT_BOUND = 1e-4     # of a range: a fitted value this close to a bound is at it
+
+
+def _calibration_warnings(mf, cm, ds, held, out):
+    """A fitted value at a bound of its range (the data push it beyond a
+    plausible value: a unit, a wrong measure), and a measured value far from
+    what the fitted model gives (other sign, or a factor 10 away)."""
+    for name, v in out.values.items():
+        lo, hi = mf.free.get(name, (None, None))
+        if lo is None:
+            try:
+                d = cm.params[cm.param_index(name)].decl
+                lo, hi = d.min, d.max
+            except (AcausalError, AttributeError):
+                continue
+        span = (hi - lo) if lo is not None and hi is not None else abs(v) or 1.0
+        for bound, which in ((lo, "lower"), (hi, "upper")):
+            if bound is not None and abs(v - bound) <= AT_BOUND * span:
+                ci = out.ci95.get(name)
+                _warn(f"{name} = {v:.6g} is at the {which} bound {bound:g} of its range"
+                      + (" (its 95 % interval is undefined)" if ci is not None and
+                         not all(math.isfinite(c) for c in ci) else "")
+                      + ": the data push it out of range; check the data's values and units")
+    residuals = {**(out.validation or {}), **out.residuals}
+    for e in list(ds.experiments) + list(getattr(held, "experiments", None) or []):
+        for k, r in residuals.get(e.name, {}).items():
+            measured = e.measures.get(k)
+            try:
+                r = np.asarray(r, dtype=float)
+            except (TypeError, ValueError):
+                continue
+            if measured is None or r.ndim != 0 or not math.isfinite(float(r)):
+                continue
+            sim = measured + float(r)
+            if measured and (not sim or (sim > 0) != (measured > 0) or
+                             not 0.1 <= abs(measured / sim) <= 10):
+                factor, unit = _shown_unit(mf, k)
+                _warn(f"{e.name}: measured {k} = {factor * measured:.4g} {unit} is far from "
+                      f"the fitted model's {factor * sim:.4g} {unit}: check its value, sign "
+                      "and unit")
 
 
 def _profile_line(prof):
@@ -492,6 +849,11 @@ def _sweep_units(mf, cm, params, measures):
     return units
 
 
+SWEEP_POINT_BYTES = 600     # a sweep point in the main process, per column (+ 400 bytes):
+                            # 1.1 kB measured for 1 parameter and 1 measure, x 1.5
+MAX_POINTS = 1_000_000      # the sweep's default work budget
+
+
 @main.command()
 @click.argument("file", type=click.Path(dir_okay=False))
 @click.option("--param", "params", multiple=True, required=True, metavar="NAME=A:B:N",
@@ -504,48 +866,231 @@ def _sweep_units(mf, cm, params, measures):
                    "(even a kill) resumes")
 @click.option("--plot", type=click.Path(dir_okay=False), help="plot the first measure")
 @click.option("--scheduler", help="Dask scheduler address (default: local processes)")
-@click.option("--workers", type=int, help="local worker processes (default: all cores)")
+@click.option("--workers", type=COUNT, help="local worker processes (default: all cores)")
+@click.option("--max-points", type=COUNT, default=MAX_POINTS, show_default=True,
+              help="most grid points: a larger grid is refused before anything runs")
+@click.option("--max-wall", type=POSITIVE, metavar="SECONDS",
+              help="stop after this wall time, keeping the finished points")
+@click.option("--max-memory", callback=_size, metavar="SIZE", help=MAX_MEMORY_HELP)
 @click.option("--no-progress", is_flag=True)
-def sweep(file, params, measures, out, plot, scheduler, workers, no_progress):
-    """Run a grid of simulations in parallel."""
+def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max_wall,
+          max_memory, no_progress):
+    """Run a grid of simulations in parallel. Budgets, checked before anything
+    runs: the grid's point count (--max-points) and its memory (points x
+    bytes per point, plus each worker's output rows: --max-memory); while it
+    runs: memory and wall time (--max-wall), which stop it like Ctrl-C,
+    keeping the finished points."""
     import functools
-    import os
 
+    from .budget import PROCESS_BYTES, Watchdog, check_estimate
+    from .budget import max_memory as memory_limit
     from .infra.checkpoint import source_files
-    from .infra.executor import open_executor, terminate_on_sigterm
+    from .infra.executor import default_workers, open_executor, terminate_on_sigterm
     from .modelfile import compile_file, sweep_task
     from .studies.sweep import grid, parse_param, plot_sweep, run_sweep
     measures = _csv_list(",".join(measures))
     try:
-        mf, cm = compile_file(file)
-        specs = [parse_param(p) for p in params]
-        for name, _ in specs:   # a parameter, or a fixed start value (mass.v)
-            if name in cm.split_overrides({name: 0.0})[0]:
-                cm.param_index(name)
-        for m in measures:
-            if m not in mf.measures:
-                raise click.BadParameter(f"--measure {m!r}: the model file defines "
-                                         f"{sorted(mf.measures) or 'no measures'}")
-        task = functools.partial(sweep_task, os.path.abspath(file))
-        units = _sweep_units(mf, cm, [name for name, _ in specs], measures)
-        with terminate_on_sigterm(), _resumable(out), open_executor(scheduler, workers) as ex:
-            rows = run_sweep(task, grid(specs), out, executor=ex, measures=measures,
-                             progress=not no_progress, inputs=source_files(file), units=units)
-        if plot:
-            plot_sweep(rows, specs[0][0], measures[0], plot)
+        with _quiet_warnings():
+            if not measures:
+                raise UsageError("--measure: no measure named (give --measure M1,M2)")
+            _check_output(out, "--out", create=True)
+            _check_output(plot, "--plot", plot=True, create=True)
+            specs = [parse_param(p, max_points) for p in params]
+            n_points = math.prod(len(v) for _, v in specs)
+            if n_points > max_points:
+                raise _budget_error(f"the grid has {n_points:,} points, more than the limit "
+                                    f"of {max_points:,} (--max-points): fewer values per "
+                                    "parameter, or raise --max-points")
+            limit = memory_limit(max_memory)
+            n_workers = workers or (default_workers() if scheduler is None else 1)
+            per_point = 400 + SWEEP_POINT_BYTES * (len(specs) + len(measures) + 3)
+            main_need = PROCESS_BYTES + n_points * per_point
+            check_estimate(main_need + n_workers * PROCESS_BYTES, limit,
+                           f"a sweep of {n_points:,} points on {n_workers} workers",
+                           "sweep fewer points")
+            per_worker = (limit - main_need) / max(n_workers, 1) - PROCESS_BYTES
+            mf, cm = compile_file(file)
+            _check_sweep_params(cm, specs)
+            for m in measures:
+                if m not in mf.measures:
+                    raise click.BadParameter(f"--measure {m!r}: the model file defines "
+                                             f"{sorted(mf.measures) or 'no measures'}")
+            task = functools.partial(sweep_task, os.path.abspath(file),
+                                     max_memory=max(per_worker, 50e6))
+            units = _sweep_units(mf, cm, [name for name, _ in specs], measures)
+            points = grid(specs)
+            with terminate_on_sigterm(), _resumable(out), \
+                    Watchdog(limit, max_wall, "the sweep"), \
+                    open_executor(scheduler, workers) as ex:
+                rows = run_sweep(task, points, out, executor=ex, measures=measures,
+                                 progress=not no_progress, inputs=source_files(file),
+                                 units=units, on_resume=_say_resumed("points"))
+            if plot:
+                fn = mf.measures[measures[0]]
+                y_unit, y_factor = units.get(measures[0]), 1.0
+                if getattr(fn, "display", None) and y_unit:
+                    y_factor, y_unit = fn.shown(1.0)
+                plot_sweep(rows, specs[0][0], measures[0], plot,
+                           x_unit=units.get(specs[0][0]), y_unit=y_unit, y_factor=y_factor)
     except (AcausalError, click.BadParameter) as exc:
         _fail(exc)
     failed = sum(1 for r in rows if r.get("status") != "ok")
     click.echo(f"{len(rows)} points, {failed} failed; results in {out}")
 
 
+@main.command()
+@click.argument("file", type=click.Path(dir_okay=False))
+@click.option("--spec", required=True, type=click.Path(dir_okay=False),
+              help="CSV of the toleranced parameters: name, normal|uniform, a, b, unit per "
+                   "line (normal: mean, std; uniform: low, high; b as p% is relative to a; "
+                   "a as 'nominal' is the model's value)")
+@click.option("-n", "n", type=COUNT, default=1024, show_default=True,
+              help="sets drawn (sobol: the base sample N, a power of 2; it runs N (d + 2) "
+                   "simulations for d parameters)")
+@click.option("--sampling", type=click.Choice(["lhs", "sobol"]), default="lhs", show_default=True,
+              help="Latin hypercube (variance shares: correlation ratios, regression) or "
+                   "Sobol' in Saltelli's design (first-order and total Sobol' indices)")
+@click.option("--seed", type=int, default=0, show_default=True, help="the sampling's seed")
+@click.option("--measure", "measures", multiple=True, metavar="M1,M2,...",
+              help="measures to study (default: every measure of the model file)")
+@click.option("--out", type=click.Path(dir_okay=False), default="tolerance.csv",
+              show_default=True, help="one row per set; finished chunks are checkpointed in "
+              "OUT.partial/, so running the same command again after a kill resumes")
+@click.option("--plot", "plot_prefix", metavar="PREFIX",
+              help="write PREFIX_<measure>_hist.png and PREFIX_<measure>_tornado.png")
+@click.option("--json", "json_path", type=click.Path(dir_okay=False),
+              help="write the summary as JSON")
+@click.option("--scheduler", help="Dask scheduler address (default: local processes)")
+@click.option("--workers", type=COUNT, help="local worker processes (default: all cores)")
+@click.option("--chunk", type=COUNT, default=64, show_default=True,
+              help="sets per task (each task is one batched run, journaled when it ends)")
+@click.option("--max-points", type=COUNT, default=MAX_POINTS, show_default=True,
+              help="most simulations: a larger study is refused before anything runs")
+@click.option("--max-wall", type=POSITIVE, metavar="SECONDS",
+              help="stop after this wall time, keeping the finished chunks")
+@click.option("--max-memory", callback=_size, metavar="SIZE", help=MAX_MEMORY_HELP)
+@click.option("--no-progress", is_flag=True)
+def tolerance(file, spec, n, sampling, seed, measures, out, plot_prefix, json_path, scheduler,
+              workers, chunk, max_points, max_wall, max_memory, no_progress):
+    """A tolerance (Monte-Carlo) study: how the measures spread when the
+    parameters spread as the spec says; their mean, standard deviation,
+    percentiles and each parameter's share of the variance. Budgets as
+    sweep's: the number of simulations (--max-points) and their memory are
+    checked before anything runs."""
+    from .budget import PROCESS_BYTES, Watchdog, check_estimate
+    from .budget import max_memory as memory_limit
+    from .infra.executor import default_workers, open_executor, terminate_on_sigterm
+    from .modelfile import compile_file, show_measure
+    from .studies import tolerance as tol
+    try:
+        with _quiet_warnings():
+            for path, option in ((out, "--out"), (json_path, "--json")):
+                _check_output(path, option, create=True)
+            if plot_prefix:
+                _check_output(plot_prefix + "_hist.png", "--plot", plot=True, create=True)
+            tol.check_n(n, sampling)
+            mf, cm = compile_file(file)
+            dists = tol.parse_spec(spec, cm)
+            measures = _csv_list(",".join(measures)) or list(mf.measures)
+            if not measures:
+                raise UsageError(f"{file}: the model file defines no measures to study")
+            for m in measures:
+                if m not in mf.measures:
+                    raise click.BadParameter(f"--measure {m!r}: the model file defines "
+                                             f"{sorted(mf.measures)}")
+            runs = n * (len(dists) + 2) if sampling == "sobol" else n
+            if runs > max_points:
+                raise _budget_error(f"the study needs {runs:,} simulations, more than the limit "
+                                    f"of {max_points:,} (--max-points): a smaller -n, or raise "
+                                    "--max-points")
+            limit = memory_limit(max_memory)
+            n_workers = workers or (default_workers() if scheduler is None else 1)
+            main_need = PROCESS_BYTES + runs * (400 + SWEEP_POINT_BYTES * (
+                len(dists) + len(measures) + 3))
+            check_estimate(main_need + n_workers * PROCESS_BYTES, limit,
+                           f"a tolerance study of {runs:,} simulations on {n_workers} workers",
+                           "draw fewer sets")
+            per_worker = (limit - main_need) / max(n_workers, 1) - PROCESS_BYTES
+            with terminate_on_sigterm(), _resumable(out + ".partial"), \
+                    Watchdog(limit, max_wall, "the tolerance study"), \
+                    open_executor(scheduler, workers) as ex:
+                res = tol.run_tolerance(os.path.abspath(file), dists, n, executor=ex,
+                                        measures=measures, sampling=sampling, seed=seed,
+                                        out_csv=out, chunk=chunk, progress=not no_progress,
+                                        max_memory=max(per_worker, 50e6), backend=None,
+                                        on_resume=_say_resumed("sets"))
+            display = {m: _display(mf, m) for m in measures}
+            if plot_prefix:
+                tol.plot_histograms(res, plot_prefix, display)
+                tol.plot_tornado(res, plot_prefix, display)
+            if json_path:
+                with open(json_path, "w", encoding="utf-8") as f:
+                    json.dump(tol.summary_json(res), f, indent=1)
+    except tol.SpecError as exc:                # one line per bad row of the spec
+        for line in exc.lines:
+            click.echo(f"acausal: error: {_one_line(line)}", err=True)
+        sys.exit(2)
+    except (AcausalError, click.BadParameter) as exc:
+        _fail(exc)
+    for line in tol.report_lines(res, lambda m, v: show_measure(mf, m, v)):
+        click.echo(line)
+    click.echo(f"results in {out} ({res.wall_s:.1f} s)")
+
+
+def _display(mf, name):
+    """(factor from SI, display unit) of a measure ((1, '') without a unit)."""
+    fn = mf.measures.get(name)
+    if getattr(fn, "unit", None):
+        return fn.shown(1.0)
+    return 1.0, mf.measure_unit(name) or ""
+
+
+def _budget_error(message):
+    from .errors import BudgetError
+    return BudgetError(message)
+
+
+def _check_sweep_params(cm, specs):
+    """Every swept name is a parameter or a fixed start value, and every
+    value of its range is within the parameter's bounds: checked before
+    the sweep runs (-1:1:3 for a speed that must be > 0 ran and failed
+    point by point)."""
+    for name, values in specs:
+        params, _ = cm.split_overrides({name: 0.0})
+        if name not in params:
+            continue                      # a fixed start value: no bounds
+        e = cm.params[cm.param_index(name)]
+        lo, hi = float(np.min(values)), float(np.max(values))
+        for v in (lo, hi):
+            try:
+                e.decl.check_bounds(v, name)
+            except AcausalError as exc:
+                raise UsageError(f"--param {name}={lo:g}..{hi:g}: {exc}", variable=name
+                                 ) from None
+
+
+def _say_resumed(what):
+    """The line a resumed command prints: 'resumed: 4,141 of 10,000 points already done'."""
+    def say(done, total):
+        click.echo(f"acausal: resumed: {done:,} of {total:,} {what} already done", err=True)
+    return say
+
+
 @contextlib.contextmanager
 def _resumable(where):
     """An interruption (Ctrl-C, SIGTERM) ends with one line saying where the
     finished work is, and exit code 130."""
+    from .budget import tripped
+    from .infra.executor import exit_soon
     try:
         yield
     except KeyboardInterrupt:
+        exit_soon(130)
+        why = tripped()
+        if why:
+            click.echo(f"acausal: error: stopped: {why}; finished work is saved in {where}: "
+                       "run the same command again to resume", err=True)
+            sys.exit(3)
         click.echo(f"acausal: interrupted; finished work is saved in {where}: run the same "
                    "command again to resume", err=True)
         sys.exit(130)
@@ -566,11 +1111,14 @@ def _csv_list(text):
                                       "they finish, so running the same command again after an "
                                       "interruption (even a kill) resumes")
 @click.option("--scheduler", help="Dask scheduler address (default: local processes)")
-@click.option("--workers", type=int, help="local worker processes (default: all cores)")
+@click.option("--workers", type=COUNT, help="local worker processes (default: all cores)")
+@click.option("--max-wall", type=POSITIVE, metavar="SECONDS",
+              help="stop after this wall time, keeping the finished fits")
+@click.option("--max-memory", callback=_size, metavar="SIZE", help=MAX_MEMORY_HELP)
 @click.option("--hypotheses", metavar="ID,ID,...", help="only these hypotheses")
 @click.option("--locations", metavar="PATH,PATH,...",
               help="only these locations (a path or a prefix of paths)")
-@click.option("--alpha", type=float, default=0.01, show_default=True,
+@click.option("--alpha", type=FRACTION, default=0.01, show_default=True,
               help="family significance level of the discrepancy decision")
 @click.option("--starts", type=click.IntRange(0, 64), default=4, show_default=True,
               help="Latin-hypercube starts per fit (besides the neutral and calibrated ones)")
@@ -578,27 +1126,41 @@ def _csv_list(text):
               help="best starts refined per fit (their agreement is reported)")
 @click.option("--no-progress", is_flag=True)
 @click.option("--library", hidden=True, help="module standing in for the hypothesis library")
-def diagnose(file, data, json_path, report_dir, scheduler, workers, hypotheses, locations,
-             alpha, starts, refine, no_progress, library):
+def diagnose(file, data, json_path, report_dir, scheduler, workers, max_wall, max_memory,
+             hypotheses, locations, alpha, starts, refine, no_progress, library):
     """Show what a model gets wrong against measured data, name the cause,
-    extend the model and measure the gain."""
+    extend the model and measure the gain. A long trace is thinned to what
+    its instrument floor supports (said on stderr); past --max-memory or
+    --max-wall, or at Ctrl-C or SIGTERM, it stops keeping its finished fits."""
+    from .budget import PROCESS_BYTES, Watchdog, check_estimate
+    from .budget import max_memory as memory_limit
     from .diagnose.problem import FitSettings
     from .diagnose.run import diagnose as run_diagnosis
-    from .infra.executor import terminate_on_sigterm
+    from .infra.executor import default_workers, terminate_on_sigterm
     try:
-        if not 0 < alpha < 1:
-            raise click.BadParameter(f"--alpha {alpha}: must be between 0 and 1")
-        with terminate_on_sigterm(), _resumable(f"{report_dir}/checkpoint"):
-            out = run_diagnosis(file, data, out_dir=report_dir, scheduler=scheduler,
-                                workers=workers, progress=not no_progress,
-                                hypotheses=_csv_list(hypotheses),
-                                locations=_csv_list(locations), alpha=alpha, library=library,
-                                settings=FitSettings(lhs=starts, refine=refine))
+        with _quiet_warnings():
+            _check_output(json_path, "--json")
+            _check_output(os.path.join(report_dir, "report.md"), "--report", create=True)
+            limit = memory_limit(max_memory)
+            n_workers = workers or (default_workers() if scheduler is None else 1)
+            check_estimate((n_workers + 1) * PROCESS_BYTES, limit,
+                           f"a diagnosis on {n_workers} workers", "use fewer --workers")
+            with terminate_on_sigterm(), _resumable(f"{report_dir}/checkpoint"), \
+                    Watchdog(limit, max_wall, "the diagnosis"):
+                out = run_diagnosis(file, data, out_dir=report_dir, scheduler=scheduler,
+                                    workers=workers, progress=not no_progress,
+                                    hypotheses=_csv_list(hypotheses),
+                                    locations=_csv_list(locations), alpha=alpha,
+                                    library=library,
+                                    settings=FitSettings(lhs=starts, refine=refine),
+                                    on_resume=lambda n, path: click.echo(
+                                        f"acausal: resumed: {n:,} fits already done "
+                                        f"(from {path})", err=True))
+            if json_path:
+                with open(json_path, "w") as f:
+                    json.dump(out, f, indent=1)
     except (AcausalError, click.BadParameter) as exc:
         _fail(exc)
-    if json_path:
-        with open(json_path, "w") as f:
-            json.dump(out, f, indent=1)
     g = out["gain"]
     if not out["discrepancy"]:
         click.echo("no significant discrepancy between the calibrated model and the data")

@@ -18,6 +18,10 @@ Hierarchy::
       DiagnosisError                  a diagnosis cannot be carried out
       SolverError                     the integrator failed (t, component, result)
         ChatteringError               too many events in a tiny window
+        LimitError                    a limit stopped the run (the partial result kept)
+          Interrupted                 Ctrl-C, SIGTERM or a watchdog stopped the run
+      UsageError                      an option or argument that cannot be used
+        BudgetError                   the work asked for exceeds a budget (before it starts)
 """
 import re
 
@@ -120,6 +124,11 @@ class LimitError(SolverError):
     ``component`` names the component whose events dominated."""
 
 
+class Interrupted(LimitError):
+    """The run was interrupted (Ctrl-C, SIGTERM, a memory or wall-time
+    watchdog); ``result`` holds what was computed up to ``t``."""
+
+
 class ModelFileError(ModelError):
     """A model file could not be loaded; the message names file and line."""
 
@@ -154,6 +163,17 @@ class AnalysisError(AcausalError):
 class UsageError(AcausalError):
     """An option or argument that cannot be used as given (a malformed
     ``--param`` spec, ``workers=0``, a missing optional package, ...)."""
+
+
+class BudgetError(UsageError):
+    """The work asked for exceeds a budget before anything runs (memory
+    estimated as points x rows, a count of points or rows): a usage error."""
+
+
+class OutputGridError(BudgetError, LimitError):
+    """An output grid of more rows than ``max_rows`` (or than the memory
+    limit holds), refused before the run: a usage error, and a LimitError
+    as it always was for callers that catch one."""
 
 
 class UnknownNameError(AcausalError, KeyError):

@@ -12,7 +12,9 @@ of parameter -> (low, high) or (low, high, unit), their ranges, which
 names (a dataset must give at least one of them), ``free_parameters``, a
 dict of parameter -> (low, high) that calibration and diagnosis may fit,
 and ``plot(result, path)``. A model file can import
-another one (``from breaker_24kv import build``): its folder is on the path.
+another one (``from breaker_24kv import build``): its folder, ``$ACAUSAL_MODEL_PATH``,
+the current folder's ``models/`` and the bundled ``models/`` are on the path
+(:func:`model_path`).
 """
 import math
 import os
@@ -71,7 +73,11 @@ def _run(path):
         raise _error(path, _line(exc, path), str(exc)) from None
     except Exception as exc:  # a bug in the script: say where
         line = _line(exc, path) or _bad_byte_line(path)
-        raise _error(path, line, f"{type(exc).__name__}: {exc}") from None
+        hint = ""
+        if isinstance(exc, ModuleNotFoundError):
+            hint = (" (a model file's imports are searched in " + ", ".join(model_path(path))
+                    + " and ACAUSAL_MODEL_PATH)")
+        raise _error(path, line, f"{type(exc).__name__}: {exc}{hint}") from None
 
 
 def _bad_byte_line(path):
@@ -90,20 +96,39 @@ def _bad_byte_line(path):
     return data.count(b"\n", 0, bad) + 1 if bad >= 0 else None
 
 
+def model_path(path):
+    """The folders a model file's imports are searched in, first to last:
+    its own folder, the folders of ``$ACAUSAL_MODEL_PATH`` (separated like
+    PATH), the current folder's ``models/``, and the ``models/`` folder
+    beside the acausal package (its bundled models). So a variant written
+    anywhere imports its base (``from breaker_24kv import build``) without
+    PYTHONPATH=models."""
+    here = os.path.dirname(os.path.abspath(path))
+    env = [p for p in os.environ.get("ACAUSAL_MODEL_PATH", "").split(os.pathsep) if p]
+    bundled = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                           "models")
+    out = []
+    for folder in [here, *env, os.path.join(os.getcwd(), "models"), bundled]:
+        folder = os.path.abspath(folder)
+        if os.path.isdir(folder) and folder not in out:
+            out.append(folder)
+    return out
+
+
 def load_model_file(path):
-    """Run a model file and collect ``model``, ``experiment`` and ``measures``."""
+    """Run a model file and collect ``model``, ``experiment`` and ``measures``
+    (its imports searched in :func:`model_path`)."""
     path = os.path.abspath(path)
     if not os.path.isfile(path):
         raise ModelFileError(f"{path}: no such model file", file=path)
-    folder = os.path.dirname(path)
-    added = folder not in sys.path
-    if added:
-        sys.path.insert(0, folder)
+    added = [f for f in model_path(path) if f not in sys.path]
+    sys.path[0:0] = added
     try:
         ns = _run(path)
     finally:
-        if added:
-            sys.path.remove(folder)
+        for f in added:
+            if f in sys.path:
+                sys.path.remove(f)
     return _collect(ns, path)
 
 
@@ -310,12 +335,16 @@ def run_file(path, params=None, **overrides):
     return res, evaluate_measures(mf, res)
 
 
-def sweep_task(path, point):
+def sweep_task(path, point, max_memory=None):
     """One sweep point: the model file compiled once per worker process
     (the compile cache is per process), simulated with ``point`` as
     parameter overrides; returns the measures (NaN for one that cannot be
-    computed, with its reason in ``"__missing__"``). Module-level, so picklable."""
+    computed, with its reason in ``"__missing__"``). ``max_memory``: the
+    bytes this worker's run may store (:func:`acausal.runtime.hybrid.simulate`).
+    Module-level, so picklable."""
     mf, cm = compile_file(path)
     opts = mf.experiment.run_options()
+    if max_memory is not None:
+        opts["max_memory"] = max_memory
     values, missing = measure_values(mf, cm.simulate(params=point, **opts))
     return {**values, "__missing__": missing}

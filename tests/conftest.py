@@ -59,3 +59,14 @@ def pytest_terminal_summary(terminalreporter, config):
             terminalreporter.write_line(line)
     terminalreporter.write_sep("-", "versions")
     terminalreporter.write_line(", ".join(_versions()))
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _commands_share_this_process():
+    """Commands run in-process by CliRunner share the process with pytest:
+    an interrupted one must not arm acausal.executor.exit_soon, which would
+    end the whole test run (the tests that need it run the command in a
+    subprocess)."""
+    import acausal.infra.executor as ex
+    ex.EXIT_SOON = False
+    yield

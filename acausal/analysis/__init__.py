@@ -8,6 +8,6 @@ iteration, a simulated state, the re-initialisation of the algebraic
 unknowns). :mod:`acausal.cli` and :mod:`acausal.studies` may import it; it
 imports neither.
 """
-from .linearize import Equilibrium, Linearization, linearize, trim
+from .linearize import Equilibrium, Linearization, RunSettings, linearize, trim
 
-__all__ = ["linearize", "trim", "Linearization", "Equilibrium"]
+__all__ = ["linearize", "trim", "Linearization", "Equilibrium", "RunSettings"]

@@ -83,6 +83,21 @@ _memo = weakref.WeakKeyDictionary()     # compiled model -> {what: made once per
 # operating points
 # ---------------------------------------------------------------------------
 
+@dataclass(frozen=True)
+class RunSettings:
+    """How the operating point is computed: the integrator ``backend``
+    (None: the default) and the tolerances of a simulation to a time
+    (``rtol``, ``atol``); ``tol`` and ``max_iter``: the equilibrium search's
+    residual tolerance (relative to each equation's terms) and its limit of
+    evaluations."""
+
+    backend: str | None = None
+    rtol: float = 1e-8
+    atol: float = 1e-10
+    tol: float = 1e-10
+    max_iter: int = 100
+
+
 @dataclass
 class _Point:
     """A consistent point of the DAE: time, unknowns, derivatives, modes,
@@ -218,16 +233,17 @@ def _residual_check(cm, pt, what):
                             component=getattr(origin, "origin", None))
 
 
-def _point(cm, at, params, t, backend, rtol, atol):
+def _point(cm, at, params, t, run):
     """The consistent :class:`_Point` that ``at`` describes (see :func:`linearize`)."""
     from ..runtime.result import Result
+    backend = run.backend
     t0 = 0.0 if t is None else float(t)
     if isinstance(at, Equilibrium):
         if at.model is not cm:
             raise AnalysisError("at: the equilibrium is of another compiled model")
         return at._pt
     if isinstance(at, str) and at == "equilibrium":
-        return trim(cm, params=params, t=t0, backend=backend)._pt
+        return trim(cm, params=params, t=t0, run=run)._pt
     if isinstance(at, Result):
         if at.model is not cm:
             raise AnalysisError("at: the result is of another compiled model")
@@ -241,8 +257,8 @@ def _point(cm, at, params, t, backend, rtol, atol):
     if at is None or (isinstance(at, str) and at == "start"):
         return _start(cm, params, t0, backend)
     if isinstance(at, (int, float)) and not isinstance(at, bool):
-        res = cm.simulate(t_end=float(at), params=params, output_step=0, rtol=rtol, atol=atol,
-                          backend=backend)
+        res = cm.simulate(t_end=float(at), params=params, output_step=0, rtol=run.rtol,
+                          atol=run.atol, backend=backend)
         if res.t[-1] < float(at) * (1 - 1e-12) - 1e-12:
             raise AnalysisError(f"at = {at:g} s: the run stopped at t = {res.t[-1]:g} s "
                                 f"({[n for _, n in res.events][-1:] or 'no event'})")
@@ -519,8 +535,8 @@ class Linearization:
         return "\n".join(out)
 
 
-def linearize(cm, at=None, inputs=(), outputs=(), *, params=None, t=None, backend=None,
-              rtol=1e-8, atol=1e-10):
+def linearize(cm, at=None, inputs=(), outputs=(), *, params=None, t=None,
+              run: RunSettings = RunSettings()):
     """The linearisation of compiled model ``cm`` (module docstring):
     a :class:`Linearization` with ``A``, ``B``, ``C``, ``D`` as numpy arrays
     (``.to_statespace()``: python-control's ``StateSpace``).
@@ -542,7 +558,7 @@ def linearize(cm, at=None, inputs=(), outputs=(), *, params=None, t=None, backen
     ``inputs``: names of free parameters (a list, or a dict giving their
     values at the point); ``outputs``: names of variables (default: the
     states, ``C = I``). ``params``: other parameter and fixed-start
-    overrides. ``rtol``, ``atol``, ``backend``: of the simulation to ``at``.
+    overrides. ``run``: :class:`RunSettings` of the simulation to ``at``.
     Discrete modes are the point's (held fixed)."""
     from ..runtime.result import Result
     ins, in_values = _inputs(cm, inputs)
@@ -552,7 +568,7 @@ def linearize(cm, at=None, inputs=(), outputs=(), *, params=None, t=None, backen
                             f"{type(at).__name__.lower()} given as at; name the inputs "
                             "without values and give no params")
     params = _input_params(cm, ins, in_values, params or {})
-    pt = _point(cm, at, params, t, backend, rtol, atol)
+    pt = _point(cm, at, params, t, run)
     return _linearize_at(cm, pt, ins, out_names)
 
 
@@ -624,7 +640,7 @@ def _solve(cm, E, rhs, pt):
 # ---------------------------------------------------------------------------
 
 def trim(cm, inputs=None, *, hold=None, free=(), start=None, params=None, t=0.0,
-         backend=None, tol=1e-10, max_iter=100):
+         run: RunSettings = RunSettings()):
     """The static equilibrium of ``cm`` (module docstring): a consistent
     point with every state's derivative zero, under the loads of the model
     and the fixed ``inputs`` (dict name -> value, free parameters).
@@ -644,7 +660,8 @@ def trim(cm, inputs=None, *, hold=None, free=(), start=None, params=None, t=0.0,
     if both:
         raise AnalysisError(f"trim: {sorted(both)[0]} is both a fixed input and a free one")
     params = _input_params(cm, ins, in_values, params or {})
-    pt = _start(cm, params, float(t), backend)
+    pt = _start(cm, params, float(t), run.backend)
+    tol, max_iter = run.tol, run.max_iter
     dae = cm.dae
     n, ns = len(dae.y), dae.n_states
     y = np.array(pt.y, dtype=float)

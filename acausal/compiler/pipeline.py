@@ -525,23 +525,6 @@ def _alias_starts(flat, red):
     return out, via
 
 
-def _nothing_to_integrate(flat):
-    """Why a model leaves the solver no unknown: its bodies' motion is
-    prescribed (a mass tied to a wall), or it has no dynamic element."""
-    moving = sorted({base_and_order(s)[0].name for eq in flat.equations
-                     for s in sp.sympify(eq.expr).free_symbols if base_and_order(s)[1] > 0})
-    if moving:
-        shown = ", ".join(moving[:4]) + (" ..." if len(moving) > 4 else "")
-        return ("the model leaves nothing to integrate: the motion of every body is "
-                f"prescribed ({shown} follow from the constraints alone, e.g. a mass "
-                "connected directly to a fixed support or to a prescribed motion cannot "
-                "move); join such a body to its support through a spring or a damper, or "
-                "remove the body")
-    return ("the model leaves nothing to integrate: it has no dynamic element (every "
-            "variable is given explicitly by constants or prescribed motion); add a mass, "
-            "an inertia or a damper between moving parts")
-
-
 def _is_zero(v):
     try:
         return float(v) == 0.0

@@ -9,7 +9,7 @@ from typing import Iterable, Mapping, Optional, Union
 import numpy as np
 
 from .records import DataError, Dataset, Experiment, Instrument, Trace
-from .table import Table, number, read_table
+from .table import Table, number, read_numeric_table, read_table
 from .units import converter
 
 EXPERIMENTS = "experiments.csv"
@@ -114,10 +114,11 @@ def _row(columns, values, i: int, role: str) -> dict[str, float]:
 
 
 def _read_trace(path: Path, variables) -> Trace:
-    """A trace file: ``time`` strictly increasing, signals in SI."""
-    table = read_table(path)
+    """A trace file: ``time`` strictly increasing, signals in SI (a large
+    file through numpy's reader: :func:`.table.read_numeric_table`)."""
+    table, values = read_numeric_table(path)
     table.column("time")
-    if not table.rows:
+    if not len(values):
         raise DataError("no samples", path, table.header_line)
     converters = []
     for k, name in enumerate(table.names):
@@ -127,14 +128,13 @@ def _read_trace(path: Path, variables) -> Trace:
         expected = "s" if name == "time" else (variables or {}).get(name)
         converters.append(converter(table.units[k], expected, table.header(k),
                                     name, where))
-    data = {n: c(table.numbers(k, True)) for k, (n, c) in
-            enumerate(zip(table.names, converters))}
+    data = {n: c(values[:, k]) for k, (n, c) in enumerate(zip(table.names, converters))}
     time = data.pop("time")
     bad = np.flatnonzero(np.diff(time) <= 0)
     if bad.size:
         i = bad[0] + 1
         raise DataError(f"time does not increase ({time[i]:g} s after "
-                        f"{time[i - 1]:g} s)", path, table.rows[i][0], "time")
+                        f"{time[i - 1]:g} s)", path, table.line_of(i), "time")
     return Trace(time, data, path)
 
 

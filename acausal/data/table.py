@@ -39,6 +39,21 @@ class Table:
         unit = self.units[k]
         return self.names[k] if unit is None else f"{self.names[k]} [{unit}]"
 
+    def line_of(self, i: int) -> Optional[int]:
+        """The file line of data row ``i`` (a table read by
+        :func:`read_numeric_table` keeps no rows: the file is scanned)."""
+        if self.rows:
+            return self.rows[i][0]
+        seen = -1
+        with open(self.file, encoding="utf-8-sig", errors="replace") as f:
+            for line, raw in enumerate(f, start=1):
+                if line <= self.header_line or not raw.strip() or raw.lstrip().startswith("#"):
+                    continue
+                seen += 1
+                if seen == i:
+                    return line
+        return None
+
     def numbers(self, k: int, required: bool) -> np.ndarray:
         """Column ``k`` as floats, NaN for empty cells (error if ``required``)."""
         out = np.empty(len(self.rows))
@@ -131,3 +146,162 @@ def read_table(path: Path) -> Table:
                             f"has {len(names)}",
                             path, row_line, column)
     return Table(path, line, names, units, rows)
+
+
+FAST_MIN_BYTES = 2_000_000   # files larger than this are parsed by pandas (or numpy) in C
+CHUNK_LINES = 200_000        # lines per chunk (a progress-bar step; a failed chunk is re-read exactly)
+PROGRESS_MIN_BYTES = 20_000_000   # a file this large shows a progress bar on stderr
+
+
+def read_numeric_table(path: Path, progress: bool = True) -> tuple[Table, np.ndarray]:
+    """A table whose every cell is a required finite number (a trace), as
+    (Table without its rows, values: rows x columns). Small files go
+    through :func:`read_table`; larger ones are parsed in chunks by
+    pandas' C parser (:func:`_read_pandas`), else numpy's (a 5 M-row,
+    120 MB trace: 47-128 s and 2.3 GB through the exact reader, 10 s and
+    0.36 GB with numpy, 2 s of parsing with pandas), with a progress bar on
+    stderr above ``PROGRESS_MIN_BYTES``. Every error is located as by the
+    exact reader: a file pandas finds irregular goes to numpy, and a chunk
+    that numpy cannot read, or that holds a non-finite value, is read again
+    line by line."""
+    path = Path(path)
+    if not path.is_file() or path.stat().st_size < FAST_MIN_BYTES:
+        table = read_table(path)
+        values = np.column_stack([table.numbers(k, True) for k in range(len(table.names))]) \
+            if table.rows else np.zeros((0, len(table.names)))
+        return table, values
+    head = _text_head(path)
+    rows = _rows(path, head)
+    if not rows:
+        raise DataError("no header row (empty file)", path)
+    header_line, header = rows[0]
+    names, units = _header(path, header_line, header)
+    table = Table(path, header_line, names, units, [])
+    size = path.stat().st_size
+    bar = None
+    if progress and size >= PROGRESS_MIN_BYTES:
+        import sys
+
+        from tqdm import tqdm
+        bar = tqdm(total=size, unit="B", unit_scale=True, desc=f"reading {path.name}",
+                   file=sys.stderr, leave=False, delay=0.5)
+    try:
+        values = _read_pandas(path, header_line, len(names), bar)
+        if values is not None:
+            return table, values
+        blocks = []
+        if bar is not None:
+            bar.reset()
+        with open(path, "rb") as f:
+            line_no = 0
+            while True:
+                raw = f.readlines(CHUNK_LINES * 24)
+                if not raw:
+                    break
+                first = line_no + 1
+                line_no += len(raw)
+                if bar is not None:
+                    bar.update(sum(len(r) for r in raw))
+                lines = _decode(path, raw, first)
+                if first <= header_line:        # the header and what precedes it
+                    lines = [ln if k + first > header_line else "#"
+                             for k, ln in enumerate(lines)]
+                blocks.append(_chunk(path, lines, first, names))
+    finally:
+        if bar is not None:
+            bar.close()
+    values = np.concatenate(blocks) if blocks else np.zeros((0, len(names)))
+    return table, values
+
+
+PANDAS_CHUNK = 1_000_000   # rows per pandas chunk (a progress-bar step)
+
+
+def _read_pandas(path: Path, header_line: int, width: int, bar) -> Optional[np.ndarray]:
+    """The body after the header line read by pandas' C parser (3.3x
+    faster than numpy's loadtxt on a 5 M-row trace: 1.9 against 6.2 s), or
+    None when pandas is missing or finds anything irregular (a cell that is
+    not a finite number, a ragged row, bytes that are not UTF-8): the
+    exact reader then says where."""
+    try:
+        import pandas as pd
+    except ImportError:
+        return None
+    blocks = []
+    try:
+        with open(path, "rb") as f:
+            reader = pd.read_csv(f, header=None, names=list(range(width)), skiprows=header_line,
+                                 comment="#", dtype=float, engine="c", encoding="utf-8",
+                                 skip_blank_lines=True, chunksize=PANDAS_CHUNK,
+                                 skipinitialspace=True)
+            for chunk in reader:
+                blocks.append(chunk.to_numpy(dtype=float))
+                if bar is not None:
+                    bar.update(max(f.tell() - bar.n, 0))
+    except (ValueError, UnicodeDecodeError, pd.errors.ParserError, OverflowError):
+        return None
+    values = np.concatenate(blocks) if blocks else np.zeros((0, width))
+    if values.ndim != 2 or values.shape[1] != width or not np.all(np.isfinite(values)):
+        return None
+    return values
+
+
+def _text_head(path: Path, limit: int = 1 << 16) -> str:
+    """The first bytes of a file as text, up to a whole line (for its header)."""
+    with open(path, "rb") as f:
+        data = f.read(limit)
+    if data[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        raise DataError("the file is UTF-16 (save it as UTF-8)", path, 1)
+    cut = data.rfind(b"\n")
+    data = data[:cut + 1] if cut >= 0 else data
+    return _decode(path, [data], 1)[0]
+
+
+def _decode(path: Path, raw: list, first: int) -> list:
+    """Lines as text; a DataError at the first byte that is not UTF-8 or is NUL."""
+    out = []
+    for k, b in enumerate(raw):
+        if k == 0 and first == 1 and b.startswith(b"\xef\xbb\xbf"):
+            b = b[3:]
+        try:
+            text = b.decode("utf-8")
+        except UnicodeDecodeError as exc:
+            line = first + k + b.count(b"\n", 0, exc.start)
+            col = exc.start - (b.rfind(b"\n", 0, exc.start) + 1) + 1
+            raise DataError(f"byte 0x{b[exc.start]:02x} (byte {col} of the line) is "
+                            "not UTF-8 (save the file as UTF-8)", path, line) from None
+        if "\0" in text:
+            raise DataError("NUL byte (not a text file?)", path,
+                            first + k + text.count("\n", 0, text.index("\0")))
+        out.append(text)
+    return out
+
+
+def _chunk(path: Path, lines: list, first: int, names: list) -> np.ndarray:
+    """The numbers of ``lines`` (file lines from ``first``), read by numpy;
+    on any doubt, line by line, so that the error names its line and column."""
+    try:
+        with np.errstate(all="ignore"):
+            values = np.loadtxt(lines, delimiter=",", comments="#", ndmin=2, dtype=float)
+        if values.size == 0:
+            values = values.reshape(0, len(names))
+        if values.shape[1] == len(names) and np.all(np.isfinite(values)):
+            return values
+    except ValueError:
+        pass
+    out = []
+    for k, raw in enumerate(lines):
+        line = first + k
+        if not raw.strip() or raw.lstrip().startswith("#"):
+            continue
+        try:
+            cells = next(csv.reader([raw], strict=True))
+        except csv.Error as exc:
+            raise DataError(f"cannot read the row as CSV: {exc}", path, line) from None
+        cells = [c.strip() for c in cells]
+        if len(cells) != len(names):
+            column = names[len(cells)] if len(cells) < len(names) else None
+            raise DataError(f"row has {len(cells)} cell{'s' * (len(cells) != 1)}, header "
+                            f"has {len(names)}", path, line, column)
+        out.append([number(c, True, (path, line, n)) for c, n in zip(cells, names)])
+    return np.array(out, dtype=float).reshape(len(out), len(names))

@@ -204,14 +204,15 @@ def tube_bounds(t_ref, y_ref, t, dt, dy):
 
 
 def tube_compare(t_ref, y_ref, t_test, y_test, tol=1e-3, *, nominal=1e-3,
-                 dt_abs=None, dy_abs=None, require_coverage=True):
+                 absolute=None, require_coverage=True):
     """Compare a test signal with a reference by csv-compare's tube.
 
     ``t_ref``, ``y_ref``: the reference (time non-decreasing; an event is two
     points at one time). ``t_test``, ``y_test``: the signal to check (the
     same). ``tol``: the tube's relative size in time and in value (see the
-    module's docstring); ``nominal``: the least value base; ``dt_abs`` /
-    ``dy_abs``: absolute half-width / half-height instead.
+    module's docstring); ``nominal``: the least value base; ``absolute``:
+    ``(dt, dy)``, an absolute half-width / half-height instead (either may be
+    None).
     ``require_coverage``: fail when the test's time span falls short of the
     reference's by more than ``dt`` at either end.
 
@@ -219,6 +220,7 @@ def tube_compare(t_ref, y_ref, t_test, y_test, tol=1e-3, *, nominal=1e-3,
     """
     tr, yr = _as_curve(t_ref, y_ref, "reference")
     tt, yt = _as_curve(t_test, y_test, "test")
+    dt_abs, dy_abs = absolute if absolute is not None else (None, None)
     dt, dy = tube_size(tr, yr, tol, nominal=nominal, dt_abs=dt_abs, dy_abs=dy_abs)
     inside_span = (tt >= tr[0]) & (tt <= tr[-1])
     n_outside = int(np.count_nonzero(~inside_span))

@@ -134,7 +134,7 @@ def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
              progress=True, hypotheses=None, locations=None, alpha=st.ALPHA,
              exact_cv=True, library=None, plots=True, max_nfev=60, settings=None,
              collect=None, generic=True, pairs=True, families=True, profile=True,
-             design=True) -> dict:
+             design=True, on_resume=None) -> dict:
     """Diagnose ``model_path`` against the dataset folder ``data_folder``.
 
     Writes ``report.md``, ``diagnosis.json``, ``candidates.json``, plots and
@@ -145,7 +145,9 @@ def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
     nominal and best models without each experiment (else the linearised
     leave-one-out); ``library`` names a module standing in for
     :mod:`acausal.diagnose.hypotheses`; ``settings`` a
-    :class:`~.problem.FitSettings` (``max_nfev`` kept for compatibility).
+    :class:`~.problem.FitSettings` (``max_nfev`` kept for compatibility);
+    ``on_resume(n, path)`` is called when ``n`` fits of an interrupted run
+    of the same command are found in its checkpoint ``path``.
     """
     settings = settings or FitSettings(max_nfev=max_nfev)
     store = None
@@ -154,6 +156,8 @@ def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
             hypotheses=hypotheses, locations=locations, alpha=alpha, exact_cv=exact_cv,
             library=library, settings=repr(settings), generic=generic, pairs=pairs,
             families=families))
+        if store.saved and on_resume is not None:
+            on_resume(len(store.saved), store.checkpoint.path)
     d = run_stages(model_path, data_folder, out_dir=out_dir, scheduler=scheduler,
                    workers=workers, progress=progress, hypotheses=hypotheses,
                    locations=locations, alpha=alpha, exact_cv=exact_cv, library=library,

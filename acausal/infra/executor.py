@@ -192,6 +192,24 @@ class Executor:
             return iter(distributed.as_completed(futures))
         return cf.as_completed(futures)
 
+    def wait_any(self, futures: Iterable) -> list:
+        """Block until at least one of ``futures`` is done; return the done
+        ones (serial: runs the first not yet run)."""
+        futures = list(futures)
+        if self.kind == "serial":
+            for fut in futures:
+                if isinstance(fut, _DeferredFuture) and not fut.done():
+                    fut.run()
+                    break
+            return [f for f in futures if f.done()]
+        if self.kind == "dask":
+            import distributed
+
+            done, _ = distributed.wait(futures, return_when="FIRST_COMPLETED")
+            return list(done)
+        done, _ = cf.wait(futures, return_when=cf.FIRST_COMPLETED)
+        return list(done)
+
     @staticmethod
     def _serial_as_completed(futures: list) -> Iterator:
         for fut in futures:
@@ -255,6 +273,16 @@ def _die_with_parent(parent: int) -> None:
     parent (an orphan is re-parented) and ends the worker if not. So a
     sweep or diagnosis killed by SIGKILL leaves no worker computing on.
     """
+    # The command's process handles the interruption: a worker ignores
+    # Ctrl-C (the terminal sends it to the whole process group) and ends at
+    # once, quietly, on SIGTERM (the parent's handler, inherited through
+    # fork, printed two worker tracebacks on a killed sweep)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    import warnings
+    warnings.simplefilter("ignore")   # numpy/scipy warnings: not a wall on the terminal
+    if hasattr(signal, "SIGHUP"):
+        signal.signal(signal.SIGHUP, signal.SIG_DFL)
     if sys.platform.startswith("linux"):
         try:
             libc = ctypes.CDLL(None, use_errno=True)
@@ -318,13 +346,50 @@ def terminate_on_sigterm():
         return
 
     def handler(signum, frame):
+        exit_soon()   # whatever the unwinding meets, the process ends
         raise KeyboardInterrupt(f"terminated by signal {signum}")
 
-    old = signal.signal(signal.SIGTERM, handler)
+    names = [n for n in ("SIGTERM", "SIGHUP") if hasattr(signal, n)]
+    old = {n: signal.signal(getattr(signal, n), handler) for n in names}
     try:
         yield
     finally:
-        signal.signal(signal.SIGTERM, old)
+        for n, h in old.items():
+            signal.signal(getattr(signal, n), h)
+
+
+EXIT_GRACE_S = 20.0   # an interrupted command has this long to save its work and end
+EXIT_SOON = True      # False where commands run inside another program (the tests' CliRunner)
+
+
+def exit_soon(code: int = 130, grace: float = EXIT_GRACE_S) -> None:
+    """After an interruption: end this process ``grace`` seconds from now
+    if it has not ended by then (a cleanup that blocks, an interpreter
+    shutdown joining a stuck thread, a C call that does not return), with
+    ``code``; its pool workers follow it (:func:`_die_with_parent`). A
+    later call can only bring the deadline closer. (A diagnosis stopped by
+    SIGTERM printed 'interrupted' and went on computing.)"""
+    if not EXIT_SOON:
+        return
+    deadline = time.monotonic() + grace
+    if _EXITING["deadline"] is not None:
+        _EXITING["deadline"] = min(_EXITING["deadline"], deadline)
+        return
+    _EXITING["deadline"], _EXITING["code"] = deadline, code
+
+    def later():
+        while time.monotonic() < _EXITING["deadline"]:
+            time.sleep(0.05)
+        try:
+            sys.stderr.write(f"acausal: the command did not end within {grace:g} s of its "
+                             "interruption: ended\n")
+            sys.stderr.flush()
+        finally:
+            os._exit(_EXITING["code"])
+    threading.Thread(target=later, daemon=True, name="acausal-exit-soon").start()
+
+
+_EXITING = {"deadline": None, "code": 130}
 
 
 @contextlib.contextmanager

@@ -1,5 +1,13 @@
 """Coulomb + viscous friction with stick/slip modes switched by events.
 
+MSL's friction elements (normal-force inputs, friction tables, the free
+mode, startForward/startBackward, hard stops, lossy gears) are in
+:mod:`acausal.mechanics.rotational` and :mod:`acausal.mechanics.translational`,
+on the shared mode machine :mod:`acausal.mechanics.frictionmodes`. The four
+elements here keep this module's machine: their tests fix behaviour that
+MSL's machine does differently at exact ties (docs/components.md,
+"Friction elements").
+
 Sign convention: :mod:`acausal.connectors` (through variables positive INTO
 the component). Every element here has a relative motion ``x_rel`` (the
 position/angle of flange_b relative to flange_a, or of the flange relative

@@ -16,7 +16,8 @@ from collections import Counter, deque
 import numpy as np
 
 from .backends import BACKENDS, BackendError, make_solver
-from ..errors import ChatteringError, LimitError, SolverError, UsageError
+from ..errors import ChatteringError, Interrupted, LimitError, OutputGridError, SolverError, \
+    UsageError
 from .events import EventState
 from .initialize import ask_components, initial_point, reinitialize, suspect_parameters
 from .result import Result
@@ -31,6 +32,30 @@ SAME_INSTANT = 256 * np.finfo(float).eps   # (relative) times closer than this a
 MAX_ROWS = 1_000_000    # stored output rows, by default (each 8 bytes per unknown, twice)
 WINDOW_S = 0.25         # wall time per integration window when watched [s]
 PROGRESS_DELAY_S = 2.0  # a progress bar shows once a run has lasted this long [s]
+ROW_FACTOR = 3          # memory of a stored row: its arrays, the result's copy, the CSV
+
+
+class _StopRequest:
+    """A request to stop the running simulations now, keeping their rows
+    (the command line's Ctrl-C and SIGTERM handler, a memory watchdog):
+    :func:`request_stop` sets ``reason``; each run checks it between solver
+    calls and, through its wrapped residual or the compiled backend's
+    guard, inside them. ``active``: runs in progress in this process;
+    ``armed``: a handler may request a stop (the command line's), so runs
+    check for it inside their solver calls too."""
+    reason = None
+    active = 0
+    armed = False
+
+
+STOP = _StopRequest()
+
+
+def request_stop(reason):
+    """Ask the running simulation(s) to stop with their partial result;
+    False when none is running (the caller then interrupts as it would)."""
+    STOP.reason = reason
+    return STOP.active > 0
 
 
 def _output_times(t0, t_end, output_step, output_times):
@@ -110,6 +135,22 @@ class _Run:
             self.SD.append(np.tile(self.sens.sd_all.ravel(), (len(self.T[-1]), 1)))
         self.rows += len(self.T[-1])
 
+    def trim(self, n):
+        """Keep only the first ``n`` stored rows (at least the first)."""
+        n = max(int(n), 1)
+        if self.rows <= n:
+            return
+        kept = 0
+        for k, block in enumerate(self.T):
+            if kept + len(block) >= n:
+                m = n - kept
+                for blocks in (self.T, self.Y, self.YP, self.D) + ((self.SD,) if self.SD else ()):
+                    blocks[k] = blocks[k][:m]
+                    del blocks[k + 1:]
+                break
+            kept += len(block)
+        self.rows = n
+
     def callbacks(self, d):
         """Mode ``d``'s generated callbacks, as the backend serves them to
         the loop (the compiled backend's call C: :meth:`SegmentSolver.callbacks`),
@@ -165,7 +206,7 @@ class _Run:
 def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_step=None,
              output_times=None, max_step=None, max_steps=100000, atol_algebraic=None,
              backend=None, max_rows=MAX_ROWS, max_wall=None, max_total_steps=None,
-             progress=False, linsolver="auto", sensitivities=None):
+             progress=False, linsolver="auto", sensitivities=None, max_memory=None):
     """Simulate a :class:`CompiledModel` from ``t0`` to ``t_end`` (or until a
     terminal event). ``params`` overrides parameter values, and the start
     values of variables whose start is fixed, by dotted path (both are
@@ -197,7 +238,14 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
     stderr, shown once a run has lasted 2 s (it does not change the
     solution). With a wall or step limit the time span is integrated in
     windows of about a quarter of a second of wall time each (see
-    :class:`_Watch`).
+    :class:`_Watch`). ``max_memory`` (bytes): the stored rows are also
+    capped so that they fit in it (about :data:`ROW_FACTOR` x 8 bytes per
+    stored number); a requested output grid that does not fit is refused
+    before the run. A stop requested by :func:`request_stop` (the command
+    line's Ctrl-C and SIGTERM) ends the run like a limit, with an
+    :class:`~acausal.errors.Interrupted` error holding the partial result.
+    Every limit keeps the rows computed up to the stop, also when it falls
+    inside one solver call (the solver's own steps, ``output_step=0``).
 
     ``linsolver``: IDA's linear solver, see
     :meth:`acausal.compile.CompiledModel.linear_solver` (``"auto"`` chooses
@@ -210,13 +258,16 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
     every ``res.t``, ``res.event_sensitivity("spring.c")`` the derivatives of
     the event times."""
     wall0 = _time.perf_counter()
+    _check_times(t0, t_end, rtol, atol, max_rows, max_wall, max_total_steps, max_memory)
+    _check_output_size(cm, t0, t_end, output_step, output_times, max_rows, max_memory)
     run, y, yp, d, cb, stop = _start(cm, t0, t_end, params, rtol, atol, atol_algebraic,
                                      max_step, max_steps, _backend(backend), linsolver,
                                      sensitivities)
-    _check_output_size(cm, t0, t_end, output_step, output_times, max_rows)
     tout = _output_times(t0, t_end, output_step, output_times)
     run.record(t0, y, yp, d)
+    max_rows = _row_cap(cm, max_rows, max_memory)
     watch = _Watch(run, wall0, max_rows, max_wall, max_total_steps, progress)
+    STOP.active += 1
     try:
         _integrate(run, watch, cb, t0, y, yp, d, stop, tout, output_step)
     except SolverError as exc:
@@ -224,6 +275,9 @@ def simulate(cm, t_end=1.0, t0=0.0, params=None, rtol=1e-6, atol=1e-8, output_st
         exc.result.stats["wall_s"] = _time.perf_counter() - wall0
         raise
     finally:
+        STOP.active -= 1
+        if STOP.active == 0:
+            STOP.reason = None     # the request is answered
         watch.close()
     res = run.result()
     res.stats["wall_s"] = _time.perf_counter() - wall0
@@ -276,6 +330,15 @@ def _integrate(run, watch, cb, t, y, yp, d, stop, tout, output_step, t_stop=None
         run.nfev += seg.nfev
         run.njev += seg.njev
         run.steps += seg.steps
+        if watch.stopping:     # a limit or a stop request inside the call: keep its rows
+            st = np.asarray(seg.t, float)
+            keep = (st > float(run.T[-1][-1])) & np.r_[False, np.diff(st) > 0]
+            if watch.stopping == "rows" and watch.max_rows is not None:
+                keep[np.cumsum(keep) > max(int(watch.max_rows) - run.rows, 0)] = False
+            if keep.any():
+                run.record(np.asarray(seg.t)[keep], np.asarray(seg.y)[keep],
+                           np.asarray(seg.yp)[keep], d)
+            raise watch._error(watch.stopping, float(run.T[-1][-1]))
         if len(seg.t) > 1:
             run.record(seg.t[1:], seg.y[1:], seg.yp[1:], d)
         if seg.status < 0:
@@ -405,18 +468,66 @@ def _output_count(t0, t_end, output_step, output_times):
     return (t_end - t0) / step + 1
 
 
-def _check_output_size(cm, t0, t_end, output_step, output_times, max_rows):
-    """Refuse, before allocating it, an output grid of more than ``max_rows`` rows."""
+def _count(n):
+    """A count as '1,000,001' (exact below 1e9), else '5e+13'."""
+    return f"{n:,.0f}" if n < 1e9 else f"{n:.3g}"
+
+
+def _row_bytes(cm):
+    """Bytes one stored output row takes, all copies counted (:data:`ROW_FACTOR`)."""
+    return ROW_FACTOR * 8 * (2 * len(cm.dae.y) + len(cm.discretes) + 1)
+
+
+def _row_cap(cm, max_rows, max_memory):
+    """``max_rows``, lowered so that the stored rows fit in ``max_memory``."""
+    if max_memory is None:
+        return max_rows
+    cap = max(2, int(max_memory // _row_bytes(cm)))
+    return cap if max_rows is None else min(max_rows, cap)
+
+
+def _check_times(t0, t_end, rtol, atol, max_rows, max_wall, max_total_steps, max_memory):
+    """The run's times, tolerances and limits are numbers in range (a
+    UsageError naming the one that is not; -1 or nan reached IDA and
+    numpy as tracebacks)."""
+    def bad(name, value, what):
+        raise UsageError(f"{name} = {value!r}: must be {what}", variable=name)
+    for name, value in (("t0", t0), ("t_end", t_end)):
+        if not isinstance(value, (int, float, np.floating, np.integer)) or \
+                not np.isfinite(value):
+            bad(name, value, "a finite number")
+    if not t_end > t0:
+        bad("t_end", t_end, f"after t0 = {t0:g} s")
+    if not (isinstance(rtol, (int, float, np.floating)) and 0 < rtol < 1):
+        bad("rtol", rtol, "a number between 0 and 1")
+    atols = list(atol.values()) if isinstance(atol, dict) else \
+        np.ravel(np.asarray(atol, dtype=float)).tolist() if not isinstance(atol, str) else [atol]
+    if not all(isinstance(a, (int, float)) and np.isfinite(a) and a > 0 for a in atols):
+        bad("atol", atol, "a finite number > 0")
+    for name, value in (("max_rows", max_rows), ("max_wall", max_wall),
+                        ("max_total_steps", max_total_steps), ("max_memory", max_memory)):
+        if value is not None and not (np.isfinite(value) and value > 0):
+            bad(name, value, "a number > 0 (or None: no limit)")
+
+
+def _check_output_size(cm, t0, t_end, output_step, output_times, max_rows, max_memory=None):
+    """Refuse, before allocating it, an output grid of more than ``max_rows``
+    rows, or of more than ``max_memory`` bytes."""
     n = _output_count(t0, t_end, output_step, output_times)
+    need = n * _row_bytes(cm)
+    grid = ("the output times" if output_times is not None else
+            f"the output grid (every {output_step or (t_end - t0) / 500:g} s from {t0:g} "
+            f"to {t_end:g} s)")
     if max_rows is not None and n > max_rows:
-        gb = n * 8 * (2 * len(cm.dae.y) + len(cm.discretes) + 1) / 1e9
-        grid = ("the output times" if output_times is not None else
-                f"the output grid (every {output_step or (t_end - t0) / 500:g} s from {t0:g} "
-                f"to {t_end:g} s)")
-        raise LimitError(
-            f"{grid} has {n:.3g} rows (~{gb:.3g} GB), more than max_rows = {max_rows:g}: "
-            "choose a larger output step, output_step=0 (the solver's own steps), a shorter "
-            "t_end, or raise max_rows (--max-rows)", t=t0)
+        raise OutputGridError(
+            f"{grid} has {_count(n)} rows (~{need / 1e9:.3g} GB), more than max_rows = "
+            f"{_count(max_rows)}: choose a larger output step, output_step=0 (the solver's own "
+            "steps), a shorter t_end, or raise max_rows (--max-rows)", t=t0)
+    if max_memory is not None and need > max_memory:
+        raise OutputGridError(
+            f"{grid} has {_count(n)} rows, which need about {need / 1e9:.3g} GB, more than the "
+            f"memory limit {max_memory / 1e9:.3g} GB: choose a larger output step, a shorter "
+            "t_end, or raise the limit (--max-memory)", t=t0)
 
 
 def _tspan(t, tout, t_end, horizon, t_event=np.inf):
@@ -440,21 +551,22 @@ def _tspan(t, tout, t_end, horizon, t_event=np.inf):
                            else np.append(later, t_end)])
 
 
-class _HardStop(Exception):
-    """Raised from inside the residual when a limit is far exceeded."""
-
-
 class _Watch:
     """The limits and the progress bar of one run.
 
-    Between two solver calls: the stored rows, the wall time and the steps
-    are checked (:meth:`check`), the progress bar moves. With a wall or step
-    limit the span is cut into windows (:meth:`horizon`)
-    sized to take about ``WINDOW_S`` of wall time each (every window
-    restarts IDA, like an event). Inside a solver call the residual is
-    wrapped (:meth:`wrap`): a call that runs far past a limit (or stores
-    every step past ``max_rows``) is stopped; the rows of that call are lost,
-    the earlier ones kept."""
+    Between two solver calls: the stored rows, the wall time, the steps and
+    a stop request (:data:`STOP`) are checked (:meth:`check`), the progress
+    bar moves. With a wall or step limit the span is cut into windows
+    (:meth:`horizon`) sized to take about ``WINDOW_S`` of wall time each
+    (every window restarts IDA, like an event). Inside a solver call the
+    residual is wrapped (:meth:`wrap`; the compiled backend calls
+    :meth:`guard` each time its output buffer fills): a call that runs far
+    past a limit, stores every step past ``max_rows``, or meets a stop
+    request, is ended (``stopping`` says why) and the rows it computed
+    until then are kept: the Python residual then returns NaN, so that IDA
+    gives up at its last accepted step and returns what it has (scikit-sundae
+    loses a call's rows when the residual raises), and the compiled
+    backend's guard returns True."""
 
     def __init__(self, run, wall0, max_rows, max_wall, max_total_steps, progress):
         self.run, self.wall0 = run, wall0
@@ -466,57 +578,118 @@ class _Watch:
         self.t_call = None
         self.counter = None
         self.every_step = False
+        self.stopping = None
 
     def horizon(self, t):
         return t + self.dt if self.windowed else None
 
     def wrap(self, cb, tspan):
         """``cb`` with its residual checking the limits and moving the
-        progress bar every 64 calls (when limits are set, a bar is shown or
-        the call stores every step, as a two-point ``tspan`` does; else
-        ``cb`` itself)."""
+        progress bar every 64 calls (when limits are set, a bar is shown,
+        a stop may be requested or the call stores every step, as a
+        two-point ``tspan`` does; else ``cb`` itself); once the call is
+        to stop, the residual is NaN and the Jacobian is not evaluated."""
         res, count, calls = cb[0], cb[5], [0]
         self.counter = count
-        if not self.windowed and self.bar is None and len(tspan) != 2:
+        if not self.windowed and self.bar is None and len(tspan) != 2 and not STOP.armed:
             return cb
 
         def checked(t, y, yp, r):
+            if self.stopping:
+                r[:] = np.nan
+                return
             calls[0] += 1
             if calls[0] % 64 == 0:
-                self._hard(count[0])
+                self.stopping = self._hard(count[0])
                 self._show(t)
+                if self.stopping:
+                    self._mute()   # IDA's message about the failure it is led into
+                    r[:] = np.nan
+                    return
             res(t, y, yp, r)
-        return (checked,) + tuple(cb[1:])
+
+        def jacobian(fn):
+            def jac(*args):
+                if not self.stopping:
+                    fn(*args)
+            return jac
+        wrapped = list(cb)
+        wrapped[0] = checked
+        for k in (1, 6):
+            if k < len(wrapped) and callable(wrapped[k]):
+                wrapped[k] = jacobian(wrapped[k])
+        return tuple(wrapped)
+
+    def _mute(self):
+        """Send what C code prints (SUNDIALS writes its error lines to
+        stdout) to /dev/null until the call returns."""
+        self._saved_fds = []
+        try:
+            sys.stdout.flush()
+            sys.stderr.flush()
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            for fd in (1, 2):
+                self._saved_fds.append((fd, os.dup(fd)))
+                os.dup2(devnull, fd)
+            os.close(devnull)
+        except (OSError, ValueError):
+            self._unmute()
+
+    def _unmute(self):
+        saved, self._saved_fds = getattr(self, "_saved_fds", []), []
+        if saved:
+            try:
+                import ctypes
+                ctypes.CDLL(None).fflush(None)   # C stdio buffers, into /dev/null
+            except (OSError, TypeError, AttributeError):
+                pass
+        for fd, copy in saved:
+            os.dup2(copy, fd)
+            os.close(copy)
 
     def _show(self, t):
         if self.bar is not None and t - self.run.t0 > self.bar.n:
             self.bar.update(t - self.run.t0 - self.bar.n)
 
     def _hard(self, steps_now):
+        """Why the current solver call must end now, or None: a stop
+        request; a limit exceeded (far exceeded when windows will stop the
+        run at their end; exactly when the call stores every step, which
+        no window cuts)."""
+        if STOP.reason:
+            return "interrupt"
         steps = self.run.steps + steps_now
         wall = _time.perf_counter() - self.wall0
-        if self.max_wall is not None and wall > 1.25 * self.max_wall + 1.0:
-            raise _HardStop("wall")
-        if self.max_steps is not None and steps > 1.25 * self.max_steps + 1000:
-            raise _HardStop("steps")
+        exact = self.every_step
+        if self.max_wall is not None and wall > (
+                self.max_wall if exact else 1.25 * self.max_wall + 1.0):
+            return "wall"
+        if self.max_steps is not None and steps > (
+                self.max_steps if exact else 1.25 * self.max_steps + 1000):
+            return "steps"
         if (self.every_step and self.max_rows is not None
                 and self.run.rows + steps_now > self.max_rows):
-            raise _HardStop("rows")  # every step is stored (a two-point span)
+            return "rows"   # every step is stored (a two-point span)
+        return None
+
+    def guard(self, steps_now):
+        """The compiled backend's check, each time its output buffer fills:
+        True to end the call (its rows are kept)."""
+        self.stopping = self.stopping or self._hard(steps_now)
+        return bool(self.stopping)
 
     def solve(self, solver, cb, d, tspan, y, yp, every_step):
         """One segment of ``solver`` (:mod:`acausal.backends`) over ``tspan``;
         a limit far exceeded inside it (seen by the wrapped residual of a
-        Python backend) stops the run."""
+        Python backend, or the compiled backend's guard) or a stop request
+        ends the call early, with ``stopping`` set."""
         self.t_call = _time.perf_counter()
         self.every_step = len(tspan) == 2
-        solver.guard = self._hard     # (a compiled backend's check, per output buffer)
+        solver.guard = self.guard
         try:
             return solver.solve(cb, d, float(tspan[0]), y, yp, tspan[1:], every_step)
-        except _HardStop as exc:
-            self.run.steps += self.counter[0]
-            self.counter[0] = 0
-            raise self._error(str(exc), float(tspan[0])) from None
         finally:
+            self._unmute()
             # no cycle solver -> watch -> run -> solver: the run's IDA handle
             # goes back to the backend's pool as soon as the run is dropped
             solver.guard = None
@@ -530,6 +703,8 @@ class _Watch:
         if self.bar is not None:
             self._show(t)
             self.bar.set_postfix(steps=run.steps, events=len(run.events), refresh=False)
+        if STOP.reason:
+            raise self._error("interrupt", t)
         if self.max_rows is not None and run.rows > self.max_rows:
             raise self._error("rows", t)
         if self.max_wall is not None and now - self.wall0 > self.max_wall:
@@ -541,16 +716,21 @@ class _Watch:
         run = self.run
         what = {"rows": ("more than max_rows = {:g} stored output rows", self.max_rows),
                 "wall": ("the wall-time limit max_wall = {:g} s", self.max_wall),
-                "steps": ("the step limit max_total_steps = {:g}", self.max_steps)}[which]
+                "steps": ("the step limit max_total_steps = {:g}", self.max_steps),
+                "interrupt": ("{}", STOP.reason)}[which]
         what = what[0].format(what[1])
+        if which == "rows" and self.max_rows is not None:
+            run.trim(int(self.max_rows))
         t_last = float(run.T[-1][-1]) if run.T else t
-        why = (_dominant(run) if which != "rows" else "an output step, a shorter t_end or a "
-               "larger max_rows (--max-rows) stores less")
+        why = (_dominant(run) if which not in ("rows", "interrupt") else
+               "an output step, a shorter t_end or a larger max_rows (--max-rows) stores less"
+               if which == "rows" else "the result up to there is kept")
         msg = (f"stopped at t = {t_last:.6g} s of {run.t_end:g} s by {what} "
                f"({run.steps} steps, {len(run.events)} events, "
                f"{_time.perf_counter() - self.wall0:.3g} s): {why}")
-        return LimitError(msg, t=t_last, component=_dominant_owner(run),
-                          result=run.result("stopped", msg))
+        cls = Interrupted if which == "interrupt" else LimitError
+        return cls(msg, t=t_last, component=_dominant_owner(run),
+                   result=run.result("stopped", msg))
 
     def close(self):
         if self.bar is not None:
@@ -784,7 +964,8 @@ def _failure(run, cm, sol, cb):
         extra += ("; " + ", ".join(f"parameter {nm} = {v:g} [{u}] is far from its default "
                                    f"{dv:g}" for nm, v, dv, u in suspect)
                   + ": check its value and unit")
-    message = f"IDA failed at t = {t:.9g} s{where}: {r.message}{extra}"
+    who = "IDA failed" if cm.dae.n_states else "solving the equations (no states) failed"
+    message = f"{who} at t = {t:.9g} s{where}: {r.message}{extra}"
     result = run.result("failed", r.message)
     hint = ask_components(cm.model, "solver_failure", [comp] if comp else [], message, t,
                           result)

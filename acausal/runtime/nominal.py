@@ -10,13 +10,17 @@ applies to IDA and DASSL. IDA's error weight for the unknown is then
 its own scale, not to a fixed SI tolerance. Unknowns without a nominal
 keep ``atol``; an unknown named in an ``atol`` dict keeps that value.
 """
+import weakref
+
 import numpy as np
+
+_SLOTS = weakref.WeakKeyDictionary()   # compiled model -> {solver slot: nominal value}
 
 
 def nominal_slots(cm):
     """Solver slot -> nominal value (the smallest of the variables that
     are, up to sign, that slot), made once per model."""
-    out = cm.__dict__.get("_nominal_slots")
+    out = _SLOTS.get(cm)
     if out is None:
         out = {}
         variables = cm.flat.variables
@@ -25,7 +29,7 @@ def nominal_slots(cm):
                     if n in variables and variables[n].nominal is not None]
             if noms:
                 out[i] = min(noms)
-        cm._nominal_slots = out
+        _SLOTS[cm] = out
     return out
 
 

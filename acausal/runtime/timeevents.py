@@ -17,6 +17,7 @@ same instant computed two ways, a pulse's period and its width at 100 %)
 are one event.
 """
 import math
+import weakref
 
 import numpy as np
 import sympy as sp
@@ -25,6 +26,7 @@ from ..lang.symbols import time
 from .events import EventState
 
 MERGE = 256 * np.finfo(float).eps   # instants closer than this (x time scale) are one
+_SWITCHES = weakref.WeakKeyDictionary()   # compiled model -> its compiled time switches
 
 
 class _Due:
@@ -126,9 +128,9 @@ class TimeSchedule:
 
     def __init__(self, cm, p, t0, t_end):
         self.cm, self.p = cm, np.asarray(p, float)
-        funcs = cm.__dict__.get("_time_switch_fns")
+        funcs = _SWITCHES.get(cm)
         if funcs is None:   # made once per model
-            funcs = cm._time_switch_fns = [_Switch(sw, cm) for sw in cm.flat.time_switches]
+            funcs = _SWITCHES[cm] = [_Switch(sw, cm) for sw in cm.flat.time_switches]
         self.switches = funcs
         self.events = list(cm.flat.time_events)
         self.nd = len(cm.disc_syms)

@@ -270,6 +270,23 @@ def residual_vector(path, dataset, params, signals=None, options=None):
     return np.asarray(vec), labels, raw
 
 
+def _check_finite(vec, labels, dataset):
+    """A CalibrationError naming the first measured value whose weighted
+    residual is not a finite number (1e308 in the data overflowed, and
+    scipy stopped with a traceback)."""
+    with np.errstate(all="ignore"):
+        bad = np.flatnonzero(~np.isfinite(np.asarray(vec, float)))
+    if not bad.size:
+        return
+    exp, signal = labels[int(bad[0])]
+    e = dataset.experiment(exp)
+    value = e.measures.get(signal)
+    what = f"measured {signal} = {value:g} (SI)" if value is not None else f"trace {signal}"
+    raise CalibrationError(f"{exp}: {what}: its residual weighted by the instrument floor is "
+                           "not a finite number; check the value and its unit",
+                           file=getattr(dataset, "folder", None), column=signal)
+
+
 def residual_jacobian(path, dataset, params, names, signals=None, options=None):
     """(weighted residuals, their Jacobian d r / d x over the parameters
     ``names``), in the order of :func:`residual_vector`, from one simulation
@@ -382,7 +399,9 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, prof
         except AcausalError:
             return np.full(n_res, 1e6)
 
-    n_res = len(residual_vector(path, dataset, dict(zip(names, start)), signals)[0])
+    r0, labels0, _ = residual_vector(path, dataset, dict(zip(names, start)), signals)
+    _check_finite(r0, labels0, dataset)
+    n_res = len(r0)
     if n_res < len(names):
         raise CalibrationError(f"{n_res} measured values cannot determine {len(names)} "
                                "parameters")

@@ -79,17 +79,25 @@ def _number(text: str, spec: str, what: str) -> float:
     return value
 
 
-def _range_values(text: str, spec: str) -> np.ndarray:
-    """Values of ``start:stop:count`` (inclusive linspace)."""
+def _range_values(text: str, spec: str, max_count: int | None = None) -> np.ndarray:
+    """Values of ``start:stop:count`` (inclusive linspace); a count above
+    ``max_count`` is refused before any value is made."""
     parts = text.split(":")
     if len(parts) != 3:
         raise UsageError(f"bad parameter spec {spec!r}: a range is start:stop:count, e.g. 'x=3.0:5.0:21'")
     start = _number(parts[0], spec, "start")
     stop = _number(parts[1], spec, "stop")
     try:
-        count = int(parts[2])
+        count = float(parts[2].strip().replace("_", ""))
     except ValueError:
-        raise UsageError(f"bad parameter spec {spec!r}: count {parts[2].strip()!r} must be an integer >= 1") from None
+        count = math.nan
+    if not (math.isfinite(count) and count == int(count)):
+        raise UsageError(f"bad parameter spec {spec!r}: count {parts[2].strip()!r} must be an integer >= 1")
+    count = int(count)
+    if max_count is not None and count > max_count:
+        from ..errors import BudgetError
+        raise BudgetError(f"bad parameter spec {spec!r}: {count:,} points, more than the "
+                          f"sweep's limit of {max_count:,} points (--max-points)")
     if count < 1:
         raise UsageError(f"bad parameter spec {spec!r}: count must be an integer >= 1, got {count}")
     if count == 1 and start != stop:
@@ -97,10 +105,11 @@ def _range_values(text: str, spec: str) -> np.ndarray:
     return np.linspace(start, stop, count)
 
 
-def parse_param(spec: str) -> tuple[str, np.ndarray]:
+def parse_param(spec: str, max_count: int | None = None) -> tuple[str, np.ndarray]:
     """Parse ``"name=values"`` into ``(name, float array)``.
 
-    Values are ``start:stop:count`` (inclusive linspace, e.g. ``"v=3.0:5.0:21"``),
+    Values are ``start:stop:count`` (inclusive linspace, e.g. ``"v=3.0:5.0:21"``;
+    a count above ``max_count`` is refused before the values are made),
     a comma list (``"k=1,2,5"``) or one number (``"k=3"``). Names are dotted
     identifiers such as ``contact.K``. Raises ValueError naming ``spec`` if it is
     malformed, has non-finite or repeated values, or a count that is not an
@@ -114,7 +123,7 @@ def parse_param(spec: str) -> tuple[str, np.ndarray]:
     if not text:
         raise UsageError(f"bad parameter spec {spec!r}: no values after '='")
     if ":" in text:
-        values = _range_values(text, spec)
+        values = _range_values(text, spec, max_count)
     else:
         values = np.array([_number(item, spec, "value") for item in text.split(",")], dtype=float)
     if len(np.unique(values)) != len(values):
@@ -328,6 +337,7 @@ class _Journal:
         self.out_csv, self.store, self.header, self.cells = out_csv, store, list(header), cells
         self.units = dict(units or {})
         self.written = time.monotonic()
+        self.order: dict = {}    # point key -> its place in the grid (rows are written so)
 
     def add(self, key: tuple, cells: dict[str, str]) -> None:
         if self.store is not None:
@@ -337,7 +347,10 @@ class _Journal:
             self.write_csv()
 
     def write_csv(self) -> None:
-        _write_csv(self.out_csv, self.header, self.cells.values(), self.units)
+        """The CSV, rows in grid order (points of other grids kept after them)."""
+        last = len(self.order)
+        keys = sorted(self.cells, key=lambda k: self.order.get(k, last))
+        _write_csv(self.out_csv, self.header, (self.cells[k] for k in keys), self.units)
         self.written = time.monotonic()
 
 
@@ -426,19 +439,41 @@ def _progress_bar(total: int, initial: int, enabled: bool):
     return tqdm(total=total, initial=initial, disable=not enabled, file=sys.stderr, desc="sweep", unit="pt")
 
 
-def _collect(executor, futures: dict, on_row: Callable[[dict, dict], None], bar) -> None:
-    """Record futures as they finish; cancel the rest if anything goes wrong."""
+def _window(executor) -> int:
+    """Points in flight at once: enough to keep every worker busy."""
+    return max(16, 4 * (getattr(executor, "workers", None) or 16))
+
+
+def _wait_any(executor, futures: list) -> list:
+    """The finished ones among ``futures`` (at least one): the executor's
+    ``wait_any``, else the first its ``as_completed`` yields."""
+    if hasattr(executor, "wait_any"):
+        return executor.wait_any(futures)
+    return [next(iter(executor.as_completed(futures)))]
+
+
+def _collect_windowed(executor, todo: list, submit: Callable, on_row: Callable[[dict, dict], None],
+                      bar, window: int) -> None:
+    """Submit ``todo`` in order, at most ``window`` unfinished at a time;
+    record each as it finishes; cancel the rest if anything goes wrong."""
+    inflight: dict = {}
+    nxt = 0
     failed = 0
     try:
-        for future in executor.as_completed(list(futures)):
-            record = _result(future)
-            on_row(futures[future], record)
-            failed += record["status"] == "failed"
-            if failed:
-                bar.set_postfix(failed=failed, refresh=False)
-            bar.update(1)
+        while nxt < len(todo) or inflight:
+            while nxt < len(todo) and len(inflight) < window:
+                inflight[submit(todo[nxt])] = todo[nxt]
+                nxt += 1
+            for future in _wait_any(executor, list(inflight)):
+                point = inflight.pop(future)
+                record = _result(future)
+                on_row(point, record)
+                failed += record["status"] == "failed"
+                if failed:
+                    bar.set_postfix(failed=failed, refresh=False)
+                bar.update(1)
     except BaseException:
-        executor.cancel(list(futures))
+        executor.cancel(list(inflight))
         raise
     finally:
         bar.close()
@@ -455,6 +490,8 @@ def run_sweep(
     checkpoint: str | Path | None | bool = None,
     inputs: Sequence[Any] = (),
     units: Mapping[str, str] | None = None,
+    on_resume: Callable[[int, int], None] | None = None,
+    window: int | None = None,
 ) -> SweepRows:
     """Run ``task(point)`` for every point not already in ``out_csv``.
 
@@ -482,6 +519,12 @@ def run_sweep(
         units: column name -> unit, written into the header as
             ``"name [unit]"``. A resumed file's
             header is read with or without units.
+        on_resume: called as ``on_resume(done, total)`` before the run when
+            points were already done (the command line says "resumed: ...").
+        window: most points submitted and not yet finished (default
+            :func:`_window`): the executor holds a bounded number of tasks
+            whatever the grid's size (all of a 1e9-point grid's were
+            submitted at once).
 
     Returns:
         :class:`SweepRows` (a list) with one row per point, in ``points`` order:
@@ -498,6 +541,8 @@ def run_sweep(
     measures = _check_measures(measures, params)
     out_csv = Path(out_csv)
     journal = _open_journal(out_csv, params, measures, checkpoint, inputs, units)
+    for p in points:
+        journal.order.setdefault(_key(p, params), len(journal.order))
     todo = list({_key(p, params): p for p in points if _key(p, params) not in journal.cells}.values())
     if todo and executor.needs_pickle:
         _check_picklable(task)
@@ -505,11 +550,13 @@ def run_sweep(
     def on_row(point: dict, record: dict) -> None:
         journal.add(_key(point, params), _format_cells(point, record, params, measures))
 
-    futures = {executor.submit(_run_point, task, p, measures): p for p in todo}
-    n_unique = len({_key(p, params) for p in points})
+    n_unique = len(journal.order)
+    if n_unique > len(todo) and on_resume is not None:
+        on_resume(n_unique - len(todo), n_unique)
     bar = _progress_bar(n_unique, n_unique - len(todo), progress)
     try:
-        _collect(executor, futures, on_row, bar)
+        _collect_windowed(executor, todo, lambda p: executor.submit(_run_point, task, p, measures),
+                          on_row, bar, window or _window(executor))
     finally:
         journal.write_csv()
     if journal.store is not None:
@@ -547,10 +594,11 @@ def _series(rows: Sequence[Mapping], x: str, by: str | None) -> list[tuple[Any, 
     return series
 
 
-def _plot_series(ax, group: list[Mapping], x: str, measure: str, label: str | None) -> bool:
+def _plot_series(ax, group: list[Mapping], x: str, measure: str, label: str | None,
+                 factor: float = 1.0) -> bool:
     """One line (failed points are gaps, marked by an x at the bottom); True if any failed."""
     xs = [r[x] for r in group]
-    ys = [float(r[measure]) if r["status"] == "ok" else math.nan for r in group]
+    ys = [factor * float(r[measure]) if r["status"] == "ok" else math.nan for r in group]
     (line,) = ax.plot(xs, ys, "o-", ms=3, label=label)
     failed = [r[x] for r in group if r["status"] != "ok"]
     if failed:
@@ -559,12 +607,15 @@ def _plot_series(ax, group: list[Mapping], x: str, measure: str, label: str | No
     return bool(failed)
 
 
-def plot_sweep(rows: Sequence[Mapping], x: str, measure: str, path: str | Path, *, by: str | None = None) -> Path:
+def plot_sweep(rows: Sequence[Mapping], x: str, measure: str, path: str | Path, *, by: str | None = None,
+               x_unit: str | None = None, y_unit: str | None = None, y_factor: float = 1.0) -> Path:
     """Save a line plot of ``measure`` against parameter ``x`` to ``path``.
 
     One line per value of ``by``; with rows from :func:`run_sweep` of a 2-D grid,
     ``by`` defaults to the other parameter. Failed points leave a gap in their
-    line and are marked with an ``x`` at the bottom of the axes. Uses a bare
+    line and are marked with an ``x`` at the bottom of the axes. The axes are
+    labelled ``name [unit]`` with ``x_unit`` and ``y_unit`` (the measure's
+    values multiplied by ``y_factor``, e.g. 1e3 for a time shown in ms). Uses a bare
     matplotlib ``Figure`` (Agg), so no pyplot state or backend is touched.
     """
     from matplotlib.figure import Figure
@@ -576,14 +627,14 @@ def plot_sweep(rows: Sequence[Mapping], x: str, measure: str, path: str | Path, 
     any_failed = False
     for value, group in _series(rows, x, by):
         label = f"{by} = {value:g}" if by else None
-        any_failed |= _plot_series(ax, group, x, measure, label)
+        any_failed |= _plot_series(ax, group, x, measure, label, y_factor)
     handles, _ = ax.get_legend_handles_labels()
     if any_failed:
         handles.append(Line2D([], [], ls="", marker="x", color="0.3", mew=2, label="failed"))
     if handles:
         ax.legend(handles=handles, fontsize="small")
-    ax.set_xlabel(x)
-    ax.set_ylabel(measure)
+    ax.set_xlabel(column_label(x, {x: x_unit} if x_unit else None))
+    ax.set_ylabel(column_label(measure, {measure: y_unit} if y_unit else None))
     ax.grid(alpha=0.3)
     fig.savefig(path, dpi=120)
     return Path(path)

@@ -13,6 +13,7 @@ from scipy.optimize import brentq
 
 from acausal import Model, compile_model
 from acausal.analysis import linearize, trim
+from acausal.analysis.linearize import RunSettings
 from acausal.blocks.sources import Constant
 from acausal.cli import main
 from acausal.errors import AnalysisError
@@ -173,7 +174,7 @@ def test_a_and_b_against_finite_differences_of_the_simulated_response():
 def test_linearisation_at_a_simulated_time_and_from_a_result():
     cm = compile_model(pendulum(torque=False))
     res = cm.simulate(t_end=0.7, output_step=0.1, rtol=1e-10, atol=1e-12)
-    a = linearize(cm, at=0.7, rtol=1e-10, atol=1e-12)
+    a = linearize(cm, at=0.7, run=RunSettings(rtol=1e-10, atol=1e-12))
     b = linearize(cm, at=res)
     assert a.t == pytest.approx(0.7) and b.t == pytest.approx(0.7)
     assert np.allclose(a.x0, b.x0, atol=1e-8)

@@ -62,4 +62,4 @@ def test_commands_of_many_runs_default_to_compiled(monkeypatch, tmp_path):
     monkeypatch.setattr(run, "diagnose", fake)
     CliRunner().invoke(main, ["diagnose", OSC, str(tmp_path)])
     assert seen == ["compiled"] and "ACAUSAL_BACKEND" not in os.environ
-    assert MANY_RUNS == {"calibrate", "sweep", "diagnose"}
+    assert MANY_RUNS == {"calibrate", "sweep", "diagnose", "tolerance"}

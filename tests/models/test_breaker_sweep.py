@@ -87,18 +87,15 @@ def test_sweep_on_dask_equals_sequential_runs_and_resumes(cluster, submissions, 
     assert out.read_bytes() == before             # and nothing appended
 
 
-def test_failing_point_is_recorded_and_the_sweep_goes_on(cluster, submissions, tmp_path):
-    """v_impact = 0 violates the parameter's bound (> 0): that point fails
-    with the model's message, the two valid points around it finish; a rerun
-    does not retry it."""
+def test_a_point_outside_the_parameter_bounds_is_refused_before_the_sweep(submissions,
+                                                                          tmp_path):
+    """v_impact = 0 violates the parameter's bound (> 0): the sweep is refused
+    with the model's message before any point runs (issue 21: it used to run
+    and fail point by point). Points that fail while running are still
+    recorded and the sweep goes on (tests/core/test_sweep.py)."""
     out = tmp_path / "bad.csv"
-    text = sweep(out, cluster.scheduler_address, "v_impact=3.8,0,4.5")
-    assert "3 points, 1 failed" in text
-    got = {float(r["v_impact"]): r for r in rows(out)}
-    assert got[0.0]["status"] == "failed" and got[0.0]["thrt"] == ""
-    assert got[0.0]["error"].startswith("ParameterError: parameter v_impact = 0")
-    assert [got[v]["status"] for v in (3.8, 4.5)] == ["ok", "ok"]
-    assert float(got[3.8]["thrt"]) * 1e3 == pytest.approx(1.900, abs=1e-3)
-    submissions.clear()
-    assert "3 points, 1 failed" in sweep(out, cluster.scheduler_address, "v_impact=3.8,0,4.5")
-    assert submissions == []
+    r = CliRunner().invoke(main, ["sweep", MODEL, "--measure", "thrt", "--out", str(out),
+                                  "--no-progress", "--param", "v_impact=3.8,0,4.5"])
+    assert r.exit_code == 2, r.output
+    assert "v_impact = 0 [m/s] must be > 0" in r.output and len(r.output.splitlines()) == 1
+    assert submissions == [] and not out.exists()

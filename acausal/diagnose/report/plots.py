@@ -33,11 +33,11 @@ def _located(plt, d):
         lw = 2.0 if i == 0 else 0.8
         axes[0].plot(t.shape["x"], t.shape["f_x"], lw=lw, label=t.node)
         axes[1].plot(t.shape["v"], t.shape["f_v"], lw=lw, label=t.node)
-    axes[0].set_xlabel("position of the node's body [SI]")
-    axes[1].set_xlabel("velocity of the node's body [SI]")
+    axes[0].set_xlabel("position of the node's body [m, or rad for a rotating body]")
+    axes[1].set_xlabel("velocity of the node's body [m/s, or rad/s]")
     for ax in axes:
         ax.axhline(0, color="k", lw=0.5)
-        ax.set_ylabel("generic force [SI]")
+        ax.set_ylabel("generic force [N, or N*m]")
         ax.legend(fontsize=7)
     axes[0].set_title("located generic term (thick: the best node)", fontsize=9)
     return fig
@@ -111,11 +111,57 @@ def _panel_figure(plt, d, height, on_trace, on_measure):
     return fig, axes, panels
 
 
+def _shown(d, s):
+    """(factor, unit) a signal's values are shown in: a measure's display
+    unit (thrt in ms), else the SI unit of the measure or variable
+    (the axes said only "[SI]")."""
+    try:
+        from ...lang.experiment import Measure
+        from ...modelfile import compile_file
+        mf, cm = compile_file(d.problem.model_path)
+    except Exception:  # noqa: BLE001 - a figure without units rather than none
+        return 1.0, "SI"
+    fn = mf.measures.get(s)
+    if isinstance(fn, Measure):
+        factor, unit = fn.shown(1.0)
+        return factor, unit
+    unit = mf.measure_unit(s)
+    if unit is None and s in cm.flat.variables:
+        unit = cm.flat.variables[s].unit
+    if unit is None:
+        for e in cm.params:
+            if e.name == s:
+                unit = e.unit
+    return 1.0, unit or "SI"
+
+
+def _in_unit(ax, factor, axis="y"):
+    """Tick labels of ``ax`` showing SI values multiplied by ``factor``."""
+    if factor == 1.0:
+        return
+    from matplotlib.ticker import FuncFormatter
+    fmt = FuncFormatter(lambda v, _: f"{v * factor:.6g}")
+    (ax.yaxis if axis == "y" else ax.xaxis).set_major_formatter(fmt)
+
+
+def _condition_label(ax, d, cond):
+    if cond:
+        factor, unit = _shown(d, cond)
+        ax.set_xlabel(f"{cond} [{unit}]")
+        _in_unit(ax, factor, "x")
+
+
 def _residuals(plt, d):
     fig, axes, panels = _panel_figure(plt, d, 2.8, _residual_trace, _residual_measure)
+    cond = d.dataset.condition_names[0] if d.dataset.condition_names else None
+    traces, _ = _panels(d.dataset)
     for ax, s in zip(axes[:, 0], panels):
         ax.axhline(0, color="k", lw=0.5)
-        ax.set_ylabel(f"{s}\nresidual [SI]")
+        factor, unit = _shown(d, s)
+        ax.set_ylabel(f"{s}\nresidual [{unit}]")
+        _in_unit(ax, factor)
+        if s not in traces:
+            _condition_label(ax, d, cond)
         ax.legend(fontsize=7, ncol=3)
     label = _label(d)
     axes[0, 0].set_title("residuals (simulated - measured): solid/o before, dashed/x after"
@@ -180,8 +226,14 @@ def _fitted_measure(ax, d, s, cond):
 
 def _fitted(plt, d):
     fig, axes, panels = _panel_figure(plt, d, 3, _fitted_trace, _fitted_measure)
+    cond = d.dataset.condition_names[0] if d.dataset.condition_names else None
+    traces, _ = _panels(d.dataset)
     for ax, s in zip(axes[:, 0], panels):
-        ax.set_ylabel(f"{s} [SI]")
+        factor, unit = _shown(d, s)
+        ax.set_ylabel(f"{s} [{unit}]")
+        _in_unit(ax, factor)
+        if s not in traces:
+            _condition_label(ax, d, cond)
         ax.legend(fontsize=7, ncol=2)
     axes[0, 0].set_title("measured (dots) against the calibrated model (solid) and "
                          "the extended one (dashed)", fontsize=9)

@@ -143,6 +143,7 @@ def summary(d: Diagnosis) -> dict:
     named = rk.named
     causes = [] if named is None else _causes(d, named)
     return dict(
+        notes=list(getattr(d.dataset, "notes", [])),
         discrepancy=d.decision.discrepancy,
         cause=None if named is None else named.candidate.hypothesis,
         location=None if named is None else named.candidate.location,

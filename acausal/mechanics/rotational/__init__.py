@@ -26,3 +26,9 @@ __all__ = ["Fixed", "Inertia", "Disc", "RelativeStates", "TorsionSpring", "Rotat
            "LinearSpeedDependentTorque", "TorqueStep", "Angle", "Position", "Speed", "Accelerate",
            "Move", "AngleSensor", "SpeedSensor", "AccSensor", "TorqueSensor", "PowerSensor",
            "MultiSensor", "RelAngleSensor", "RelSpeedSensor", "RelAccSensor"]
+
+# friction elements on the shared mode machine (acausal.mechanics.frictionmodes)
+from .friction import BearingFriction, Brake, Clutch, OneWayClutch, LossyGear  # noqa: E402
+from .planetary import IdealPlanetary  # noqa: E402
+
+__all__ += ["BearingFriction", "Brake", "Clutch", "OneWayClutch", "LossyGear", "IdealPlanetary"]

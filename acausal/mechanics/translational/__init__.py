@@ -25,3 +25,8 @@ __all__ = ["Fixed", "Mass", "Rod", "Spring", "Damper", "SpringDamper", "ElastoGa
            "Speed", "Accelerate", "Move", "PositionSensor", "SpeedSensor", "AccSensor",
            "ForceSensor", "PowerSensor", "MultiSensor", "RelPositionSensor", "RelSpeedSensor",
            "RelAccSensor"]
+
+# friction elements on the shared mode machine (acausal.mechanics.frictionmodes)
+from .friction import SupportFriction, Brake, MassWithStopAndFriction, stribeck_table  # noqa: E402
+
+__all__ += ["SupportFriction", "Brake", "MassWithStopAndFriction", "stribeck_table"]

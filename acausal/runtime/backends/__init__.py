@@ -85,7 +85,8 @@ class SegmentSolver:
     fallback = None   # why another backend runs in place of the one asked for
     # guard(steps): called by a backend that does not call the Python residual
     # (compiled) whenever its output buffer fills, with the steps of the call
-    # so far; raises to stop a call that runs far past the run's limits
+    # so far; returns True to end the call (past a limit, or a stop request),
+    # the segment then being the rows computed so far
     guard = None
 
     def solve(self, cb, d, t, y, yp, tout, every_step):

@@ -22,6 +22,7 @@ from . import Root, Segment, SegmentSolver
 
 SUBDIVISIONS = 100   # root checks per segment at least (without max_step)
 XTOL = 1e-14         # Brent's tolerance on t, relative to the time scale
+RES_TOL = 1e-8       # largest residual accepted at a point, relative to 1 + |J_i| |y|
 
 
 class AlgebraicSolver(SegmentSolver):
@@ -43,9 +44,24 @@ class AlgebraicSolver(SegmentSolver):
         return self._serve(model, p, d)
 
     def _point(self, cb, t, y, yp):
+        """The unknowns at ``t`` (Newton from ``y``), or _NoSolution."""
         from ..initialize import reinitialize
         self.evals += 1
-        return reinitialize(self.cm, cb, t, y, yp)
+        y1, yp1 = reinitialize(self.cm, cb, t, y, yp)
+        if len(y1):
+            r = np.zeros(len(y1))
+            cb[0](t, y1, yp1, r)
+            bad = ~np.isfinite(r)
+            if not bad.any() and np.any(np.abs(r) > RES_TOL):
+                # each equation against the size of its terms, |J_i| |y| (the
+                # initialisation's consistency test)
+                n = len(y1)
+                Jy, Jyp = np.zeros((n, n)), np.zeros((n, n))
+                cb[3](t, y1, yp1, Jy, Jyp)
+                bad = np.abs(r) > RES_TOL * (1.0 + np.abs(Jy) @ np.abs(y1))
+            if bad.any():
+                raise _NoSolution(t, y1, yp1, int(np.argmax(bad)))
+        return y1, yp1
 
     def _roots(self, cb, t, y, yp):
         g = np.zeros(self.cm.n_roots)
@@ -54,13 +70,24 @@ class AlgebraicSolver(SegmentSolver):
         return g
 
     def solve(self, cb, d, t, y, yp, tout, every_step):
+        T, Y, YP = [t], [np.array(y, float)], [np.array(yp, float)]
+        try:
+            return self._solve(cb, t, y, yp, tout, every_step, (T, Y, YP))
+        except _NoSolution as exc:
+            T.append(exc.t), Y.append(exc.y), YP.append(exc.yp)
+            org = self.cm.dae.origins[exc.row]
+            what = org.describe() if hasattr(org, "describe") else str(org)
+            return self._segment(T, Y, YP, -1, [], "no solution near the previous point "
+                                 f"({what})")
+
+    def _solve(self, cb, t, y, yp, tout, every_step, rows):
         tout = np.asarray(tout, float)
         span = float(tout[-1]) - t
         h = self.max_step if self.max_step > 0 else span / SUBDIVISIONS
         grid = np.union1d(tout, np.linspace(t, tout[-1], int(np.ceil(span / h)) + 1)[1:-1]) \
             if span > 0 else tout
         keep = set(tout.tolist())
-        T, Y, YP, roots = [t], [np.array(y, float)], [np.array(yp, float)], []
+        (T, Y, YP), roots = rows, []
         y, yp = np.array(y, float), np.array(yp, float)
         g0 = self._roots(cb, t, y, yp)
         t0, self.evals = t, 0
@@ -118,8 +145,16 @@ class AlgebraicSolver(SegmentSolver):
         hit = [i for i in self._crossed(g0, g) if i in fired] or fired[:1]
         return float(first), yr, ypr, hit
 
-    def _segment(self, T, Y, YP, status, roots):
+    def _segment(self, T, Y, YP, status, roots, message="ok"):
         return Segment(np.array(T, float), np.array(Y, float).reshape(len(T), -1),
-                       np.array(YP, float).reshape(len(T), -1), status,
-                       "ok" if status >= 0 else "failed", roots, nfev=self.evals, njev=0,
-                       steps=max(len(T) - 1, 0))
+                       np.array(YP, float).reshape(len(T), -1), status, message, roots,
+                       nfev=self.evals, njev=0, steps=max(len(T) - 1, 0))
+
+
+class _NoSolution(Exception):
+    """Newton found no point where the residual vanishes (``row``: the
+    worst equation)."""
+
+    def __init__(self, t, y, yp, row):
+        super().__init__(t)
+        self.t, self.y, self.yp, self.row = float(t), y, yp, row

@@ -303,7 +303,9 @@ class CompiledSolver(SegmentSolver):
                            float(tout[-1]))
         if flag < 0:
             return Segment(np.array([t]), y0[None], yp0[None], flag, self._message(flag))
-        cap = 1024 if every_step else len(tout) + 1
+        # (a dense grid's buffer fills every 256 rows too: the guard then
+        # sees a limit or a stop request within a bounded time)
+        cap = 1024 if every_step else min(len(tout) + 1, 256)
         T, Y, YP = [np.array([t])], [y0[None]], [yp0[None]]
         roots, iout, nrows = [], ctypes.c_int(0), ctypes.c_int(0)
         bt, by, byp = np.empty(cap), np.empty((cap, n)), np.empty((cap, n))
@@ -319,7 +321,9 @@ class CompiledSolver(SegmentSolver):
             if flag == _FULL:
                 if self.guard is not None:
                     L.acs_counters(self.h, self.counters.ctypes.data)
-                    self.guard(int(self.counters[0]))
+                    if self.guard(int(self.counters[0])):
+                        flag = 0      # stopped: the rows so far are the segment
+                        break
                 continue
             if flag != _ROOT:
                 break
