@@ -7,8 +7,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass, field
 
-from .problem import FitSettings
-from .stages.stats import ALPHA
+from .problem import ALPHA, FitSettings
 
 
 @dataclass(frozen=True)

@@ -58,7 +58,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
-ALPHA = 0.01          # family significance level of the discrepancy decision
+from ..problem import ALPHA  # noqa: F401  (the discrepancy decision's level)
 EQUIVALENCE = 4.0     # candidates within this many AICc units of the best: one class
 EQUIVALENCE_HELDOUT = 7.0  # ... or within this many with a held-out error no worse
 STRONG = 10.0         # dAICc vs no extension below which the evidence is weak
