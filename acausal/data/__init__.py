@@ -45,9 +45,21 @@ the model file's ``conditions``.
 """
 
 from .load import load_dataset
-from .records import DataError, Dataset, Experiment, Instrument, Trace
+from .records import DataError, Dataset, Instrument, MeasuredExperiment, Trace
 from .tube import TubeResult, tube_compare
 from .write import write_dataset
 
-__all__ = ["DataError", "Dataset", "Experiment", "Instrument", "Trace",
+__all__ = ["DataError", "Dataset", "Instrument", "MeasuredExperiment", "Trace",
            "TubeResult", "load_dataset", "tube_compare", "write_dataset"]
+
+
+def __getattr__(name):
+    """``Experiment``: the old name of :class:`MeasuredExperiment` (deprecated:
+    ``acausal.Experiment`` is a model file's simulation settings)."""
+    if name == "Experiment":
+        import warnings
+        warnings.warn("acausal.data.Experiment is now acausal.data.MeasuredExperiment (a "
+                      "measured experiment; acausal.Experiment is a model file's simulation "
+                      "settings)", DeprecationWarning, stacklevel=2)
+        return MeasuredExperiment
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -8,7 +8,7 @@ from typing import Iterable, Mapping, Optional, Union
 
 import numpy as np
 
-from .records import DataError, Dataset, Experiment, Instrument, Trace
+from .records import DataError, Dataset, Instrument, MeasuredExperiment, Trace
 from .table import Table, number, read_numeric_table, read_table
 from .units import converter
 
@@ -85,7 +85,7 @@ def _check_conditions(table: Table, columns, conditions) -> None:
 
 
 def _read_experiments(folder: Path, parameters, measures, conditions=()
-                      ) -> list[Experiment]:
+                      ) -> list[MeasuredExperiment]:
     """Experiments of ``experiments.csv``, values in SI, no traces yet."""
     table = read_table(folder / EXPERIMENTS)
     names = _experiment_names(table)
@@ -102,8 +102,8 @@ def _read_experiments(folder: Path, parameters, measures, conditions=()
     _check_conditions(table, columns, list(conditions or ()))
     values = {name: convert(table.numbers(k, role == "condition"))
               for name, role, convert, k in columns}
-    return [Experiment(names[i], _row(columns, values, i, "condition"),
-                       _row(columns, values, i, "measure"), None, line, uses[i])
+    return [MeasuredExperiment(names[i], _row(columns, values, i, "condition"),
+                               _row(columns, values, i, "measure"), None, line, uses[i])
             for i, (line, _) in enumerate(table.rows)]
 
 
@@ -138,7 +138,7 @@ def _read_trace(path: Path, variables) -> Trace:
     return Trace(time, data, path)
 
 
-def _attach_traces(folder: Path, experiments: list[Experiment], variables) -> None:
+def _attach_traces(folder: Path, experiments: list[MeasuredExperiment], variables) -> None:
     """Read ``<name>.csv`` traces into ``experiments``; error on orphans."""
     by_name = {e.name: e for e in experiments}
     for path in sorted(folder.glob("*.csv")):

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..errors import DataError, UnknownNameError
 
-__all__ = ["DataError", "Instrument", "Trace", "Experiment", "Dataset"]
+__all__ = ["DataError", "Instrument", "Trace", "MeasuredExperiment", "Dataset"]
 
 
 @dataclass
@@ -42,8 +42,10 @@ class Trace:
 
 
 @dataclass
-class Experiment:
-    """One experiment: SI ``conditions`` and measured-only SI ``measures``.
+class MeasuredExperiment:
+    """One measured experiment: SI ``conditions`` and measured-only SI
+    ``measures`` (and a measured ``trace``). Not the simulation settings of a
+    model file, which are :class:`acausal.lang.Experiment`.
 
     ``use`` is 'calibrate' (fitted by ``acausal calibrate``) or 'validate'
     (held back: predicted with the calibrated values and compared)."""
@@ -61,7 +63,7 @@ class Dataset:
     """Experiments and instrument description read from (or for) ``folder``."""
 
     folder: Optional[Path]
-    experiments: list[Experiment]
+    experiments: list[MeasuredExperiment]
     instrument: dict[str, Instrument] = field(default_factory=dict)
 
     @property
@@ -74,10 +76,21 @@ class Dataset:
         """Names of the measures taken in at least one experiment."""
         return list(dict.fromkeys(n for e in self.experiments for n in e.measures))
 
-    def experiment(self, name: str) -> Experiment:
+    def experiment(self, name: str) -> MeasuredExperiment:
         """The experiment called ``name`` (UnknownNameError, also a KeyError,
         if there is none)."""
         for e in self.experiments:
             if e.name == name:
                 return e
         raise UnknownNameError(f"no experiment {name!r}", file=self.folder)
+
+
+def __getattr__(name):
+    """``Experiment``: the old name of :class:`MeasuredExperiment` (deprecated)."""
+    if name == "Experiment":
+        import warnings
+        warnings.warn("acausal.data.Experiment is now acausal.data.MeasuredExperiment (a "
+                      "measured experiment; acausal.Experiment is a model file's simulation "
+                      "settings)", DeprecationWarning, stacklevel=2)
+        return MeasuredExperiment
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

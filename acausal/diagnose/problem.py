@@ -7,6 +7,8 @@ import math
 import os
 from dataclasses import dataclass, field
 
+ALPHA = 0.01          # family significance level of the discrepancy decision
+
 # ftol/xtol of the candidate fits: S to about 1e-5 relative (0.01-0.03 on the
 # breaker's 1272 values, against decisions made in AICc units and the
 # converged-start rule's max(0.5, 1e-3 S)); 1e-6 took 9 % more simulations

@@ -1,12 +1,18 @@
 """The diagnosis driver: from a model file and measured data to a named
 cause, an extended model and the measured gain.
 
-:func:`diagnose` chains the stages of :mod:`.stages` (calibrate ->
-candidates -> fit -> family members -> decide -> pairs -> cross-validate ->
-rank -> tied sites -> locate -> intervals -> extend -> next experiment -> views),
-keeps what they return in a :class:`~.result.Diagnosis`, renders the
-report from it (:mod:`.report`, a pure view) and returns the JSON summary
-(:func:`.result.summary`).
+:func:`diagnose` chains the stages (calibrate -> fit -> decide -> family
+members -> pairs -> cross-validate -> rank -> shown row and tied sites ->
+locate -> intervals -> extend -> next experiment -> views), each a function
+``stage(ctx, state) -> state`` of this module: ``ctx`` (a
+:class:`~.stages.context.Context`) holds the executor, the progress
+setting, the collector of finished fits and the clock; ``state`` (a
+:class:`~.stages.state.State`) what the stages computed so far, each
+stage returning a new one. The final state becomes a
+:class:`~.report.result.Diagnosis`, from which the report is rendered
+(:mod:`.report`, a pure view) and the JSON summary taken
+(:func:`.report.result.summary`). The options are one
+:class:`~.options.DiagnosisOptions`.
 
 Errors are in units of the instrument floor throughout (RMS of
 (simulated - measured)/floor): 1.0 is what the instrument's noise and
@@ -14,158 +20,226 @@ resolution alone explain.
 """
 from __future__ import annotations
 
+import dataclasses
 import json
-import time
 from pathlib import Path
 
 from ..infra.executor import open_executor
+from .options import DiagnosisOptions
+from .report.result import Diagnosis, details, summary
 from .stages import chain as stages
-from .stages import stats as st
-from .stages.families import Members, family_index, fit_members, prefer_simplest
+from .stages.chain import DiagnosisError
+from .stages.context import Clock, Context
+from .stages.families import family_index, fit_members, prefer_simplest
 from .stages.intervals import intervals
 from .stages.kinematics import Kinematics, equivalents, kinematics, prefer_site
 from .stages.locate import Location, locate
 from .stages.nextexp import next_experiment
-from .problem import FitSettings
-from .report.result import Diagnosis, details, summary
 from .stages.resume import FitStore
-from .stages.chain import DiagnosisError
+from .stages.state import State
 from .stages.tasks import fit_candidate
 
-__all__ = ["diagnose", "run_stages", "DiagnosisError"]
+__all__ = ["diagnose", "run_stages", "DiagnosisError", "DiagnosisOptions"]
 
 
-def run_stages(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
-               progress=True, hypotheses=None, locations=None, alpha=st.ALPHA,
-               exact_cv=True, library=None, views=True, settings=None,
-               collect=None, generic=True, pairs=True, families=True, profile=True,
-               design=True) -> Diagnosis:
-    """The stages in order; returns the :class:`Diagnosis` (writes only the
-    extended model file into ``out_dir``). ``collect(task, result)`` is
-    called as each fit result arrives (a checkpoint store plugs in there).
-    ``generic``: locate a discrepancy the library does not explain
-    (:mod:`.locate`); ``pairs``: search pairs of causes when the best single
-    one leaves misfit (:func:`.stages.search_pairs`); ``families``: fit
-    the other members of a competitive family (:mod:`.families`);
-    ``profile``: profile-likelihood intervals where the linearised ones fail
-    the check (:mod:`.intervals`); ``design``: the next experiment that
-    splits the best candidate's class (:mod:`.nextexp`)."""
-    t0, clock = time.perf_counter(), {}
-    problem, ds = stages.load_problem(model_path, data_folder, library, settings)
-    cands = stages.candidates(problem, hypotheses, locations)
-    with open_executor(scheduler, workers) as ex:
-        cal = stages.calibrate(problem, ex, progress, collect)
-        fits = stages.fit(problem, cal, cands, ex, progress, collect)
-        t_fit = time.perf_counter() - t0
-        dec = stages.decide(ds, cal, fits, alpha)
-        members = _timed(clock, "families_s", fit_members, problem, cal, dec, ex, progress,
-                         collect) if families else Members()
-        if members.fits:
-            fits += members.fits
-            dec = stages.decide(ds, cal, fits, alpha)
-        if pairs and stages.pairs_needed(dec):
-            fits, dec = _timed(clock, "pairs_s", _pairs, problem, ds, cal, dec, fits, ex,
-                               (progress, collect, alpha), clock)
-        cv = stages.cross_validate(problem, ds, cal, dec, ex, exact_cv, progress)
-        rk = stages.rank(ds, cal, dec, cv, members.unfitted)
-        rk, kin = _shown(problem, cal, rk, families, clock)
-        where = locate(problem, cal, dec, rk, ex, progress, collect) if generic else Location(
-            skipped="not run (generic=False)")
-        ivs = _timed(clock, "profile_s", intervals, problem, cal, rk, ex,
-                     progress) if profile else None
-    Path(out_dir).mkdir(parents=True, exist_ok=True)
-    extended = stages.extend(problem, rk, out_dir)
-    tied = equivalents(problem, kin, rk)
-    index = family_index(problem.library)
-    nxt = _timed(clock, "design_s", next_experiment, problem, ds, dec, rk,
-                 index) if design else None
-    t_cv = time.perf_counter() - t0 - t_fit
-    shown = None
-    if views:
-        from .stages.views import views as make_views
-        shown = make_views(problem, cal, rk)
-    n_sim = cal.fit.n_sim + sum(r.fit.n_sim for r in fits if r.fit is not None) + clock.get(
-        "pair_screen_n_sim", 0)
-    timing = dict(fit_s=t_fit, cv_s=t_cv, n_candidates=len(cands), n_sim=n_sim,
-                  total_s=time.perf_counter() - t0, **clock)
-    return Diagnosis(problem, ds, cal, len(cands), dec, cv, rk, extended, shown,
-                     nxt, timing, where, ivs, index, kin, tied)
+# -- the stages, each stage(ctx, state) -> state ------------------------------------------
+def calibrated(ctx: Context, s: State) -> State:
+    """The nominal model's free parameters fitted (:func:`.stages.chain.calibrate`)."""
+    return dataclasses.replace(s, calibration=stages.calibrate(ctx, s.problem))
 
 
-def _shown(problem, cal, rk, families, clock):
-    """(ranking, Kinematics): the row shown moved to the simplest member of
-    its family the data support (:func:`.families.prefer_simplest`), then to
-    a kinematically tied site whose coordinate is measured when the data
-    cannot tell the two apart (:func:`.kinematics.prefer_site`)."""
-    if families:
-        rk = prefer_simplest(rk, family_index(problem.library))
+def fitted(ctx: Context, s: State) -> State:
+    """Every candidate fitted (:func:`.stages.chain.fit`)."""
+    return dataclasses.replace(s, fits=stages.fit(ctx, s.problem, s.calibration, s.candidates))
+
+
+def decided(ctx: Context, s: State) -> State:
+    """The fits so far scored and the discrepancy decided (:func:`.stages.chain.decide`)."""
+    return dataclasses.replace(s, decision=stages.decide(s.dataset, s.calibration, s.fits,
+                                                         s.options.alpha))
+
+
+def members_fitted(ctx: Context, s: State) -> State:
+    """The other members of each competitive family fitted and the decision
+    taken again with them (:func:`.stages.families.fit_members`; option
+    ``families``)."""
+    if not s.options.families:
+        return s
+    with ctx.clock.timing("families_s"):
+        members = fit_members(ctx, s.problem, s.calibration, s.decision)
+    s = dataclasses.replace(s, members=members)
+    if not members.fits:
+        return s
+    return decided(ctx, dataclasses.replace(s, fits=s.fits + members.fits))
+
+
+def pairs_searched(ctx: Context, s: State) -> State:
+    """When the best single cause leaves misfit (option ``pairs``): the pair
+    search (:func:`.stages.chain.search_pairs`) and, when a pair comes out
+    best, its members refitted alone from the pair's point
+    (:func:`.stages.chain.member_refit_tasks`), each followed by the decision."""
+    if not (s.options.pairs and stages.pairs_needed(s.decision)):
+        return s
+    with ctx.clock.timing("pairs_s"):
+        got, screen_n_sim = stages.search_pairs(ctx, s.problem, s.calibration, s.decision)
+        s = decided(ctx, dataclasses.replace(s, fits=s.fits + tuple(got),
+                                             pair_screen_n_sim=screen_n_sim))
+        again = stages.member_refit_tasks(s.problem, s.calibration, s.decision)
+        if again:
+            refits = ctx.run(fit_candidate, again, "refitting the pair's members")
+            s = decided(ctx, dataclasses.replace(s, fits=s.fits + tuple(refits)))
+    return s
+
+
+def cross_validated(ctx: Context, s: State) -> State:
+    """Exact leave-one-experiment-out refits (:func:`.stages.chain.cross_validate`)."""
+    return dataclasses.replace(s, cv=stages.cross_validate(
+        ctx, s.problem, s.dataset, s.calibration, s.decision, s.options.exact_cv))
+
+
+def ranked(ctx: Context, s: State) -> State:
+    """The ranking and the verdict (:func:`.stages.chain.rank`)."""
+    return dataclasses.replace(s, ranking=stages.rank(s.dataset, s.calibration, s.decision,
+                                                      s.cv, s.members.unfitted))
+
+
+def shown(ctx: Context, s: State) -> State:
+    """The row shown moved to the simplest member of its family the data
+    support (:func:`.stages.families.prefer_simplest`, with ``families``),
+    then to a kinematically tied site whose coordinate is measured when the
+    data cannot tell the two apart (:func:`.stages.kinematics.prefer_site`)."""
+    rk = s.ranking
+    if s.options.families:
+        rk = prefer_simplest(rk, family_index(s.problem.library))
     if rk.after is None:
-        return rk, Kinematics(message="no cause to place")
-    kin = _timed(clock, "kinematics_s", kinematics, problem, cal)
-    return prefer_site(rk, kin), kin
+        return dataclasses.replace(s, ranking=rk,
+                                   kinematics=Kinematics(message="no cause to place"))
+    with ctx.clock.timing("kinematics_s"):
+        kin = kinematics(s.problem, s.calibration)
+    return dataclasses.replace(s, ranking=prefer_site(rk, kin), kinematics=kin)
 
 
-def _pairs(problem, ds, cal, dec, fits, ex, opts, clock):
-    """(fits, decision) after the pair search (:func:`.stages.search_pairs`)
-    and, when a pair comes out best, its members refitted alone from the
-    pair's point (:func:`.stages.member_refit_tasks`)."""
-    progress, collect, alpha = opts
-    got, clock["pair_screen_n_sim"] = stages.search_pairs(problem, cal, dec, ex, progress,
-                                                          collect)
-    fits += got
-    dec = stages.decide(ds, cal, fits, alpha)
-    again = stages.member_refit_tasks(problem, cal, dec)
-    if not again:
-        return fits, dec
-    fits += tuple(stages.run_tasks(ex, fit_candidate, again, "refitting the pair's members",
-                                   progress, collect))
-    return fits, stages.decide(ds, cal, fits, alpha)
+def located(ctx: Context, s: State) -> State:
+    """A discrepancy the library does not explain located (:mod:`.stages.locate`;
+    option ``generic``)."""
+    if not s.options.generic:
+        return dataclasses.replace(s, location=Location(skipped="not run (generic=False)"))
+    return dataclasses.replace(s, location=locate(ctx, s.problem, s.calibration, s.decision,
+                                                  s.ranking))
 
 
-def _timed(clock, key, fn, *args):
-    """``fn(*args)``, its wall time [s] kept in ``clock[key]``."""
-    t = time.perf_counter()
-    out = fn(*args)
-    clock[key] = time.perf_counter() - t
-    return out
+def profiled(ctx: Context, s: State) -> State:
+    """Checked or profiled 95 % intervals (:mod:`.stages.intervals`; option ``profile``)."""
+    if not s.options.profile:
+        return s
+    with ctx.clock.timing("profile_s"):
+        ivs = intervals(ctx, s.problem, s.calibration, s.ranking)
+    return dataclasses.replace(s, intervals=ivs)
 
 
-def diagnose(model_path, data_folder, *, out_dir, scheduler=None, workers=None,
-             progress=True, hypotheses=None, locations=None, alpha=st.ALPHA,
-             exact_cv=True, library=None, plots=True, max_nfev=60, settings=None,
-             collect=None, generic=True, pairs=True, families=True, profile=True,
-             design=True, on_resume=None) -> dict:
+def extended(ctx: Context, s: State) -> State:
+    """The named cause's extended model file written into ``out_dir``
+    (:func:`.stages.chain.extend`) and its kinematically tied sites
+    (:func:`.stages.kinematics.equivalents`)."""
+    Path(s.out_dir).mkdir(parents=True, exist_ok=True)
+    path = stages.extend(s.problem, s.ranking, s.out_dir)
+    return dataclasses.replace(s, extended_model=path,
+                               tied=equivalents(s.problem, s.kinematics, s.ranking))
+
+
+def designed(ctx: Context, s: State) -> State:
+    """The library's families and the next experiment that splits the best
+    candidate's class (:mod:`.stages.nextexp`; option ``design``)."""
+    index = family_index(s.problem.library)
+    if not s.options.design:
+        return dataclasses.replace(s, families=index)
+    with ctx.clock.timing("design_s"):
+        nxt = next_experiment(s.problem, s.dataset, s.decision, s.ranking, index)
+    return dataclasses.replace(s, families=index, next_experiment=nxt)
+
+
+def viewed(ctx: Context, s: State) -> State:
+    """What the report shows that needs simulations (:mod:`.stages.views`; option ``views``)."""
+    if not s.options.views:
+        return s
+    from .stages.views import views as make_views
+    return dataclasses.replace(s, views=make_views(s.problem, s.calibration, s.ranking))
+
+
+# -- the chain ------------------------------------------------------------------------------
+def run_stages(model_path, data_folder, options: DiagnosisOptions | None = None, *, out_dir,
+               collect=None, **keywords) -> Diagnosis:
+    """The stages in order; returns the :class:`Diagnosis` (writes only the
+    extended model file into ``out_dir``). ``options``: a
+    :class:`DiagnosisOptions` (None: the defaults); ``keywords``: its fields,
+    replacing those of ``options`` (``run_stages(model, data, out_dir=...,
+    workers=2, pairs=False)``). ``collect(task, result)`` is called as each
+    fit result arrives (a checkpoint store plugs in there)."""
+    opts = DiagnosisOptions.of(options, "run_stages", **keywords)
+    clock = Clock()
+    problem, ds = stages.load_problem(model_path, data_folder, opts.library, opts.settings)
+    s = State(problem, ds, opts, str(out_dir),
+              stages.candidates(problem, opts.hypotheses, opts.locations))
+    with open_executor(opts.scheduler, opts.workers) as ex:
+        ctx = Context(ex, opts.progress, collect, clock)
+        s = fitted(ctx, calibrated(ctx, s))
+        t_fit = clock.elapsed()
+        for stage in (decided, members_fitted, pairs_searched, cross_validated, ranked, shown,
+                      located, profiled):
+            s = stage(ctx, s)
+    ctx = Context(None, opts.progress, collect, clock)   # the stages below submit no task
+    s = designed(ctx, extended(ctx, s))
+    t_cv = clock.elapsed() - t_fit
+    s = viewed(ctx, s)
+    return diagnosis_of(s, _timing(s, clock, t_fit, t_cv))
+
+
+def _timing(s: State, clock: Clock, t_fit: float, t_cv: float) -> dict:
+    """``candidates.json``'s timing: the fit stage's and the later stages'
+    wall times, candidates, simulations, the total and each timed stage's."""
+    extra = dict(clock.times)
+    if s.pair_screen_n_sim is not None:
+        extra["pair_screen_n_sim"] = s.pair_screen_n_sim
+    return dict(fit_s=t_fit, cv_s=t_cv, n_candidates=len(s.candidates), n_sim=s.n_sim,
+                total_s=clock.elapsed(), **extra)
+
+
+def diagnosis_of(s: State, timing: dict) -> Diagnosis:
+    """The :class:`Diagnosis` of the final state."""
+    return Diagnosis(problem=s.problem, dataset=s.dataset, calibration=s.calibration,
+                     n_candidates=len(s.candidates), decision=s.decision, cv=s.cv,
+                     ranking=s.ranking, extended_model=s.extended_model, views=s.views,
+                     next_experiment=s.next_experiment, timing=timing, location=s.location,
+                     intervals=s.intervals, families=s.families, kinematics=s.kinematics,
+                     tied=s.tied)
+
+
+def diagnose(model_path, data_folder, options: DiagnosisOptions | None = None, *, out_dir,
+             collect=None, on_resume=None, **keywords) -> dict:
     """Diagnose ``model_path`` against the dataset folder ``data_folder``.
 
     Writes ``report.md``, ``diagnosis.json``, ``candidates.json``, plots and
     (when a cause is named) the extended model file into ``out_dir``;
-    returns the summary dict (docs/diagnosis.md). ``hypotheses`` /
-    ``locations`` restrict the candidates; ``alpha`` is the family
-    significance level of the discrepancy decision; ``exact_cv`` refits the
-    nominal and best models without each experiment (else the linearised
-    leave-one-out); ``library`` names a module standing in for
-    :mod:`acausal.diagnose.hypotheses`; ``settings`` a
-    :class:`~.problem.FitSettings` (``max_nfev`` kept for compatibility);
-    ``on_resume(n, path)`` is called when ``n`` fits of an interrupted run
-    of the same command are found in its checkpoint ``path``.
+    returns the summary dict (docs/diagnosis.md). ``options``: a
+    :class:`DiagnosisOptions` (None: the command line's defaults);
+    ``keywords``: its fields, replacing those of ``options``
+    (``diagnose(model, data, out_dir=..., workers=2, hypotheses=[...])``;
+    ``max_nfev`` kept for compatibility). Finished fits are kept in
+    ``<out_dir>/checkpoint/`` (a run after an interruption resumes) unless
+    ``collect`` takes them instead; ``on_resume(n, path)`` is called when
+    ``n`` fits of an interrupted run of the same command are found in its
+    checkpoint ``path``.
     """
-    settings = settings or FitSettings(max_nfev=max_nfev)
+    opts = DiagnosisOptions.of(options, "diagnose", **keywords)
     store = None
     if collect is None:   # keep finished fits in <out_dir>/checkpoint/ (resume after a kill)
-        store = collect = FitStore(out_dir, model_path, data_folder, dict(
-            hypotheses=hypotheses, locations=locations, alpha=alpha, exact_cv=exact_cv,
-            library=library, settings=repr(settings), generic=generic, pairs=pairs,
-            families=families))
+        store = collect = FitStore(out_dir, model_path, data_folder, opts.checkpoint_key())
         if store.saved and on_resume is not None:
             on_resume(len(store.saved), store.checkpoint.path)
-    d = run_stages(model_path, data_folder, out_dir=out_dir, scheduler=scheduler,
-                   workers=workers, progress=progress, hypotheses=hypotheses,
-                   locations=locations, alpha=alpha, exact_cv=exact_cv, library=library,
-                   settings=settings, collect=collect, generic=generic, pairs=pairs,
-                   families=families, profile=profile, design=design)
+    d = run_stages(model_path, data_folder, opts, out_dir=out_dir, collect=collect)
     out_dir = Path(out_dir)
     from .report.markdown import write_report
-    write_report(out_dir, d, plots=plots)
+    write_report(out_dir, d, plots=opts.plots)
     out = summary(d)
     (out_dir / "diagnosis.json").write_text(json.dumps(out, indent=1))
     (out_dir / "candidates.json").write_text(json.dumps(details(d), indent=1))

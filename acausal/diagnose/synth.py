@@ -33,9 +33,10 @@ import numpy as np
 from scipy import optimize
 
 from ..errors import AcausalError, UsageError
-from ..data import Dataset, Experiment, Instrument, Trace, write_dataset
+from ..data import Dataset, Instrument, MeasuredExperiment, Trace, write_dataset
 from ..modelfile import compile_file, evaluate_measures
 from .library.loader import load_library
+from .options import replaced
 
 TOO_STRONG = 1e6   # the effect [floors] of a magnitude at which the run fails
 
@@ -54,6 +55,92 @@ class Truth:
 
     def to_dict(self):
         return asdict(self)
+
+
+@dataclass(frozen=True)
+class SynthSpec:
+    """What :func:`synthesize` makes (module doc).
+
+    The experiments and the instrument: ``conditions`` (dict name -> list
+    of values, one experiment per index, or a list of dicts); ``names`` of
+    the experiments (default E01, E02, ...); ``measures`` (measure names to
+    record) and ``traces`` (variables sampled at ``sample_rate`` Hz from
+    t = 0 to the end of the run); ``noise`` / ``resolution``: signal -> SI
+    value of the Gaussian noise added and the step read values are rounded
+    to; ``units``: how columns are written (``{"time": "ms", "hook.phi":
+    "deg"}``).
+
+    The hidden extension: ``hypothesis`` / ``location`` (None: a null
+    dataset, only noise) of the hypothesis ``library`` (None: the
+    library's); its size by ``values`` (the parameters outright),
+    ``magnitude`` (a range for the first parameter, drawn log-uniformly) or
+    ``effect`` (a range in noise floors the data change is solved for);
+    ``sign``: of a drawn first parameter.
+
+    The truth's free parameters: ``free`` (values; default the model's, each
+    times exp(``free_jitter`` N(0, 1)), kept in its bounds). ``seed``: of
+    every draw."""
+
+    conditions: object
+    hypothesis: str | None = None
+    location: str | None = None
+    values: dict | None = None
+    magnitude: tuple | None = None
+    effect: tuple | None = None
+    sign: float = 1.0
+    free: dict | None = None
+    free_jitter: float = 0.0
+    measures: tuple = ()
+    traces: tuple = ()
+    sample_rate: float | None = None
+    noise: dict | None = None
+    resolution: dict | None = None
+    units: dict | None = None
+    names: list | None = None
+    seed: int = 0
+    library: str | None = None
+
+    @classmethod
+    def of(cls, spec=None, what="synthesize", **keywords) -> "SynthSpec":
+        """``spec`` with ``keywords`` (field names) replaced; without a
+        ``spec``, ``conditions`` is required."""
+        if spec is None:
+            if "conditions" not in keywords:
+                raise TypeError(f"{what}() missing required keyword argument 'conditions'")
+            spec = cls(keywords["conditions"])
+        return replaced(spec, what, **keywords)
+
+    def reading(self) -> dict:
+        """How the instrument reads the runs: measures, traces, floors, rate."""
+        measures, traces = list(self.measures), list(self.traces)
+        return dict(measures=measures, traces=traces,
+                    floors=_floors(measures + traces, self.noise, self.resolution),
+                    rate=self.sample_rate)
+
+
+@dataclass(frozen=True)
+class _Effect:
+    """The effect of an extension on the data (RMS over every data value of
+    (extended - nominal) / floor): the extended model ``pair`` simulated with
+    the truth's ``free`` parameters at the conditions ``conds`` against the
+    nominal runs ``ref``, both read as ``read`` (:meth:`SynthSpec.reading`)
+    says."""
+
+    pair: tuple
+    free: dict
+    conds: list
+    ref: list
+    read: dict
+
+    def runs(self, values) -> list:
+        """The extended model's runs with its parameters at ``values`` (a run
+        that fails raises its AcausalError)."""
+        return _simulate(self.pair, {**self.free, **values}, self.conds)
+
+    def size(self, runs) -> float:
+        """The effect [floors] of the extended model's ``runs``."""
+        r = self.read
+        return _effect(runs, self.ref, r["measures"], r["traces"], r["floors"], r["rate"])
 
 
 def _conditions(conditions):
@@ -96,63 +183,52 @@ def _effect(runs, ref, measures, traces, floors, rate):
     return float(np.sqrt(np.mean(a ** 2))) if a.size else 0.0
 
 
-def synthesize(model_path, folder, *, conditions, hypothesis=None, location=None,
-               values=None, magnitude=None, effect=None, sign=1.0, free=None,
-               free_jitter=0.0, measures=(), traces=(), sample_rate=None, noise=None,
-               resolution=None, units=None, names=None, seed=0, library=None) -> Truth:
+def synthesize(model_path, folder, spec: SynthSpec | None = None, **keywords) -> Truth:
     """Write a synthetic dataset to ``folder``; return the :class:`Truth`.
 
-    ``conditions``: dict name -> list of values (one experiment per index) or
-    a list of dicts. ``hypothesis``/``location``: the hidden extension (None:
-    a null dataset, only noise). ``values``/``magnitude``/``effect``: its size
-    (module doc); ``sign`` the sign of a drawn first parameter. ``free``:
-    values of the model's free parameters in the truth (default: the model's
-    values, each multiplied by exp(free_jitter * N(0, 1)) and kept in its
-    bounds). ``measures``: measure names to record; ``traces``: variables to
-    sample at ``sample_rate`` Hz. ``noise``/``resolution``: signal -> SI value.
-    ``units``: how to write columns (``{"time": "ms", "hook.phi": "deg"}``).
+    ``spec``: a :class:`SynthSpec`; ``keywords``: its fields, replacing those
+    of ``spec`` (``synthesize(model, folder, conditions={"F": [1, 2]},
+    traces=["mass.s"], sample_rate=1e3, ...)``).
     """
-    rng = np.random.default_rng(seed)
-    conds = _conditions(conditions)
-    measures, traces = list(measures), list(traces)
+    spec = SynthSpec.of(spec, "synthesize", **keywords)
+    rng = np.random.default_rng(spec.seed)
+    conds = _conditions(spec.conditions)
+    measures, traces = list(spec.measures), list(spec.traces)
     if not measures and not traces:
         raise UsageError("record at least one measure or trace")
-    if traces and not sample_rate:
+    if traces and not spec.sample_rate:
         raise UsageError("traces need a sample_rate")
     mf, cm = compile_file(model_path)
     for m in measures:
         if m not in mf.measures:
             raise UsageError(f"the model file has no measure {m!r}")
-    truth_free = _truth_free(mf, cm, free, free_jitter, rng)
-    read = dict(measures=measures, traces=traces, floors=_floors(measures + traces, noise,
-                                                                  resolution),
-                rate=sample_rate)
-    pair, ext_values, location = (mf, cm), {}, location
-    if hypothesis is not None:
-        pair, ext_values, location = _hidden(model_path, (mf, cm), hypothesis, location,
-                                             values, magnitude, effect, sign, truth_free,
-                                             conds, read, library, rng)
+    truth_free = _truth_free(mf, cm, spec.free, spec.free_jitter, rng)
+    read = spec.reading()
+    pair, ext_values, location = (mf, cm), {}, spec.location
+    if spec.hypothesis is not None:
+        pair, ext_values, location = _hidden(model_path, (mf, cm), spec, truth_free, conds,
+                                             rng)
     runs = _simulate(pair, {**truth_free, **ext_values}, conds)
     achieved = 0.0
-    if hypothesis is not None:
+    if spec.hypothesis is not None:
         ref = _simulate((mf, cm), truth_free, conds)
-        achieved = _effect(runs, ref, measures, traces, read["floors"], sample_rate)
-    names = list(names or [f"E{i + 1:02d}" for i in range(len(conds))])
-    experiments = [_experiment(name, c, res, meas, read, noise, resolution, rng)
+        achieved = _effect(runs, ref, measures, traces, read["floors"], spec.sample_rate)
+    names = list(spec.names or [f"E{i + 1:02d}" for i in range(len(conds))])
+    experiments = [_experiment(name, c, res, meas, read, spec, rng)
                    for name, c, (res, meas) in zip(names, conds, runs)]
+    noise, resolution = spec.noise, spec.resolution
     instrument = {s: Instrument(s, (resolution or {}).get(s, 0.0), (noise or {}).get(s, 0.0))
                   for s in measures + traces}
-    write_dataset(folder, Dataset(None, experiments, instrument), units)
-    return Truth(hypothesis, location, ext_values, truth_free, achieved, seed, names)
+    write_dataset(folder, Dataset(None, experiments, instrument), spec.units)
+    return Truth(spec.hypothesis, location, ext_values, truth_free, achieved, spec.seed, names)
 
 
 SAME_LAW = 1e-4   # floors (RMS): a law this close to the truth's data is the truth's law
                   # (identical laws differ by the solver's error, ~4e-6 on the breaker)
 
 
-def same_law_members(model_path, truth: Truth, *, conditions, measures=(), traces=(),
-                     sample_rate=None, noise=None, resolution=None, library=None,
-                     tol=SAME_LAW) -> list:
+def same_law_members(model_path, truth: Truth, spec: SynthSpec | None = None, *,
+                     tol=SAME_LAW, **keywords) -> list:
     """The members of the truth's family at its location (``[(hypothesis,
     location)]``) whose law, given the truth's parameter values (matched by
     name after the sub-model prefix; the member's others at their initial
@@ -162,17 +238,19 @@ def same_law_members(model_path, truth: Truth, *, conditions, measures=(), trace
     friction), so naming one of them names the truth. Only members of one family are compared: their laws are
     nested, whereas a different cause that merely mimics the truth on these
     experiments (a constant load for a friction that never reverses) is not
-    the same cause."""
+    the same cause. ``spec`` / ``keywords``: the data's
+    :class:`SynthSpec` (its conditions, measures, traces, sample rate,
+    noise, resolution and library are used)."""
     if truth.hypothesis is None:
         return []
-    lib = load_library(library)
+    spec = SynthSpec.of(spec, "same_law_members", **keywords)
+    lib = load_library(spec.library)
     family = next((ms for ms in lib.FAMILIES.values() if truth.hypothesis in ms), ())
     others = [m for m in family if m != truth.hypothesis and m in lib.HYPOTHESES]
     if not others:
         return []
-    conds = _conditions(conditions)
-    measures, traces = list(measures), list(traces)
-    floors = _floors(measures + traces, noise, resolution)
+    conds = _conditions(spec.conditions)
+    read = spec.reading()
     ref = _simulate(lib.build_extended(model_path, truth.hypothesis, truth.location),
                     {**truth.free, **truth.values}, conds)
     short = {k.partition(".")[2]: v for k, v in truth.values.items()}
@@ -189,7 +267,8 @@ def same_law_members(model_path, truth: Truth, *, conditions, measures=(), trace
                              {**truth.free, **vals}, conds)
         except AcausalError:
             continue
-        if _effect(runs, ref, measures, traces, floors, sample_rate) < tol:
+        if _effect(runs, ref, read["measures"], read["traces"], read["floors"],
+                   read["rate"]) < tol:
             out.append((m, truth.location))
     return out
 
@@ -207,32 +286,32 @@ def _truth_free(mf, cm, free, jitter, rng):
     return out
 
 
-def _hidden(model_path, nominal, hypothesis, location, values, magnitude, effect, sign,
-            truth_free, conds, read, library, rng):
-    """(extended pair, extension values, location) of the hidden effect."""
-    lib = load_library(library)
-    hyp = lib.HYPOTHESES[hypothesis]
+def _hidden(model_path, nominal, spec: SynthSpec, truth_free, conds, rng):
+    """(extended pair, extension values, location) of the hidden effect of ``spec``."""
+    lib = load_library(spec.library)
+    hyp = lib.HYPOTHESES[spec.hypothesis]
     graph = lib.graph_of(model_path)
+    location = spec.location
     if location is None:
         location = hyp.candidates(graph)[0]
     specs = hyp.params(graph, location)
     ext = {s.name: float(s.initial) for s in specs}
-    ext.update(values or {})
-    pair = lib.build_extended(model_path, hypothesis, location)
+    ext.update(spec.values or {})
+    pair = lib.build_extended(model_path, spec.hypothesis, location)
     first = specs[0]
-    if values and first.name in values:
+    if spec.values and first.name in spec.values:
         return pair, ext, location
-    if magnitude is not None:
-        shape, linked = _drawn_shape(specs, sign, rng)
-        lo, hi = sorted(abs(float(x)) for x in magnitude)
+    if spec.magnitude is not None:
+        shape, linked = _drawn_shape(specs, spec.sign, rng)
+        lo, hi = sorted(abs(float(x)) for x in spec.magnitude)
         ext.update({**shape, **_sized(
-            first, sign * math.exp(rng.uniform(math.log(lo), math.log(hi))), linked)})
-    elif effect is not None:
-        lo, hi = sorted(float(x) for x in effect)
+            first, spec.sign * math.exp(rng.uniform(math.log(lo), math.log(hi))), linked)})
+    elif spec.effect is not None:
+        lo, hi = sorted(float(x) for x in spec.effect)
         target = math.exp(rng.uniform(math.log(lo), math.log(hi)))
-        ref = _simulate(nominal, truth_free, conds)
-        ext.update(_reachable(pair, truth_free, ext, specs, sign, target, conds, ref, read,
-                              rng))
+        effect = _Effect(pair, truth_free, conds, _simulate(nominal, truth_free, conds),
+                         spec.reading())
+        ext.update(_reachable(effect, ext, specs, spec.sign, target, rng))
     else:
         raise UsageError("give values, magnitude or effect for the hidden extension")
     return pair, ext, location
@@ -241,7 +320,7 @@ def _hidden(model_path, nominal, hypothesis, location, values, magnitude, effect
 SHAPE_DRAWS = 4   # shapes drawn at most until one can reach the requested effect
 
 
-def _reachable(pair, truth_free, ext, specs, sign, target, conds, ref, read, rng):
+def _reachable(effect: _Effect, ext, specs, sign, target, rng):
     """{name: value} of the extension's parameters at the requested effect:
     a shape drawn (:func:`_drawn_shape`) and the first parameter solved for.
     A shape that cannot reach the effect within the first parameter's bounds
@@ -251,9 +330,7 @@ def _reachable(pair, truth_free, ext, specs, sign, target, conds, ref, read, rng
     limit = _limit(first, sign)
     for _ in range(SHAPE_DRAWS):
         shape, linked = _drawn_shape(specs, sign, rng)
-        v = _solve_effect(pair, truth_free, {**ext, **shape}, (first, linked), sign, target,
-                          conds, ref, read["measures"], read["traces"], read["floors"],
-                          read["rate"])
+        v = _solve_effect(effect, {**ext, **shape}, (first, linked), sign, target)
         if abs(v) < limit or len(specs) == 1:
             break
     return {**shape, **_sized(first, v, linked)}
@@ -315,14 +392,17 @@ def _sized(first, v, linked):
     return out
 
 
-def _experiment(name, c, res, meas, read, noise, resolution, rng):
+def _experiment(name, c, res, meas, read, spec, rng):
+    """Experiment ``name`` at conditions ``c`` as the instrument reads the
+    run ``res`` (its measures ``meas``)."""
+    noise, resolution = spec.noise, spec.resolution
     mvals = {m: _read(meas[m], m, noise, resolution, rng) for m in read["measures"]}
     trace = None
     if read["traces"]:
         t = np.arange(0.0, res.t[-1] + 1e-15, 1.0 / read["rate"])
         trace = Trace(t, {v: _read(np.interp(t, res.t, res[v]), v, noise, resolution, rng)
                           for v in read["traces"]})
-    return Experiment(name, dict(c), mvals, trace)
+    return MeasuredExperiment(name, dict(c), mvals, trace)
 
 
 def _read(x, signal, noise, resolution, rng):
@@ -341,8 +421,7 @@ def _limit(spec, sign):
     return float(spec.high) if sign > 0 else -float(spec.low)
 
 
-def _solve_effect(pair, free, values, sized, sign, target, conds, ref, measures, traces,
-                  floors, rate):
+def _solve_effect(effect: _Effect, values, sized, sign, target):
     """First-parameter value whose effect equals ``target`` (bisection in
     log); ``sized`` = (the first parameter's spec, the magnitude parameters
     linked to it: :func:`_sized`)."""
@@ -357,10 +436,10 @@ def _solve_effect(pair, free, values, sized, sign, target, conds, ref, measures,
         # measure or the simulation fails) is stronger than any target
         v = sign * math.exp(logm)
         try:
-            runs = _simulate(pair, {**free, **values, **_sized(spec, v, linked)}, conds)
+            runs = effect.runs({**values, **_sized(spec, v, linked)})
         except AcausalError:
             return TOO_STRONG
-        return _effect(runs, ref, measures, traces, floors, rate) - target
+        return effect.size(runs) - target
 
     top = math.log(limit)
     a = math.log(min(abs(spec.scale) or 1.0, limit))

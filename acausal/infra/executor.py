@@ -358,6 +358,7 @@ def terminate_on_sigterm():
             signal.signal(getattr(signal, n), h)
 
 
+DASK_CONNECT_S = 20.0  # a Dask scheduler that does not answer within this is refused
 EXIT_GRACE_S = 20.0   # an interrupted command has this long to save its work and end
 EXIT_SOON = True      # False where commands run inside another program (the tests' CliRunner)
 
@@ -398,7 +399,12 @@ def _dask_client(scheduler: Any):
     if isinstance(scheduler, distributed.Client):
         client, owned = scheduler, False  # caller's client: leave it open
     elif isinstance(scheduler, (str, distributed.deploy.Cluster)):
-        client, owned = distributed.Client(scheduler), True
+        try:
+            client, owned = distributed.Client(scheduler, timeout=DASK_CONNECT_S), True
+        except (OSError, TimeoutError) as exc:
+            raise UsageError(f"cannot reach the Dask scheduler {scheduler!r} within "
+                             f"{DASK_CONNECT_S:g} s: {' '.join(str(exc).split())[:200]}"
+                             ) from None
     else:
         raise TypeError(f"unsupported Dask object of type {type(scheduler).__name__}")
     try:

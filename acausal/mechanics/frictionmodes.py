@@ -92,7 +92,7 @@ from sympy import Ne, Piecewise
 
 from acausal.lang import Component, Discrete, Eq, Event, Parameter, Variable
 
-__all__ = ["FrictionModes", "PartialFriction", "PartialRotFriction",
+__all__ = ["PartialFrictionModes", "PartialFriction", "PartialRotFriction",
            "UNKNOWN", "FREE", "FORWARD", "STUCK", "BACKWARD"]
 
 UNKNOWN, FREE, FORWARD, STUCK, BACKWARD = 3, 2, 1, 0, -1
@@ -121,7 +121,7 @@ def _true(state, cond):
     return bool(cond.xreplace({s: sp.Float(state[s]) for s in cond.free_symbols}))
 
 
-class FrictionModes(Component):
+class PartialFrictionModes(Component):
     """The mode machine (see the module docstring). A friction element is
     this machine plus its kinematics and its law: the leaf (or a domain
     partial, :class:`PartialFriction`, :class:`PartialRotFriction`)
@@ -146,7 +146,7 @@ class FrictionModes(Component):
     Backward), ``startForward``, ``startBackward`` (0/1). States: ``sa``
     (no unit) path parameter (the holding force while locked),
     ``sa_offset`` (no unit) its offset while sliding, ``locked``, ``free``
-    [1] (0/1, as MSL's booleans).
+    [1] (0/1, as MSL's booleans), ``lossPower`` [W] = F*w (MSL's).
     """
 
     mode = Discrete(UNKNOWN, "1", "3 unknown (before the start), 2 free, 1 sliding forward, "
@@ -160,6 +160,7 @@ class FrictionModes(Component):
                          "tau0_max/unitTorque): no unit")
     locked = Variable(0.0, "1", "1 while stuck and not starting to slide")
     free = Variable(0.0, "1", "1 while the element transmits nothing (normal force <= 0)")
+    lossPower = Variable(0.0, "W", "power dissipated by the friction, F*w (>= 0)")
 
     # -- what a leaf provides ------------------------------------------------
     def friction_motion(self):
@@ -213,7 +214,7 @@ class FrictionModes(Component):
         while getattr(top, "_parent", None) is not None:
             top = top._parent
         return [c for c in (top.walk() if hasattr(top, "walk") else [top])
-                if isinstance(c, FrictionModes)]
+                if isinstance(c, PartialFrictionModes)]
 
     def equations(self):
         w, a = self.friction_motion()
@@ -229,6 +230,7 @@ class FrictionModes(Component):
         acc.append((a - sa + self.sa_offset, True))
         force += [(F - self.sliding_force(1), forward), (F - self.sliding_force(-1), True)]
         return [Eq(0, Piecewise(*acc)), Eq(0, Piecewise(*force)),
+                Eq(self.lossPower, F * w),
                 # (0 where it is not used: a sliding law need not make sense
                 # while locked, and LossyGear's is discontinuous there)
                 Eq(self.sa_offset, Piecewise((0, locked | free), (self.slide_offset(1), forward),
@@ -394,7 +396,7 @@ class FrictionModes(Component):
             self._set(state, STUCK)
 
 
-class PartialFriction(FrictionModes):
+class PartialFriction(PartialFrictionModes):
     """MSL ``Translational.Interfaces.PartialFriction``: the mode machine
     with the levels of a friction force, ``f0`` (sliding friction at
     ``v = 0``) and ``f0_max`` (break-away force), which the leaf defines.
@@ -422,7 +424,7 @@ class PartialFriction(FrictionModes):
         return self.v_small
 
 
-class PartialRotFriction(FrictionModes):
+class PartialRotFriction(PartialFrictionModes):
     """MSL ``Rotational.Interfaces.PartialFriction``: the mode machine with
     the levels of a friction torque, ``tau0`` (sliding friction at ``w = 0``)
     and ``tau0_max`` (break-away torque), which the leaf defines.

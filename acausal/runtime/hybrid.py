@@ -547,8 +547,8 @@ def _check_times(t0, t_end, rtol, atol, max_rows, max_wall, max_total_steps, max
         if not isinstance(value, (int, float, np.floating, np.integer)) or \
                 not np.isfinite(value):
             bad(name, value, "a finite number")
-    if not t_end > t0:
-        bad("t_end", t_end, f"after t0 = {t0:g} s")
+    if not t_end >= t0:     # (t_end = t0: the consistent initial point alone, as linearize asks)
+        bad("t_end", t_end, f"at or after t0 = {t0:g} s")
     if not (isinstance(rtol, (int, float, np.floating)) and 0 < rtol < 1):
         bad("rtol", rtol, "a number between 0 and 1")
     atols = list(atol.values()) if isinstance(atol, dict) else \

@@ -11,6 +11,10 @@ Two methods:
   every experiment, weighted by the instrument's noise floor; 95 % confidence
   intervals from the Jacobian at the optimum (Student t) and the parameter
   correlation matrix.
+
+The weighted residuals are :mod:`.residuals`' (the diagnosis fits the same
+ones); :class:`ExperimentRuns` says how the calibration simulates each
+experiment for them.
 """
 from dataclasses import dataclass, field
 
@@ -18,10 +22,12 @@ import numpy as np
 from scipy import optimize, stats
 
 from ..data import load_dataset
-from .differences import ForwardDifferences  # noqa: F401  (re-exported: acausal.diagnose uses it)
+from .differences import ForwardDifferences
 from ..errors import AcausalError, CalibrationError, ModelError, ModelFileError
-from ..modelfile import compile_file, evaluate_measures
+from ..modelfile import evaluate_measures
 from .profile import Confidence, Coordinates, Tracing, profiles
+from .residuals import resolve, subset  # noqa: F401 (public here too, as before)
+from .residuals import weighted_jacobian, weighted_residuals
 
 
 # Finite-difference step of the least squares, absolute in the optimiser's
@@ -37,16 +43,6 @@ from .profile import Confidence, Coordinates, Tracing, profiles
 FD_STEP = 1e-3
 
 
-
-
-def resolve(model):
-    """(ModelFile, CompiledModel) for a model file path, or the pair itself.
-
-    Every function here taking ``path`` also accepts such a pair, e.g. the
-    model file extended with a hypothesis by :mod:`acausal.diagnose`."""
-    if isinstance(model, tuple) and len(model) == 2:
-        return model
-    return compile_file(model)
 
 
 def model_dataset(path, folder):
@@ -70,17 +66,6 @@ def _si(mf, measure):
     except Exception:  # pint raises UndefinedUnitError, TokenError, AssertionError...
         raise ModelFileError(f"{mf.path}: measure {measure!r} has unit {unit!r}, which "
                              "is not a unit expression") from None
-
-
-def subset(dataset, names):
-    """The dataset restricted to the experiments ``names`` (in that order)."""
-    import dataclasses
-    known = [e.name for e in dataset.experiments]
-    bad = [n for n in names if n not in known]
-    if bad:
-        raise CalibrationError(f"{dataset.folder}: no experiment {bad[0]!r}; the dataset has "
-                               + ", ".join(known))
-    return dataclasses.replace(dataset, experiments=[dataset.experiment(n) for n in names])
 
 
 def split(dataset, experiments=None):
@@ -142,7 +127,7 @@ class Calibration:
     dof: int = None
     n_sim: int = 0
     validation: dict = field(default_factory=dict)  # held-back experiment -> residuals
-    profile_ci95: dict = field(default_factory=dict)  # name -> acausal.profile.Profile
+    profile_ci95: dict = field(default_factory=dict)  # name -> profile.LikelihoodProfile
     jacobian: str = "finite differences"   # or "sensitivities" (see least_squares)
 
     def to_dict(self):
@@ -176,11 +161,11 @@ def report_method(path, dataset, pairs, experiment=None, brackets=None, base=Non
     exp = _nominal(dataset, names, experiment)
     values = dict(base or {})
     n_sim = [0]
-    mf, cm = compile_file(path)
+    pair = resolve(path)
     history = []
     for _ in range(max(1, passes)):
         for pname, measure in pairs:
-            values[pname] = _search(path, mf, cm, values, pname, measure, exp,
+            values[pname] = _search(pair, values, pname, measure, exp,
                                     (brackets or {}).get(pname), n_sim)
         history.append(dict(values))
         if len(history) > 1 and all(abs(history[-1][k] - history[-2][k])
@@ -204,9 +189,11 @@ def _bracket(mf, cm, pname, given):
     return lo, hi
 
 
-def _search(path, mf, cm, values, pname, measure, exp, bracket, n_sim):
+def _search(pair, values, pname, measure, exp, bracket, n_sim):
+    """The value of ``pname`` at which ``measure`` of experiment ``exp``
+    equals its measured value (:func:`report_method`)."""
     target = exp.measures[measure]
-    lo, hi = _bracket(mf, cm, pname, bracket)
+    lo, hi = _bracket(*pair, pname, bracket)
     logscale = lo > 0
     to_x = (lambda u: float(np.exp(u))) if logscale else float
     scale = max(abs(target), 1e-300)
@@ -216,7 +203,7 @@ def _search(path, mf, cm, values, pname, measure, exp, bracket, n_sim):
         trial[pname] = to_x(u)
         n_sim[0] += 1
         try:
-            return (simulate_experiment(path, trial, exp.conditions)[1][measure] - target) / scale
+            return (simulate_experiment(pair, trial, exp.conditions)[1][measure] - target) / scale
         except AcausalError:
             return 1e3   # no measure (no event, solver failure): beyond any target
     a, b = (np.log(lo), np.log(hi)) if logscale else (lo, hi)
@@ -240,34 +227,11 @@ def _nominal(dataset, measures, name=None):
 
 def residual_vector(path, dataset, params, signals=None, options=None):
     """Weighted residuals (simulated - measured)/sigma over every experiment:
-    measures first, then trace samples. Returns (vector, labels, raw).
-    ``options``: passed to :func:`simulate_experiment`."""
-    path = resolve(path)
-    vec, labels, raw = [], [], {}
-    for exp in dataset.experiments:
-        opts = options
-        if exp.trace is not None:   # samples compared with a trace: the dense grid
-            opts = {**path[0].experiment.run_options(dense=True), **(options or {})}
-        res, meas = simulate_experiment(path, params, exp.conditions, opts)
-        raw[exp.name] = {}
-        for m, y in exp.measures.items():
-            if signals and m not in signals:
-                continue
-            sigma = _sigma(dataset, m, y)
-            r = meas[m] - y
-            raw[exp.name][m] = r
-            vec.append(r / sigma)
-            labels.append((exp.name, m))
-        if exp.trace is not None:
-            for var, ys in exp.trace.signals.items():
-                if signals and var not in signals:
-                    continue
-                sim = np.interp(exp.trace.time, res.t, res[var])
-                sigma = _sigma(dataset, var, ys)
-                raw[exp.name][var] = sim - ys
-                vec.extend((sim - ys) / sigma)
-                labels.extend((exp.name, var) for _ in ys)
-    return np.asarray(vec), labels, raw
+    measures first, then trace samples (:func:`acausal.studies.residuals.weighted_residuals`,
+    each experiment run by :func:`simulate_experiment`). Returns (vector,
+    labels, raw). ``options``: passed to :func:`simulate_experiment`."""
+    got = weighted_residuals(path, dataset, params, ExperimentRuns(options), signals)
+    return got.vector, got.labels, got.raw
 
 
 def _check_finite(vec, labels, dataset):
@@ -294,33 +258,25 @@ def residual_jacobian(path, dataset, params, names, signals=None, options=None):
     a measure's derivative is :meth:`acausal.result.Result.measure_sensitivity`
     (the measure over the result moved along the sensitivities), a trace
     sample's ``interp(t_k, res.t, res[var])`` the same interpolation of
-    ``res.sensitivity(var, p)``."""
-    path = resolve(path)
-    mf = path[0]
-    vec, jac = [], []
-    for exp in dataset.experiments:
-        dense = {} if exp.trace is None else mf.experiment.run_options(dense=True)
-        opts = {**dense, **(options or {}), "sensitivities": list(names)}
-        res, meas = simulate_experiment(path, params, exp.conditions, opts)
-        for m, y in exp.measures.items():
-            if signals and m not in signals:
-                continue
-            sigma = _sigma(dataset, m, y)
-            vec.append((meas[m] - y) / sigma)
-            jac.append(np.array([[_measure_derivative(mf, res, m, n) / sigma
-                                  for n in names]]))
-        if exp.trace is None:
-            continue
-        for var, ys in exp.trace.signals.items():
-            if signals and var not in signals:
-                continue
-            sigma = _sigma(dataset, var, ys)
-            sim = np.interp(exp.trace.time, res.t, res[var])
-            vec.extend((sim - ys) / sigma)
-            jac.append(np.column_stack([np.interp(exp.trace.time, res.t,
-                                                  res.sensitivity(var, n)) / sigma
-                                        for n in names]))
-    return np.asarray(vec), np.vstack(jac)
+    ``res.sensitivity(var, p)`` (:func:`acausal.studies.residuals.weighted_jacobian`)."""
+    return weighted_jacobian(path, dataset, params, names, ExperimentRuns(options), signals)
+
+
+@dataclass(frozen=True)
+class ExperimentRuns:
+    """How the calibration simulates an experiment for its residuals:
+    :func:`simulate_experiment` with the model file's run options (the dense
+    output grid for an experiment with a trace) and ``options`` over them;
+    every measure of the model file is evaluated."""
+
+    options: dict | None = None
+
+    def __call__(self, pair, params, experiment, sensitivities=None):
+        dense = {} if experiment.trace is None else pair[0].experiment.run_options(dense=True)
+        opts = {**dense, **(self.options or {})}
+        if sensitivities is not None:
+            opts["sensitivities"] = list(sensitivities)
+        return simulate_experiment(pair, params, experiment.conditions, opts)
 
 
 class SensitivityJacobian:
@@ -341,24 +297,6 @@ class SensitivityJacobian:
         except AcausalError:
             self.fallbacks += 1
             return self.fallback.jac(z)
-
-
-def _measure_derivative(mf, res, measure, param):
-    try:
-        return float(res.measure_sensitivity(mf.measures[measure], param))
-    except AcausalError:
-        raise
-    except Exception as exc:  # a measure's own failure on the moved result
-        raise ModelFileError(f"{mf.path}: measure {measure!r} failed on the result moved "
-                             f"along d/d{param}: {type(exc).__name__}: {exc}") from None
-
-
-def _sigma(dataset, signal, values):
-    inst = dataset.instrument.get(signal)
-    s = inst.floor() if inst is not None else 0.0
-    if s <= 0:
-        s = 1e-3 * max(float(np.max(np.abs(values))), 1e-12)
-    return s
 
 
 def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, profile="none",
@@ -406,7 +344,8 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, prof
         raise CalibrationError(f"{n_res} measured values cannot determine {len(names)} "
                                "parameters")
     fd = ForwardDifferences(fun, FD_STEP, sc.zhi)
-    jac, exact = _jacobian_choice(jacobian, fd, path, dataset, names, signals, sc, n_sim)
+    target = _Target(path, dataset, list(names), signals)
+    jac, exact = _jacobian_choice(jacobian, fd, target, sc, n_sim)
     sol = optimize.least_squares(fd, sc.z0, jac=jac, bounds=(sc.zlo, sc.zhi),
                                  xtol=1e-12, ftol=1e-12, gtol=1e-12)
     kind = _jacobian_kind(exact)
@@ -418,8 +357,8 @@ def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, prof
     out = Calibration("least_squares", values, ci, corr, raw, float(2 * sol.cost), dof,
                       n_sim[0], jacobian=kind)
     if profile != "none" and names:
-        out.profile_ci95 = _profile_intervals(path, dataset, names, signals, n_res, n_sim,
-                                              sol, sc, xs, dof, profile == "all")
+        out.profile_ci95 = _profile_intervals(target, n_res, n_sim, sol, sc, dof,
+                                              profile == "all")
         out.n_sim = n_sim[0]
     return out
 
@@ -433,12 +372,23 @@ def _jacobian_kind(exact):
     return "sensitivities"
 
 
-def _profile_intervals(path, dataset, names, signals, n_res, n_sim, sol, sc, xs, dof, every):
+@dataclass(frozen=True)
+class _Target:
+    """What :func:`least_squares` fits: the (ModelFile, CompiledModel) pair,
+    the dataset, the fitted parameters' names and the signals kept (None: all)."""
+
+    pair: tuple
+    dataset: object
+    names: list
+    signals: object = None
+
+
+def _profile_intervals(target, n_res, n_sim, sol, sc, dof, every):
     """Profile-likelihood intervals at the optimum ``sol``, in the fit's own
     variables (log for a positive range, value/scale otherwise), so that the
     profiles' Wald intervals are those of :func:`_linear_intervals`."""
     return profiles(
-        _no_evidence_on_failure(path, dataset, names, signals, n_res, n_sim), xs, names,
+        _no_evidence_on_failure(target, n_res, n_sim), sc.to_x(sol.x), target.names,
         every=every, coords=Coordinates((sc.lo, sc.hi), sc.logp, sc.scale),
         confidence=Confidence(dispersion=max(2 * sol.cost / dof, 1.0) if dof > 0 else 1.0,
                               dof=dof or None),
@@ -493,7 +443,7 @@ class _Scaling:
         return np.where(self.logp, self.to_x(z), self.scale)
 
 
-def _jacobian_choice(jacobian, fd, path, dataset, names, signals, sc, n_sim):
+def _jacobian_choice(jacobian, fd, target, sc, n_sim):
     """(the ``jac`` for scipy, the :class:`SensitivityJacobian` or None)."""
     if jacobian not in ("auto", "sensitivities", "differences"):
         raise CalibrationError(f"jacobian={jacobian!r}: choose 'auto', 'sensitivities' or "
@@ -502,8 +452,9 @@ def _jacobian_choice(jacobian, fd, path, dataset, names, signals, sc, n_sim):
         return fd.jac, None
 
     def jac_x(x):
-        n_sim[0] += len(dataset.experiments)
-        return residual_jacobian(path, dataset, dict(zip(names, x.tolist())), names, signals)[1]
+        n_sim[0] += len(target.dataset.experiments)
+        return residual_jacobian(target.pair, target.dataset, dict(zip(target.names, x.tolist())),
+                                 target.names, target.signals)[1]
     exact = SensitivityJacobian(jac_x, sc.to_x, sc.dx_dz, fd)
     return exact.jac, exact
 
@@ -528,15 +479,16 @@ def _linear_intervals(sol, names, sc, dof):
     return ci, cov / np.outer(sd, sd)
 
 
-def _no_evidence_on_failure(path, dataset, names, signals, n_res, n_sim):
+def _no_evidence_on_failure(target, n_res, n_sim):
     """Residuals at parameter values x for the profile likelihood: a run that
     fails gives NaN, not the fit's penalty, since a failure is no evidence
     against x (the profile stops there and is reported open)."""
     def residuals(x):
-        n_sim[0] += len(dataset.experiments)
+        n_sim[0] += len(target.dataset.experiments)
         try:
-            return residual_vector(path, dataset, dict(zip(names, np.asarray(x).tolist())),
-                                   signals)[0]
+            return residual_vector(target.pair, target.dataset,
+                                   dict(zip(target.names, np.asarray(x).tolist())),
+                                   target.signals)[0]
         except AcausalError:
             return np.full(n_res, np.nan)
     return residuals

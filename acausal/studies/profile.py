@@ -86,8 +86,10 @@ class Tracing:
 
 
 @dataclass(frozen=True)
-class Profile:
-    """The profile of one parameter (natural units throughout).
+class LikelihoodProfile:
+    """The profile likelihood of one parameter and its interval (natural
+    units throughout). (Not :class:`acausal.mechanics.planar.polyline.Profile`,
+    a cam's polyline.)
 
     ``lower``/``upper``: the interval's ends; on an open side the bound when
     it is finite, else None (``open_lower``/``open_upper`` say which).
@@ -292,7 +294,7 @@ def _refine(obj, below, above, thresh, chi0):
 def profile_likelihood(residuals: Residuals, x_opt: Sequence[float], index: int, *,
                        coords: Coordinates = Coordinates(),
                        confidence: Confidence = Confidence(), tracing: Tracing = Tracing(),
-                       name: str | None = None, jacobian=None) -> Profile:
+                       name: str | None = None, jacobian=None) -> LikelihoodProfile:
     """Profile likelihood interval of parameter ``index``.
 
     ``residuals(x)``: weighted residuals (chi^2 = sum r^2) at the parameter
@@ -315,7 +317,7 @@ def profile_likelihood(residuals: Residuals, x_opt: Sequence[float], index: int,
     return _assemble(obj, sides, hw, thr, confidence.level, chi0, name, t.rel_tol)
 
 
-def _assemble(obj, sides, hw, thr, level, chi0, name, rel_tol) -> Profile:
+def _assemble(obj, sides, hw, thr, level, chi0, name, rel_tol) -> LikelihoodProfile:
     c, i = obj.c, obj.i
     pts = sorted(sides[0].points[1:] + sides[1].points, key=lambda p: p[0])
     us = np.array([p[0] for p in pts])
@@ -339,8 +341,9 @@ def _assemble(obj, sides, hw, thr, level, chi0, name, rel_tol) -> Profile:
         msgs.append(f"the profile found chi^2 {-d.min():.3g} below the given optimum: "
                     "the fit had not converged")
         trust = False
-    return Profile(name or f"x[{i}]", i, float(c.x0[i]), ends[0], ends[1], open_lo, open_hi,
-                   wald, bool(trust), thr, level, full[:, i], d, full, obj.n, "; ".join(msgs))
+    return LikelihoodProfile(name or f"x[{i}]", i, float(c.x0[i]), ends[0], ends[1], open_lo,
+                             open_hi, wald, bool(trust), thr, level, full[:, i], d, full, obj.n,
+                             "; ".join(msgs))
 
 
 def linear_check(residuals: Residuals, x_opt: Sequence[float], index: int, *,
@@ -398,7 +401,7 @@ def profiles(residuals: Residuals, x_opt: Sequence[float], names: Sequence[str],
              every: bool = False, coords: Coordinates = Coordinates(),
              confidence: Confidence = Confidence(), tracing: Tracing = Tracing(),
              jacobian=None) -> dict:
-    """name -> :class:`Profile` for the parameters ``names`` (in the order of
+    """name -> :class:`LikelihoodProfile` for the parameters ``names`` (in the order of
     ``x_opt``): every one when ``every``, else those whose linearised
     interval fails :func:`linear_check` (two evaluations each). ``jacobian``:
     d r / d u at the optimum (see :func:`jacobian_in_profile_variables`),
@@ -419,3 +422,14 @@ def profiles(residuals: Residuals, x_opt: Sequence[float], names: Sequence[str],
                                        confidence=confidence, tracing=tracing, name=name,
                                        jacobian=jacobian)
     return out
+
+
+def __getattr__(name):
+    """``Profile``: the old name of :class:`LikelihoodProfile` (deprecated:
+    ``acausal.mechanics.planar.polyline.Profile`` is a cam's polyline)."""
+    if name == "Profile":
+        import warnings
+        warnings.warn("acausal.studies.profile.Profile is now LikelihoodProfile",
+                      DeprecationWarning, stacklevel=2)
+        return LikelihoodProfile
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from acausal.studies import calibrate as cal
-from acausal.data import Dataset, Experiment, Instrument, Trace
+from acausal.data import Dataset, MeasuredExperiment, Instrument, Trace
 from acausal.modelfile import compile_file
 
 MODEL = '''
@@ -37,7 +37,7 @@ def _data(tmp_path):
     wd = np.sqrt(c / m - zw ** 2)
     x = 0.1 * np.exp(-zw * t) * (np.cos(wd * t) + zw / wd * np.sin(wd * t))
     x = np.round(x / 1e-5) * 1e-5
-    exp = Experiment("run1", {}, trace=Trace(t, {"mass.s": x}))
+    exp = MeasuredExperiment("run1", {}, trace=Trace(t, {"mass.s": x}))
     return compile_file(str(path)), Dataset(None, [exp], {"mass.s": Instrument("mass.s", 1e-5)})
 
 
@@ -103,7 +103,8 @@ def test_measures_take_the_exact_jacobian(tmp_path):
 
     def period(v0, K=1.3e9, m=0.1):
         return 0.8 * beta(0.4, 0.5) * (5 * m * v0 ** 2 / (4 * K)) ** 0.4 / v0
-    exps = [Experiment(f"v{v}", {"mass.v": v}, {"contact_period": period(v)}) for v in (1.0, 2.0)]
+    exps = [MeasuredExperiment(f"v{v}", {"mass.v": v}, {"contact_period": period(v)})
+            for v in (1.0, 2.0)]
     ds = Dataset(None, exps, {"contact_period": Instrument("contact_period", 1e-9)})
     exact = cal.least_squares(model, ds, ["contact.K"])
     fd = cal.least_squares(model, ds, ["contact.K"], jacobian="differences")
@@ -121,13 +122,15 @@ def test_diagnosis_fit_with_the_sensitivity_jacobian(tmp_path):
     """The diagnosis's fit (acausal.diagnose.fitting.fit) with
     jacobian="sensitivities": the same optimum as with differences, and its
     Jacobian against the differences' at the optimum."""
+    from acausal.diagnose.problem import Param
     from acausal.diagnose.stages import fitting
     model, ds = _data(tmp_path)
     names = ["spring.c", "damper.d"]
-    kw = dict(x0={"spring.c": 100.0, "damper.d": 2.0}, low={"spring.c": 10.0, "damper.d": 0.0},
-              high={"spring.c": 1e3, "damper.d": 20.0}, scale={"spring.c": 100.0, "damper.d": 2.0})
-    a = fitting.fit(model, ds, names, jacobian="sensitivities", **kw)
-    b = fitting.fit(model, ds, names, **kw)
+    params = (Param("spring.c", 100.0, 10.0, 1e3, 100.0, 100.0),
+              Param("damper.d", 2.0, 0.0, 20.0, 2.0, 2.0))
+    a = fitting.fit(model, ds, params,
+                    refinement=fitting.Refinement(jacobian="sensitivities"))
+    b = fitting.fit(model, ds, params)
     assert a.ok and b.ok
     for n in names:
         assert a.values[n] == pytest.approx(b.values[n], rel=1e-6)

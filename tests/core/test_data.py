@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from acausal.data import (DataError, Dataset, Experiment, Instrument, Trace,
+from acausal.data import (DataError, Dataset, MeasuredExperiment, Instrument, Trace,
                           load_dataset, write_dataset)
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -208,9 +208,9 @@ def _dataset() -> Dataset:
     trace = Trace(time, {"hook.phi": np.radians([0.0, 1.0, 2.5, 4.0, 5.0]),
                          "armature.v": np.array([3.8, 3.0, 2.0, 1.1, 0.4])})
     experiments = [
-        Experiment("V110", {"v_impact": 3.8, "contact.K": 6.25e8},
+        MeasuredExperiment("V110", {"v_impact": 3.8, "contact.K": 6.25e8},
                    {"thrt": 1.9e-3, "contact_period": 3e-4}, trace),
-        Experiment("V120", {"v_impact": 4.0, "contact.K": 6.25e8}, {"thrt": 1.7e-3},
+        MeasuredExperiment("V120", {"v_impact": 4.0, "contact.K": 6.25e8}, {"thrt": 1.7e-3},
                    use="validate"),
     ]
     instrument = {"thrt": Instrument("thrt", 1e-4),
@@ -251,6 +251,6 @@ def test_round_trip(tmp_path, units):
 
 
 def test_write_rejects_missing_condition(tmp_path):
-    data = Dataset(None, [Experiment("a", {"v": 1.0}), Experiment("b", {})])
+    data = Dataset(None, [MeasuredExperiment("a", {"v": 1.0}), MeasuredExperiment("b", {})])
     with pytest.raises(DataError, match="'b' lacks a condition"):
         write_dataset(tmp_path, data)

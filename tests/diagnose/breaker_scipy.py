@@ -200,7 +200,7 @@ def _grid(run):
 def write(folder, effect=None, value=None, seed=0, speeds=V_IMPACT):
     """Write a dataset: one experiment per impact speed, both signals traced
     (acausal's dataset format; the writer is the project's, the data are not)."""
-    from acausal.data import Dataset, Experiment, Instrument, Trace, write_dataset
+    from acausal.data import Dataset, MeasuredExperiment, Instrument, Trace, write_dataset
     rng = np.random.default_rng(seed)
     exps = []
     for i, v in enumerate(speeds):
@@ -210,7 +210,7 @@ def write(folder, effect=None, value=None, seed=0, speeds=V_IMPACT):
         for s in SIGNALS:
             z = run.at(t, s) + rng.normal(0.0, NOISE[s], t.shape)
             cols[s] = RESOLUTION[s] * np.round(z / RESOLUTION[s])
-        exps.append(Experiment(f"B{i + 1}", {"v_impact": float(v)}, {}, Trace(t, cols)))
+        exps.append(MeasuredExperiment(f"B{i + 1}", {"v_impact": float(v)}, {}, Trace(t, cols)))
     inst = {s: Instrument(s, RESOLUTION[s], NOISE[s]) for s in SIGNALS}
     write_dataset(folder, Dataset(None, exps, inst),
                   {"time": "ms", "hook.phi": "deg", "armature.mass.s": "mm"})

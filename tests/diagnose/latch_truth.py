@@ -33,7 +33,7 @@ added, rounded to the sensor's resolution, and written in the dataset format.
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from acausal.data import Dataset, Experiment, Instrument, Trace, write_dataset
+from acausal.data import Dataset, MeasuredExperiment, Instrument, Trace, write_dataset
 
 M_P, M_L = 0.04, 0.02              # plunger and latch masses [kg]
 C_RET, P0 = 300.0, 3.0             # return spring [N/m], its force at x = 0 [N]
@@ -137,7 +137,7 @@ def write(folder, effect=None, value=None, coils=COILS, seed=0, k=K, d=D_L):
         for name, z in zip(SIGNALS, xy):
             z = z + rng.normal(0.0, NOISE, z.shape)
             cols[name] = RESOLUTION * np.round(z / RESOLUTION)
-        exps.append(Experiment(f"L{i + 1}", {"F_coil": float(coil)}, {}, Trace(t, cols)))
+        exps.append(MeasuredExperiment(f"L{i + 1}", {"F_coil": float(coil)}, {}, Trace(t, cols)))
     inst = {s: Instrument(s, RESOLUTION, NOISE) for s in SIGNALS}
     write_dataset(folder, Dataset(None, exps, inst),
                   {"time": "ms", "plunger.s": "mm", "latch.s": "mm"})

@@ -22,7 +22,7 @@ encoder's resolution, and written in the dataset format.
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from acausal.data import Dataset, Experiment, Instrument, Trace, write_dataset
+from acausal.data import Dataset, MeasuredExperiment, Instrument, Trace, write_dataset
 
 J, C, D = 1e-3, 4.0, 1.5e-3     # the rig's nominal inertia, stiffness and damping
 T_END, RATE = 1.6, 2000.0
@@ -73,7 +73,7 @@ def write(folder, effect=None, value=0.0, starts=(0.3, 0.4, 0.5), seed=0, c=C, d
         t, phi = simulate(phi0, effect, value, c, d)
         y = phi + rng.normal(0.0, NOISE, phi.shape)
         y = RESOLUTION * np.round(y / RESOLUTION)
-        exps.append(Experiment(f"R{i + 1}", {"phi_start": float(phi0)}, {},
+        exps.append(MeasuredExperiment(f"R{i + 1}", {"phi_start": float(phi0)}, {},
                                Trace(t, {"rotor.phi": y})))
     inst = {"rotor.phi": Instrument("rotor.phi", RESOLUTION, NOISE)}
     write_dataset(folder, Dataset(None, exps, inst), {"time": "ms", "rotor.phi": "deg"})

@@ -22,7 +22,7 @@ the sensor's resolution, and written in the dataset format.
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from acausal.data import Dataset, Experiment, Instrument, Trace, write_dataset
+from acausal.data import Dataset, MeasuredExperiment, Instrument, Trace, write_dataset
 
 M, C, D = 0.1, 400.0, 0.04          # slider mass, spring, damper (nominal)
 S_LIMIT, K, BETA = 0.008, 1e7, 5e6  # stop position, Hertz stiffness, damping
@@ -87,7 +87,7 @@ def write(folder, effect=None, value=0.0, starts=(-0.012, -0.016, -0.020), seed=
         t, s = simulate(s0, effect, value, c, d)
         y = s + rng.normal(0.0, NOISE, s.shape)
         y = RESOLUTION * np.round(y / RESOLUTION)
-        exps.append(Experiment(f"S{i + 1}", {"s_start": float(s0)}, {},
+        exps.append(MeasuredExperiment(f"S{i + 1}", {"s_start": float(s0)}, {},
                                Trace(t, {"slider.s": y})))
     inst = {"slider.s": Instrument("slider.s", RESOLUTION, NOISE)}
     write_dataset(folder, Dataset(None, exps, inst), {"time": "ms", "slider.s": "mm"})

@@ -233,7 +233,7 @@ def test_blind_drag_with_another_exponent_is_named_by_its_family(tmp_path):
     slider, truth by scipy: the quadratic drag is competitive but leaves
     misfit, the family's power law is fitted there and named."""
     import time
-    from acausal.data import Dataset, Experiment, Instrument, Trace, write_dataset
+    from acausal.data import Dataset, MeasuredExperiment, Instrument, Trace, write_dataset
     from acausal.diagnose.problem import FitSettings
     from acausal.diagnose.report.result import summary
     from acausal.diagnose.run import run_stages
@@ -245,7 +245,7 @@ def test_blind_drag_with_another_exponent_is_named_by_its_family(tmp_path):
         sol = integrate.solve_ivp(
             lambda _, y: [y[1], (-100.0 * y[0] - 3.0 * y[1] * abs(y[1]) ** 0.4) / 1.0],
             (0.0, times[-1]), [s0, 0.0], t_eval=times, rtol=1e-11, atol=1e-13)
-        exps.append(Experiment(name, {"s0": s0}, {}, Trace(
+        exps.append(MeasuredExperiment(name, {"s0": s0}, {}, Trace(
             times, {"mass.s": sol.y[0] + 1e-4 * rng.standard_normal(times.size)})))
     write_dataset(tmp_path / "data", Dataset(str(tmp_path / "data"), exps,
                                             {"mass.s": Instrument("mass.s", 0.0, 1e-4)}))
@@ -295,7 +295,7 @@ def test_blind_dead_band_is_named_by_the_spring_family(tmp_path):
     truth by scipy: outside the cubic law the library used to offer, inside
     the spring-nonlinearity family, whose dead-band member is named."""
     import time
-    from acausal.data import Dataset, Experiment, Instrument, Trace, write_dataset
+    from acausal.data import Dataset, MeasuredExperiment, Instrument, Trace, write_dataset
     from acausal.diagnose.problem import FitSettings
     from acausal.diagnose.report.result import summary
     from acausal.diagnose.run import run_stages
@@ -308,7 +308,7 @@ def test_blind_dead_band_is_named_by_the_spring_family(tmp_path):
             lambda _, y: [y[1], -100.0 * (y[0] - _clip(y[0], 0.01))],
             (0.0, times[-1]), [s0, 0.0], t_eval=times, rtol=1e-11, atol=1e-13,
             max_step=1e-3)
-        exps.append(Experiment(name, {"s0": s0}, {}, Trace(
+        exps.append(MeasuredExperiment(name, {"s0": s0}, {}, Trace(
             times, {"mass.s": sol.y[0] + 1e-4 * rng.standard_normal(times.size)})))
     write_dataset(tmp_path / "data", Dataset(str(tmp_path / "data"), exps,
                                             {"mass.s": Instrument("mass.s", 0.0, 1e-4)}))

@@ -16,11 +16,11 @@ import os
 import numpy as np
 import pytest
 
-from acausal.data import Dataset, Experiment, Instrument, Trace
+from acausal.data import Dataset, MeasuredExperiment, Instrument, Trace
 from acausal.diagnose.stages.fitting import Fit
 from acausal.diagnose.problem import Candidate, FitSettings, Param, Problem
 from acausal.diagnose.stages.screen import _free_step
-from acausal.diagnose.stages.chain import Calibration, Row, _lowest_per_key, member_refit_tasks
+from acausal.diagnose.stages.chain import NominalFit, Row, _lowest_per_key, member_refit_tasks
 from acausal.diagnose.stages.tasks import CandidateFit, FitTask, Refiner, Starts, start_points
 from acausal.modelfile import compile_file
 
@@ -31,7 +31,8 @@ TIMES = np.arange(0.0, 0.25 + 1e-12, 5e-3)
 def _slider_data(c=100.0):
     """Noise-free slider traces (x = 0.1 cos(sqrt(c) t)), rate ``c``."""
     x = 0.1 * np.cos(np.sqrt(c) * TIMES)
-    return Dataset(None, [Experiment("a", dict(s0=0.1, v0=0.0), {}, Trace(TIMES, {"mass.s": x}))],
+    return Dataset(None, [MeasuredExperiment("a", dict(s0=0.1, v0=0.0), {},
+                                             Trace(TIMES, {"mass.s": x}))],
                    {"mass.s": Instrument("mass.s", 0.0, 1e-4)})
 
 
@@ -87,7 +88,7 @@ class _Dec:
 def _cal():
     fit = _fit({"k.c": 50.0}, 10.0)
     fit.jacobian = np.ones((3, 1))
-    return Calibration(CandidateFit(Candidate(None, None, ()), fit, wall_s=0.1))
+    return NominalFit(CandidateFit(Candidate(None, None, ()), fit, wall_s=0.1))
 
 
 def test_a_best_pair_has_its_members_refitted_alone_from_its_point():

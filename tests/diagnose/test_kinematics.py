@@ -13,7 +13,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from acausal.data import Dataset, Experiment, Instrument, Trace, write_dataset
+from acausal.data import Dataset, MeasuredExperiment, Instrument, Trace, write_dataset
 from acausal.diagnose.stages.fitting import Fit
 from acausal.diagnose.library.hypotheses import HYPOTHESES, build_extended
 from acausal.diagnose.stages.kinematics import (
@@ -37,7 +37,7 @@ def _dataset(folder):
     for name, x0 in (("a", 0.01), ("b", 0.016)):
         res = cm.simulate(params={"x0": x0}, **mf.experiment.run_options())
         trace = Trace(np.asarray(res.t), {"slider.s": np.asarray(res["slider.s"])})
-        exps.append(Experiment(name, {"x0": x0}, {}, trace))
+        exps.append(MeasuredExperiment(name, {"x0": x0}, {}, trace))
     write_dataset(folder, Dataset(str(folder), exps,
                                   {"slider.s": Instrument("slider.s", 0.0, 1e-6)}))
     return folder
@@ -195,7 +195,8 @@ def test_a_diagnosis_reports_the_tied_site(tmp_path):
     for name, x0 in (("a", 0.01), ("b", 0.016), ("c", 0.02)):
         res = cm.simulate(params={"x0": x0, "hyp_cf.tau": 0.002}, **mf.experiment.run_options())
         s = np.asarray(res["slider.s"]) + 1e-6 * rng.standard_normal(len(res.t))
-        exps.append(Experiment(name, {"x0": x0}, {}, Trace(np.asarray(res.t), {"slider.s": s})))
+        exps.append(MeasuredExperiment(name, {"x0": x0}, {},
+                                       Trace(np.asarray(res.t), {"slider.s": s})))
     write_dataset(tmp_path / "data", Dataset(str(tmp_path / "data"), exps,
                                              {"slider.s": Instrument("slider.s", 0.0, 1e-6)}))
     out = diagnose(LEVER, tmp_path / "data", out_dir=tmp_path / "out", workers=1,

@@ -16,7 +16,7 @@ import pytest
 from scipy import integrate
 
 from acausal.runtime.model import CompiledModel
-from acausal.data import Dataset, Experiment, Instrument, Trace, write_dataset
+from acausal.data import Dataset, MeasuredExperiment, Instrument, Trace, write_dataset
 from acausal.diagnose.problem import FitSettings
 from acausal.diagnose.report.markdown import write_report
 from acausal.diagnose.report.result import summary
@@ -44,7 +44,7 @@ def true_slider(s0, v0, times):
 def slider(tmp_path_factory):
     d = tmp_path_factory.mktemp("slider")
     rng = np.random.default_rng(5)
-    exps = [Experiment(name, dict(s0=s0, v0=v0), {},
+    exps = [MeasuredExperiment(name, dict(s0=s0, v0=v0), {},
                        Trace(TIMES, {"mass.s": true_slider(s0, v0, TIMES)
                                      + FLOOR * rng.standard_normal(TIMES.size)}))
             for name, s0, v0 in (("a", 0.1, 0.0), ("b", 0.08, -0.1))]
@@ -149,7 +149,7 @@ def test_blind_next_experiment_then_the_second_run_names_one_cause(tmp_path):
     experiment are added, and the second run names Coulomb friction alone."""
     rng = np.random.default_rng(7)
     runs = [("a", 0.1, 0.0), ("b", 0.08, -0.1)]
-    exps = [Experiment(n, dict(s0=s0, v0=v0), {}, Trace(
+    exps = [MeasuredExperiment(n, dict(s0=s0, v0=v0), {}, Trace(
         TIMES, {"mass.s": true_slider(s0, v0, TIMES) + FLOOR * rng.standard_normal(TIMES.size)}))
         for n, s0, v0 in runs]
     inst = {"mass.s": Instrument("mass.s", 0.0, FLOOR)}
@@ -170,7 +170,7 @@ def test_blind_next_experiment_then_the_second_run_names_one_cause(tmp_path):
                                        "stribeck_friction"))
     c = nxt["conditions"]
     y = stick_slip(c["s0"], c["v0"], TIMES) + FLOOR * rng.standard_normal(TIMES.size)
-    exps.append(Experiment("next", dict(c), {}, Trace(TIMES, {"mass.s": y})))
+    exps.append(MeasuredExperiment("next", dict(c), {}, Trace(TIMES, {"mass.s": y})))
     write_dataset(tmp_path / "d2", Dataset(str(tmp_path / "d2"), exps, inst))
     second = summary(run_stages(SLIDER, tmp_path / "d2", out_dir=tmp_path / "o2", **kw))
     assert second["cause"] == "coulomb_friction" and second["location"] == "mass"
@@ -193,7 +193,7 @@ def test_without_declared_conditions_the_separation_is_stated():
     from acausal.diagnose.stages.nextexp import _fixed_only
     t = np.linspace(0.0, 1.0, 11)
     rivals = {"a": lambda c: {"y": c["k"] * t}, "b": lambda c: {"y": c["k"] * t + 0.02}}
-    ref = Experiment("e1", {"k": 2.0}, {}, Trace(t, {"y": 2.0 * t}))
+    ref = MeasuredExperiment("e1", {"k": 2.0}, {}, Trace(t, {"y": 2.0 * t}))
     got = _fixed_only(rivals, [Signal("y", 0.01)], ref, t).to_dict()
     assert got["conditions"] == {} and got["decisive"] is False
     assert got["separation_floors"] == pytest.approx(2.0 * np.sqrt(11))

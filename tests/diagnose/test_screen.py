@@ -102,10 +102,11 @@ def test_members_within_reach_beyond_the_budget_are_returned_unfitted():
     a0 = st.aicc(100.0, n, 1, 1.0)
     dec = NS(rows=[NS(aicc=a_best)], a0=a0, c_hat=1.0)
 
-    def run_tasks(ex, fn, tasks, label, progress):
+    def run(fn, tasks, label, checkpoint=True, progress=None):
+        assert not checkpoint and progress is False    # a quick screen: no checkpoint, no bar
         return [cols[t.candidate.key] for t in tasks]
 
-    got = screen.screened(problem, NS(fit=f0), dec, cands, None, run_tasks)
+    got = screen.screened(NS(run=run), problem, NS(fit=f0), dec, cands)
     reach = a_best + max(screen.MARGIN, screen.SHARE * (a0 - a_best))
     within = [c.location for c, S in zip(cands, COSTS)
               if st.aicc(float(S), n, 2, 1.0) < reach]

@@ -8,7 +8,7 @@ import pytest
 from sympy import Eq
 
 from acausal import Component, Flange, Model, Parameter, Variable, der
-from acausal.data import Dataset, Experiment, Trace
+from acausal.data import Dataset, MeasuredExperiment, Trace
 from acausal.diagnose import HYPOTHESES, ModelGraph
 from acausal.diagnose.library.domain import ROTATIONAL, TRANSLATIONAL, domain_of
 from acausal.diagnose.stages.fitting import Fit
@@ -80,7 +80,7 @@ def test_starts_include_the_uncalibrated_free_values():
 
 def test_window_cuts_traces_and_drops_measures():
     t = np.linspace(0.0, 1.0, 11)
-    ds = Dataset(None, [Experiment("E", {"a": 1.0}, {"m": 2.0}, Trace(t, {"x": t ** 2}))])
+    ds = Dataset(None, [MeasuredExperiment("E", {"a": 1.0}, {"m": 2.0}, Trace(t, {"x": t ** 2}))])
     w = window(ds, 0.3)
     assert w.experiments[0].measures == {}
     assert np.allclose(w.experiments[0].trace.time, [0.0, 0.1, 0.2, 0.3])

@@ -104,14 +104,16 @@ def test_akaike_weights():
 
 def test_weak_evidence_rules_real_data_like():
     """Six 0.1 ms readings and one more, four parameters, a small gain."""
-    reasons = st.weak_evidence(n=7, k=3, d_null=-4.0, d_runner=0.5, heldout_nominal=2.0,
-                               heldout_best=1.9, ci_rel=3.0, c_hat=4.0, coarse=0.66)
+    reasons = st.weak_evidence(st.Evidence(n=7, k=3, d_null=-4.0, d_runner=0.5,
+                                           heldout_nominal=2.0, heldout_best=1.9, ci_rel=3.0,
+                                           c_hat=4.0, coarse=0.66))
     text = " | ".join(reasons)
     for part in ("too few data: 7 values for 3", "4.0 units worse", "only 0.5", "1.9",
                  "300%", "2x the noise", "0.66 resolution steps"):
         assert part in text
-    assert st.weak_evidence(n=600, k=3, d_null=300, d_runner=20, heldout_nominal=3.0,
-                            heldout_best=1.0, ci_rel=0.05, c_hat=1.0, coarse=4.0) == []
+    assert st.weak_evidence(st.Evidence(n=600, k=3, d_null=300, d_runner=20, heldout_nominal=3.0,
+                                        heldout_best=1.0, ci_rel=0.05, c_hat=1.0,
+                                        coarse=4.0)) == []
 
 
 def _linear_fit(X, y, groups):

@@ -15,7 +15,7 @@ several at once as a dict {effect: value}. Both positions are sampled at
 RATE Hz, Gaussian noise added and rounded to a 1 um sensor's resolution."""
 import numpy as np
 from scipy.integrate import solve_ivp
-from acausal.data import Dataset, Experiment, Instrument, Trace, write_dataset
+from acausal.data import Dataset, MeasuredExperiment, Instrument, Trace, write_dataset
 
 M1, M2, K1, D1, K2, D2 = 0.5, 0.2, 2000.0, 1.0, 800.0, 0.2
 T_END, RATE, NOISE, RES = 1.5, 2000.0, 2e-6, 1e-6
@@ -53,7 +53,7 @@ def write(folder, effect=None, value=0.0, seed=0):
         for s, x in zip(SIG, (x1, x2)):
             y = x + rng.normal(0.0, NOISE, x.shape)
             cols[s] = RES * np.round(y / RES)
-        exps.append(Experiment(f"T{i + 1}", {"x2_start": x20}, {}, Trace(t, cols)))
+        exps.append(MeasuredExperiment(f"T{i + 1}", {"x2_start": x20}, {}, Trace(t, cols)))
     inst = {s: Instrument(s, RES, NOISE) for s in SIG}
     write_dataset(folder, Dataset(None, exps, inst), {"time": "ms", "m1.s": "mm", "m2.s": "mm"})
     return folder

@@ -140,6 +140,12 @@ def test_clutch_engages_and_locks_at_the_momentum_time():
     assert fin["clutch.mode"] == 0 and abs(fin["clutch.tau"]) < 1e-9
     phi_a = w1 * t_lock - tau / J1 * (t_lock - t_on) ** 2 / 2 + wc * (2.0 - t_lock)
     assert abs(fin["a.phi"] - phi_a) < 1e-8
+    # the friction's loss power (linear in t while slipping) integrates to the
+    # kinetic energy lost
+    lost = 0.5 * J1 * w1 ** 2 + 0.5 * J2 * w2 ** 2 - 0.5 * (J1 + J2) * wc ** 2
+    p = res["clutch.lossPower"]
+    assert abs(np.sum((p[1:] + p[:-1]) / 2 * np.diff(res.t)) - lost) < 1e-9 * lost
+    assert np.min(p) > -1e-9
 
 
 @pytest.mark.parametrize("backend", ["sundae", "compiled"])

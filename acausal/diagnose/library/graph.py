@@ -2,7 +2,7 @@
 
 A :class:`ModelGraph` is built from an *uncompiled* :class:`~acausal.Model`.
 It joins the connectors into nodes (as flattening does) and lists the
-sites where the hypotheses of :mod:`acausal.diagnose.hypotheses` can insert
+sites where the hypotheses of :mod:`acausal.diagnose.library.hypotheses` can insert
 a component:
 
 * ``body``: a rigid body with one flange (:class:`PartialRigid`,

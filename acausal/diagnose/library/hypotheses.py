@@ -1,7 +1,7 @@
 """The library of physical causes diagnosis can name.
 
 Each :class:`Hypothesis` is a model extension: at a location of the model
-graph (:class:`~acausal.diagnose.graph.ModelGraph`) it inserts a component
+graph (:class:`~acausal.diagnose.library.graph.ModelGraph`) it inserts a component
 whose magnitude is a new model-level parameter (in a sub-model named
 ``hyp_<short>``, e.g. ``hyp_cf.F``). Every magnitude starts at 0, where the
 extended model is the nominal one (to the solver's tolerance: measured
@@ -109,7 +109,7 @@ class Hypothesis:
     fixed = {}          # name -> default of parameters added but not fitted
     odd = True          # the law is odd in the site's motion (friction, drag): the same
     #                     cause at a site moving the other way has the same sign
-    #                     (acausal.diagnose.kinematics.convert); False: a constant load
+    #                     (acausal.diagnose.stages.kinematics.convert); False: a constant load
     relative_cost = 1.0  # a simulation's cost against the nominal model's (task ordering)
 
     # -- interface ------------------------------------------------------------------
@@ -169,7 +169,7 @@ class Hypothesis:
                  f"_HYPOTHESES[{self.id!r}].renamed({self.prefix!r})")
         return (f"# hypothesis {self.id} at {location}: {self.title}\n"
                 f"#   {self.law}\n"
-                "from acausal.diagnose.hypotheses import HYPOTHESES as _HYPOTHESES\n"
+                "from acausal.diagnose.library.hypotheses import HYPOTHESES as _HYPOTHESES\n"
                 f"hypothesis_specs = {which}.apply(model, {location!r}, "
                 f"{{{vals}}})\n")
 
@@ -353,7 +353,11 @@ class HardeningSpring(Hypothesis):
         _parallel_force(model, hyp, "cubic", spring, d, lambda x: k3 * u(x) ** 3)
 
 
-class Clearance(Hypothesis):
+class ExtraClearance(Hypothesis):
+    """The hypothesis of an extra clearance (gap) before a contact (not the
+    component :class:`acausal.mechanics.contact.Clearance`, one of the
+    contacts it acts on)."""
+
     id = "clearance"
     title = "A clearance (gap) before a contact"
     prefix = "hyp_gap"
@@ -871,7 +875,7 @@ def _same_damping(law, target, e):
 
 
 HYPOTHESES = {h.id: h for h in (CoulombFriction(), QuadraticDamping(), ConstantLoad(),
-                                 HardeningSpring(), Clearance(), FlexibleLink(),
+                                 HardeningSpring(), ExtraClearance(), FlexibleLink(),
                                  PositionDependentForce(), ContactDampingLaw(),
                                  CoulombViscousFriction(), StribeckFriction(), PowerDrag(),
                                  BilinearSpring(), DeadBandSpring(), RestitutionPowerLaw())
@@ -1042,3 +1046,14 @@ plot = _base.namespace.get("plot")
     with open(out_abs, "w") as fh:
         fh.write(src)
     return out_abs
+
+
+def __getattr__(name):
+    """``Clearance``: the old name of :class:`ExtraClearance` (deprecated:
+    :class:`acausal.mechanics.contact.Clearance` is the component)."""
+    if name == "Clearance":
+        import warnings
+        warnings.warn("acausal.diagnose.library.hypotheses.Clearance is now ExtraClearance",
+                      DeprecationWarning, stacklevel=2)
+        return ExtraClearance
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

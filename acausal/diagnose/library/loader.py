@@ -1,5 +1,5 @@
 """Where the diagnosis finds its hypotheses: by default
-:mod:`acausal.diagnose.hypotheses` (with :mod:`acausal.diagnose.graph`); any
+:mod:`acausal.diagnose.library.hypotheses` (with :mod:`acausal.diagnose.library.graph`); any
 module with the same interface (``HYPOTHESES``, ``build_extended``,
 ``write_extended_model`` and optionally ``ModelGraph``, ``build_pair`` and
 ``FAMILIES``) can stand in, named

@@ -1,5 +1,5 @@
 """The diagnosis report: ``report.md`` and its plots, a pure view of a
-:class:`~acausal.diagnose.result.Diagnosis` (it simulates nothing: the
+:class:`~acausal.diagnose.report.result.Diagnosis` (it simulates nothing: the
 traces it shows were computed by the views stage, :mod:`.views`)."""
 from __future__ import annotations
 

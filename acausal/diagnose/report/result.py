@@ -8,29 +8,46 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...data import Dataset
+from ..library.loader import FamilyIndex
+from ..problem import Problem
+from ..stages.chain import CrossValidation, Decision, NominalFit, Ranking
+from ..stages.intervals import Intervals
+from ..stages.kinematics import Kinematics
+from ..stages.locate import Location
+from ..stages.nextexp import NextStep
 from ..stages.stats import OVERDISPERSION
+from ..stages.views import Views
 
 
-@dataclass
+@dataclass(frozen=True, kw_only=True)
 class Diagnosis:
-    """Everything the stages produced (:mod:`.stages`)."""
+    """Everything the stages produced (:mod:`acausal.diagnose.run`), built by
+    keyword. ``calibration``: the nominal fit; ``n_candidates``: candidates
+    fitted in the fit stage; ``cv``: the exact leave-one-out refits;
+    ``extended_model``: the file written for the named cause (None: none
+    named); ``views``, ``next_experiment``, ``location``, ``intervals``,
+    ``kinematics``: None when their stage did not run; ``families``: the
+    library's families (None: it has none); ``timing``: the stages' wall
+    times and simulation counts; ``tied``: the
+    :class:`~.stages.kinematics.SiteEquivalence` of the shown row's members."""
 
-    problem: object               # problem.Problem
-    dataset: object               # data.Dataset
-    calibration: object           # stages.Calibration
+    problem: Problem
+    dataset: Dataset
+    calibration: NominalFit
     n_candidates: int
-    decision: object              # stages.Decision
-    cv: object                    # stages.CrossValidation
-    ranking: object               # stages.Ranking
-    extended_model: str | None
-    views: object = None          # views.Views (None: not computed)
-    next_experiment: object = None  # nextexp.NextStep (None: not run)
+    decision: Decision
+    cv: CrossValidation
+    ranking: Ranking
+    extended_model: str | None = None
+    views: Views | None = None
+    next_experiment: NextStep | None = None
     timing: dict = field(default_factory=dict)
-    location: object = None       # locate.Location (None: not run)
-    intervals: object = None      # intervals.Intervals (None: not run)
-    families: object = None       # families.FamilyIndex (None: no families)
-    kinematics: object = None     # kinematics.Kinematics (None: not run)
-    tied: tuple = ()              # kinematics.SiteEquivalence of the shown row's members
+    location: Location | None = None
+    intervals: Intervals | None = None
+    families: FamilyIndex | None = None
+    kinematics: Kinematics | None = None
+    tied: tuple = ()
 
 
 def num(x):

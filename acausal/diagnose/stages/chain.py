@@ -1,15 +1,16 @@
-"""The diagnosis as a chain of stages, each a function from small
-dataclasses to a new one (none mutates its input):
+"""The diagnosis's main stages, each a function of small dataclasses
+returning a new one (none mutates its input), with the tasks it sends to
+the executor run through a :class:`.context.Context`:
 
 calibrate -> candidates -> fit -> decide -> cross-validate -> rank ->
-extend -> views (the simulated traces and fingerprints the report shows);
-the family members (:mod:`.families`), the located term (:mod:`.locate`),
-the intervals (:mod:`.intervals`) and the next experiment
-(:mod:`.nextexp`) are stages of their own modules.
+extend; the family members (:mod:`.families`), the located term
+(:mod:`.locate`), the intervals (:mod:`.intervals`), the next experiment
+(:mod:`.nextexp`) and the views (:mod:`.views`) are stages of their own
+modules. :mod:`acausal.diagnose.run` chains them, each as
+``stage(ctx, state) -> state``.
 
 The worker-side units of work are in :mod:`.tasks`; the statistics in
-:mod:`.stats`; :mod:`.run` chains the stages and :mod:`.report` renders
-the result.
+:mod:`.stats`; :mod:`acausal.diagnose.report` renders the result.
 """
 from __future__ import annotations
 
@@ -26,10 +27,11 @@ from ...errors import AcausalError, DiagnosisError  # noqa: F401  (DiagnosisErro
 from ...modelfile import compile_file
 from . import pairsearch as ps
 from . import stats as st
-from .fitting import heldout_rms
+from .context import Context, longest_first, run_tasks  # noqa: F401 (run_tasks re-exported)
+from .fitting import Fit, heldout_rms
 from ..library.loader import load_library
 from ..problem import NOMINAL, Candidate, FitSettings, Param, Problem, free_param, pair_of
-from .tasks import CandidateFit, FitTask, LooTask, calibrate_nominal, fit_candidate, \
+from .tasks import CandidateFit, FitTask, LooTask, Starts, calibrate_nominal, fit_candidate, \
     refit_without
 
 BUDGET_FACTOR = 12.0  # a candidate fit stops when it takes this many times the nominal fit
@@ -171,50 +173,13 @@ def candidates(problem: Problem, hypotheses=None, locations=None) -> tuple:
     return tuple(out)
 
 
-# -- running tasks ----------------------------------------------------------------------------
-def run_tasks(ex, fn, tasks, desc, progress, collect=None):
-    """Submit ``fn(task)`` for each task; results in task order. ``collect``
-    (task, result) is called as each result arrives (a checkpoint store
-    plugs in here: results depend only on their task); a ``collect`` with
-    ``get(task)`` (:class:`.resume.FitStore`) also gives the results of
-    tasks that finished in an earlier, interrupted run, which are not
-    submitted again. Tasks are submitted longest first (:func:`longest_first`)."""
-    lookup = getattr(collect, "get", None)
-    out = [lookup(t) if lookup is not None else None for t in tasks]
-    todo = longest_first([i for i, r in enumerate(out) if r is None], tasks)
-    futures = [ex.submit(fn, tasks[i]) for i in todo]
-    index = {id(f): i for i, f in zip(todo, futures)}
-    bar = None
-    if progress:
-        from tqdm.auto import tqdm
-        bar = tqdm(total=len(tasks), desc=desc, unit="fit", initial=len(tasks) - len(todo))
-    try:
-        for fut in ex.as_completed(futures):
-            i = index[id(fut)]
-            out[i] = fut.result()
-            if collect is not None:
-                collect(tasks[i], out[i])
-            if bar is not None:
-                bar.update(1)
-    finally:
-        if bar is not None:
-            bar.close()
-    return out
-
-
-def longest_first(indices, tasks):
-    """``indices`` of ``tasks`` ordered by decreasing expected cost (a task's
-    ``cost`` attribute, 1 without one; ties keep their order): the pool
-    hands tasks out in submission order, so the longest ones no longer
-    start last and leave a worker idle at the end of a stage (Graham's
-    longest-processing-time-first list scheduling)."""
-    return sorted(indices, key=lambda i: -float(getattr(tasks[i], "cost", 1.0)))
-
-
 # -- stage 1: calibrate ---------------------------------------------------------------------
 @dataclass
-class Calibration:
-    """The nominal fit and what the free parameters did."""
+class NominalFit:
+    """Stage 1's result: the nominal model's fit (its free parameters
+    calibrated) and what the free parameters did. (Not
+    :class:`acausal.studies.calibrate.Calibration`, a calibration study's
+    result.)"""
 
     nominal: CandidateFit
     drift: tuple = ()             # Drift of each free parameter
@@ -244,19 +209,19 @@ def _drift(problem, fit):
     return tuple(out)
 
 
-def calibrate(problem: Problem, ex, progress=True, collect=None) -> Calibration:
+def calibrate(ctx: Context, problem: Problem) -> NominalFit:
     """Stage 1: the nominal model's free parameters by weighted output error
     (multi-start and growing window: :func:`.tasks.calibrate_nominal`)."""
     task = FitTask(problem, NOMINAL, problem.free)
-    nominal = run_tasks(ex, calibrate_nominal, [task], "calibrating", progress, collect)[0]
+    nominal = ctx.run(calibrate_nominal, [task], "calibrating")[0]
     if not nominal.ok:
         why = nominal.error or (nominal.fit.message if nominal.fit else "no fit")
         raise DiagnosisError(f"the nominal model could not be fitted: {why}")
-    return Calibration(nominal, _drift(problem, nominal.fit))
+    return NominalFit(nominal, _drift(problem, nominal.fit))
 
 
 # -- stage 3: fit ---------------------------------------------------------------------------
-def fit_tasks(problem: Problem, cal: Calibration, cands) -> list:
+def fit_tasks(problem: Problem, cal: NominalFit, cands) -> list:
     """One :class:`FitTask` per candidate, starting from the calibrated
     free parameters (their priors kept for the uncalibrated starts)."""
     f0 = cal.fit
@@ -267,10 +232,10 @@ def fit_tasks(problem: Problem, cal: Calibration, cands) -> list:
     return [FitTask(problem, c, free, absorb, budget) for c in cands]
 
 
-def fit(problem: Problem, cal: Calibration, cands, ex, progress=True, collect=None) -> tuple:
+def fit(ctx: Context, problem: Problem, cal: NominalFit, cands) -> tuple:
     """Stage 3: every candidate fitted (:func:`.tasks.fit_candidate`)."""
     tasks = fit_tasks(problem, cal, cands)
-    return tuple(run_tasks(ex, fit_candidate, tasks, "fitting candidates", progress, collect))
+    return tuple(ctx.run(fit_candidate, tasks, "fitting candidates"))
 
 
 # -- stage 3b: pairs ------------------------------------------------------------------------
@@ -321,7 +286,7 @@ def partners(dec, done) -> tuple:
     return tuple(out)
 
 
-def search_pairs(problem: Problem, cal, dec, ex, progress=True, collect=None):
+def search_pairs(ctx: Context, problem: Problem, cal: NominalFit, dec: Decision):
     """Stage 3b: (fits of the pairs, simulations spent screening): the
     pairs among the best singles (:func:`pair_candidates`) fitted, and the
     best single's pairs with every other candidate at another site
@@ -334,15 +299,14 @@ def search_pairs(problem: Problem, cal, dec, ex, progress=True, collect=None):
     tasks = fit_tasks(problem, cal, top)
     budget = _budget(cal)
     others = partners(dec, {c.key for c in top})
-    screened = run_tasks(ex, ps.screen_pair, ps.screen_tasks(problem, _singles(dec)[0], others),
-                         "screening pairs", progress, collect) if others else []
+    screened = ctx.run(ps.screen_pair, ps.screen_tasks(problem, _singles(dec)[0], others),
+                       "screening pairs") if others else []
     best = _singles(dec)[0] if others else None
     tasks += ps.full_tasks(problem, cal, ps.keep(best, screened) if best else [], budget)
-    fits = run_tasks(ex, fit_candidate, tasks, "fitting pairs", progress, collect)
+    fits = ctx.run(fit_candidate, tasks, "fitting pairs")
     simpler = ps.simpler_tasks(problem, cal, fits, dec.c_hat, budget,
                                {t.candidate.key for t in tasks})
-    fits += run_tasks(ex, fit_candidate, simpler, "fitting simpler mates", progress,
-                      collect) if simpler else []
+    fits += ctx.run(fit_candidate, simpler, "fitting simpler mates") if simpler else []
     return tuple(fits), sum(r.n_sim for r in screened)
 
 
@@ -396,8 +360,8 @@ class Row:
     """One fitted candidate, scored (a ranking row)."""
 
     candidate: Candidate
-    fit: object                   # fitting.Fit
-    starts: object                # tasks.Starts
+    fit: Fit
+    starts: Starts
     loo: dict
     aicc: float
     lr_p: float
@@ -468,7 +432,7 @@ def _lowest_per_key(fits):
     return list(best.values())
 
 
-def decide(ds, cal: Calibration, fits, alpha=st.ALPHA) -> Decision:
+def decide(ds, cal: NominalFit, fits, alpha=st.ALPHA) -> Decision:
     """Stage 4: score every fitted candidate and decide whether there is a
     discrepancy (chi-square, runs, likelihood ratio of the best candidate)."""
     f0 = cal.fit
@@ -517,11 +481,11 @@ def _loo_tasks(problem, ds, jobs, budget):
     return out
 
 
-def cross_validate(problem, ds, cal, dec: Decision, ex, exact=True, progress=True,
-                   ) -> CrossValidation:
+def cross_validate(ctx: Context, problem: Problem, ds, cal: NominalFit, dec: Decision,
+                   exact=True) -> CrossValidation:
     """Stage 5: refit the nominal model and the best candidate without each
     experiment (the SMALL_TOP best on small datasets, where the linearised
-    shortcut is poor)."""
+    shortcut is poor); not checkpointed."""
     if not exact or len(ds.experiments) < 2:
         return CrossValidation()
     n = cal.fit.n
@@ -532,8 +496,8 @@ def cross_validate(problem, ds, cal, dec: Decision, ex, exact=True, progress=Tru
         jobs.append((dec.rows[0].candidate, dec.rows[0].fit))
     budget = max(BUDGET_MIN_S, BUDGET_FACTOR * cal.nominal.wall_s)
     out = {}
-    for r in run_tasks(ex, refit_without, _loo_tasks(problem, ds, jobs, budget),
-                       "leave-one-out", progress):
+    for r in ctx.run(refit_without, _loo_tasks(problem, ds, jobs, budget), "leave-one-out",
+                     checkpoint=False):
         out.setdefault(r.candidate.key, {})[r.held] = r.residuals
     return CrossValidation(out)
 
@@ -676,7 +640,7 @@ def _unfitted_reasons(unfitted):
             f"cannot be ruled out" for u in unfitted][:3]
 
 
-def rank(ds, cal: Calibration, dec: Decision, cv: CrossValidation, unfitted=()) -> Ranking:
+def rank(ds, cal: NominalFit, dec: Decision, cv: CrossValidation, unfitted=()) -> Ranking:
     """Stage 6: exact held-out errors in, classes, weak-evidence rules; a
     cause is never named while a rival candidate is untested, or screened
     as plausible and left unfitted (``unfitted``: :class:`.screen.Unfitted`)."""
@@ -694,11 +658,11 @@ def rank(ds, cal: Calibration, dec: Decision, cv: CrossValidation, unfitted=()) 
     best = 0 if rows else None
     if dec.discrepancy and rows:
         b = rows[0]
-        weak = st.weak_evidence(
+        weak = st.weak_evidence(st.Evidence(
             n=cal.fit.n, k=b.k, d_null=dec.a0 - b.aicc,
             d_runner=None if runner is None else rows[runner].aicc - b.aicc,
             heldout_nominal=held0, heldout_best=b.heldout_rmse, ci_rel=_ci_rel(b),
-            c_hat=dec.c_hat, coarse=_coarse(ds, cal.fit))
+            c_hat=dec.c_hat, coarse=_coarse(ds, cal.fit)))
         weak += _untested_reasons(untested, b) + _unfitted_reasons(unfitted)
         weak += _pair_reasons(b, rows) + _bound_reasons(b)
     cause = best if (dec.discrepancy and rows and not weak) else None
@@ -765,3 +729,14 @@ def extend(problem: Problem, ranking: Ranking, out_dir) -> str | None:
                              f"'# hypothesis' line written by the library)")
     Path(path).write_text(text[:i + 1] + "\n".join(lines) + "\n\n" + text[i + 1:])
     return path
+
+
+def __getattr__(name):
+    """``Calibration``: the old name of :class:`NominalFit` (deprecated: a
+    calibration study's result is :class:`acausal.studies.calibrate.Calibration`)."""
+    if name == "Calibration":
+        import warnings
+        warnings.warn("acausal.diagnose.stages.chain.Calibration is now NominalFit",
+                      DeprecationWarning, stacklevel=2)
+        return NominalFit
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

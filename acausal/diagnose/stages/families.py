@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from ..library.loader import FamilyIndex, family_index, load_library  # noqa: F401 (re-exported)
 from ..problem import Candidate, Param
 from .screen import screened
-from .chain import fit_tasks, run_tasks
+from .chain import fit_tasks
 from .tasks import fit_candidate
 
 TOP = 4               # members are fitted at the sites of the TOP best single candidates
@@ -75,7 +75,7 @@ class Members:
     unfitted: tuple = ()
 
 
-def fit_members(problem, cal, dec, ex, progress=True, collect=None) -> Members:
+def fit_members(ctx, problem, cal, dec) -> Members:
     """Stage: the other members of each competitive family, fitted at the
     head's site with the free parameters starting from the head's fit, and
     the members elsewhere that a one-step score screen finds promising
@@ -92,11 +92,10 @@ def fit_members(problem, cal, dec, ex, progress=True, collect=None) -> Members:
              for t, (_, head) in zip(tasks, pairs)]
     rest = other_members(problem, dec, index, done | {c.key for c, _ in pairs})
     # a screened member starts where the step predicts: one refinement suffices
-    screen = screened(problem, cal, dec, rest, ex, run_tasks)
+    screen = screened(ctx, problem, cal, dec, rest)
     tasks += [dataclasses.replace(t, seed_free=free) for t, (_, free) in zip(
         fit_tasks(problem.one_start(), cal, [c for c, _ in screen.picks]), screen.picks)]
-    fits = tuple(run_tasks(ex, fit_candidate, tasks, "fitting family members", progress,
-                           collect)) if tasks else ()
+    fits = tuple(ctx.run(fit_candidate, tasks, "fitting family members")) if tasks else ()
     return Members(fits, screen.unfitted)
 
 

@@ -3,10 +3,10 @@ model file extended with a hypothesis) fitted to a dataset by weighted least
 squares with the event-correct simulation, plus its leave-one-experiment-out
 errors (exact refits, or the linearised shortcut from the Jacobian).
 
-Residuals are the calibration's (:func:`acausal.calibrate.residual_vector`):
+Residuals are the calibration's (:mod:`acausal.studies.residuals`):
 (simulated - measured) / sigma, sigma the instrument floor of the signal, so
 every number here is in units of the noise floor (1 = what the instrument
-alone explains).
+alone explains); each experiment is simulated as :class:`FitRuns` says.
 """
 from __future__ import annotations
 
@@ -17,9 +17,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import optimize, stats
 
-from ...studies.calibrate import FD_STEP, ForwardDifferences, resolve
-from ...data import Dataset
+from ...studies.calibrate import FD_STEP
+from ...studies.differences import ForwardDifferences
+from ...studies.residuals import WeightedResiduals, resolve, weighted_jacobian, \
+    weighted_residuals
 from ...errors import AcausalError
+from ...modelfile import evaluate_measures
 
 PENALTY = 1e3   # weighted residual given to every sample of a failed simulation
 RECENT = 16     # evaluations an Objective remembers (the optimum's residuals reused)
@@ -63,13 +66,6 @@ class Fit:
         return float(np.sqrt(np.mean(r ** 2))) if r.size else float("nan")
 
 
-def subset(dataset: Dataset, names) -> Dataset:
-    """The dataset restricted to the experiments ``names`` (same instrument)."""
-    keep = set(names)
-    return Dataset(dataset.folder, [e for e in dataset.experiments if e.name in keep],
-                   dataset.instrument)
-
-
 def run_options(mf, e):
     """The simulation options of experiment ``e``: the model file's. An
     experiment with a trace and no measures is simulated only up to its
@@ -88,34 +84,31 @@ def run_options(mf, e):
     return opts
 
 
-def weighted_residuals(model, dataset, params, backend=None):
-    """(vector, groups, signals) of weighted residuals for ``params``, as
-    :func:`acausal.calibrate.residual_vector` (measures first, then trace
-    samples), except that an experiment without measures is simulated only
-    up to its last trace sample (a growing-window fit then pays only for
-    its window, with output at the sample times: :func:`run_options`) and its
-    measures are not evaluated. ``backend``: the
-    integrator (:func:`acausal.simulate.simulate`; None: the library's)."""
-    from ...studies.calibrate import _sigma
-    from ...modelfile import evaluate_measures
-    mf, cm = resolve(model)
-    vec, groups, signals = [], [], []
-    for e in dataset.experiments:
-        res = cm.simulate(params={**params, **e.conditions}, backend=backend,
-                          **run_options(mf, e))
-        if e.measures:
-            meas = evaluate_measures(mf, res)
-            for m, y in e.measures.items():
-                vec.append((meas[m] - y) / _sigma(dataset, m, y))
-                groups.append(e.name)
-                signals.append(m)
-        if e.trace is not None:
-            for var, ys in e.trace.signals.items():
-                sim = np.interp(e.trace.time, res.t, res[var])
-                vec.extend((sim - ys) / _sigma(dataset, var, ys))
-                groups.extend([e.name] * len(ys))
-                signals.extend([var] * len(ys))
-    return np.asarray(vec, float), groups, signals
+@dataclass(frozen=True)
+class FitRuns:
+    """How the diagnosis simulates an experiment for its residuals
+    (:func:`acausal.studies.residuals.weighted_residuals`): with
+    :func:`run_options` (an experiment without measures only up to its last
+    trace sample, output at the sample times: a growing-window fit then pays
+    only for its window), on the integrator ``backend``
+    (:func:`acausal.runtime.hybrid.simulate`; None: the library's); the
+    measures are evaluated only on an experiment that measures some."""
+
+    backend: str | None = None
+
+    def __call__(self, pair, params, experiment, sensitivities=None):
+        mf, cm = pair
+        extra = {} if sensitivities is None else {"sensitivities": list(sensitivities)}
+        res = cm.simulate(params={**params, **experiment.conditions}, backend=self.backend,
+                          **extra, **run_options(mf, experiment))
+        return res, (evaluate_measures(mf, res) if experiment.measures else {})
+
+
+def residuals_of(model, dataset, params, backend=None) -> WeightedResiduals:
+    """The weighted residuals of ``model`` at ``params`` as the diagnosis's
+    fits see them (:class:`FitRuns` on ``backend``). A failed run raises its
+    AcausalError."""
+    return weighted_residuals(model, dataset, params, FitRuns(backend))
 
 
 def scaled_columns(model, dataset, base, params, step, backend=None, r0=None, inside=True):
@@ -125,62 +118,45 @@ def scaled_columns(model, dataset, base, params, step, backend=None, r0=None, in
     taken backwards where it would pass the parameter's upper bound when
     ``inside``. A failed run raises its AcausalError."""
     if r0 is None:
-        r0 = weighted_residuals(model, dataset, base, backend)[0]
+        r0 = residuals_of(model, dataset, base, backend).vector
     cols = []
     for q in params:
         scale = abs(q.scale) or 1.0
         h = step * scale
         if inside and base[q.name] + h > q.high:
             h = -h
-        r = weighted_residuals(model, dataset, {**base, q.name: base[q.name] + h}, backend)[0]
+        r = residuals_of(model, dataset, {**base, q.name: base[q.name] + h}, backend).vector
         cols.append((r - r0) / (h / scale))
     return r0, (np.array(cols).T if cols else np.zeros((r0.size, 0)))
-
-
-def weighted_jacobian(model, dataset, params, names, backend=None):
-    """(vector, d vector / d params over ``names``) as
-    :func:`weighted_residuals`, the Jacobian from one simulation per
-    experiment with forward sensitivities (:mod:`acausal.sensitivity`; a
-    measure's derivative from :meth:`acausal.result.Result.measure_sensitivity`,
-    a trace sample's from the interpolated sensitivity). Raises the
-    simulation's AcausalError when a run fails."""
-    from ...studies.calibrate import _measure_derivative, _sigma
-    from ...modelfile import evaluate_measures
-    mf, cm = resolve(model)
-    vec, rows = [], []
-    for e in dataset.experiments:
-        res = cm.simulate(params={**params, **e.conditions}, backend=backend,
-                          sensitivities=list(names), **run_options(mf, e))
-        if e.measures:
-            meas = evaluate_measures(mf, res)
-            for m, y in e.measures.items():
-                sigma = _sigma(dataset, m, y)
-                vec.append((meas[m] - y) / sigma)
-                rows.append([_measure_derivative(mf, res, m, n) / sigma for n in names])
-        if e.trace is not None:
-            for var, ys in e.trace.signals.items():
-                sigma = _sigma(dataset, var, ys)
-                vec.extend((np.interp(e.trace.time, res.t, res[var]) - ys) / sigma)
-                rows.extend(np.column_stack([np.interp(e.trace.time, res.t,
-                                                       res.sensitivity(var, n)) / sigma
-                                             for n in names]))
-    return np.asarray(vec, float), np.asarray(rows, float).reshape(len(vec), len(names))
 
 
 class _OutOfTime(Exception):
     """The fit's time budget is spent (raised inside the optimiser)."""
 
 
+@dataclass(frozen=True)
+class Budget:
+    """When an :class:`Objective` stops (:class:`_OutOfTime`): after
+    ``seconds`` of wall time or ``evals`` evaluations (None: no limit)."""
+
+    seconds: float | None = None
+    evals: int | None = None
+
+
 class Objective:
     """The weighted residuals of one model on one dataset as a function of
     the fitted parameters, counting simulations, keeping the best point
-    seen, and stopping (:class:`_OutOfTime`) after ``max_evals``
-    evaluations or ``budget_s`` seconds. A failed simulation gives
-    :data:`PENALTY` residuals (after a first success, which sets the size).
+    seen, and stopping (:class:`_OutOfTime`) when its :class:`Budget` is
+    spent. A failed simulation gives :data:`PENALTY` residuals (after a
+    first success, which sets the size). ``penalty``: (rows P, scales) on the
+    last P.shape[1] parameters; ``jacobian``: see :func:`refine`;
+    ``backend``: the integrator (:class:`FitRuns`).
     """
 
-    def __init__(self, model, dataset, names, fixed=None, budget_s=None, max_evals=None,
-                 penalty=None, jacobian="differences", backend=None):
+    def __init__(self, model, dataset, names, fixed=None, budget=None, penalty=None,
+                 jacobian="differences", backend=None):
+        budget = budget or Budget()
+        budget_s, max_evals = budget.seconds, budget.evals
         self.pair = resolve(model)
         self.jacobian = jacobian      # "differences" or "sensitivities" (see refine)
         self.backend = backend
@@ -194,7 +170,7 @@ class Objective:
         self.size = None
         self.best_cost, self.best_x = np.inf, None
         self.timed = True
-        self.recent = OrderedDict()   # x bytes -> weighted_residuals output (RECENT last)
+        self.recent = OrderedDict()   # x bytes -> WeightedResiduals (the RECENT last)
         self.watch = None             # watch(x, data cost) after each evaluation (may raise)
 
     def params(self, x):
@@ -213,8 +189,8 @@ class Objective:
         self.n_eval += 1
         self.n_sim += len(self.dataset.experiments)
         try:
-            vec = self._remember(x, weighted_residuals(self.pair, self.dataset, self.params(x),
-                                                       self.backend))[0]
+            vec = self._remember(x, residuals_of(self.pair, self.dataset, self.params(x),
+                                                 self.backend)).vector
             self.size = vec.size
             if not np.all(np.isfinite(vec)):
                 vec = np.nan_to_num(vec, nan=PENALTY, posinf=PENALTY, neginf=-PENALTY)
@@ -240,22 +216,23 @@ class Objective:
         return out
 
     def residuals_at(self, x):
-        """:func:`weighted_residuals` at ``x``: an evaluation's own output when
+        """:func:`residuals_of` at ``x``: an evaluation's own output when
         ``x`` is one of the last :data:`RECENT` evaluated (the simulations are
         deterministic), else simulated (and counted)."""
         got = self.recent.get(np.asarray(x, float).tobytes())
         if got is None:
-            got = weighted_residuals(self.pair, self.dataset, self.params(x), self.backend)
+            got = residuals_of(self.pair, self.dataset, self.params(x), self.backend)
             self.n_sim += len(self.dataset.experiments)
         return got
 
     def jac_x(self, x):
-        """d residuals / d x from forward sensitivities (:func:`weighted_jacobian`),
+        """d residuals / d x from forward sensitivities
+        (:func:`acausal.studies.residuals.weighted_jacobian` with :class:`FitRuns`),
         penalty rows included; a failed run raises its AcausalError."""
         self._check()
         self.n_sim += len(self.dataset.experiments)
         J = weighted_jacobian(self.pair, self.dataset, self.params(x), self.names,
-                              self.backend)[1]
+                              FitRuns(self.backend))[1]
         if not np.all(np.isfinite(J)):
             from ...errors import SolverError
             raise SolverError("non-finite sensitivities")
@@ -334,35 +311,45 @@ def refine(obj, x_start, lo, hi, sc, max_nfev, tol):
         return x, J, True, f"{stop}; best point kept"
 
 
-def _arrays(names, *dicts):
-    return [np.array([float(d[n]) for n in names]) for d in dicts]
+@dataclass(frozen=True)
+class Refinement:
+    """How :func:`fit` refines its best start: at most ``max_nfev``
+    least-squares iterations, ``tol`` their xtol/ftol/gtol, the Jacobian by
+    ``jacobian`` ("differences" or "sensitivities": see :func:`refine`)."""
+
+    max_nfev: int = 60
+    tol: float = 1e-8
+    jacobian: str = "differences"
 
 
-def fit(model, dataset, names, x0, low, high, scale, *, fixed=None, starts=None,
-        max_nfev=60, tol=1e-8, budget_s=None, absorb=None, max_evals=None,
-        jacobian="differences") -> Fit:
-    """Weighted output-error least squares over ``names`` from the best of
+def fit(model, dataset, params, *, fixed=None, starts=None, absorb=None, budget=None,
+        refinement=Refinement()) -> Fit:
+    """Weighted output-error least squares over ``params`` from the best of
     the starting points.
 
-    ``x0``, ``low``, ``high``, ``scale``: per-name start, bounds and typical
-    magnitude (the optimiser works on value/scale). ``fixed``: other
-    parameter overrides. ``starts``: extra starting points (dicts name ->
-    value, merged into ``x0``), scored by :func:`score_starts` (with
-    ``absorb``); the best is refined by :func:`refine`. ``budget_s`` /
-    ``max_evals``: a wall-time / evaluation budget (the best point is kept).
-    ``jacobian``: "differences" (default) or "sensitivities" (see :func:`refine`).
+    ``params``: the fitted parameters, each with ``name``, ``start``,
+    ``low``, ``high`` and ``scale`` (a typical magnitude: the optimiser
+    works on value/scale), e.g. :class:`acausal.diagnose.problem.Param`.
+    ``fixed``: other parameter overrides. ``starts``: extra starting points
+    (dicts name -> value, merged into the starts), scored by
+    :func:`score_starts` (with ``absorb``); the best is refined by
+    :func:`refine` as ``refinement`` says. ``budget``: a :class:`Budget`
+    (wall time, evaluations; the best point is kept).
     """
-    names = list(names)
-    x0, lo, hi = _arrays(names, x0, low, high)
-    sc = np.array([abs(float(scale[n])) or 1.0 for n in names])
-    obj = Objective(model, dataset, names, fixed, budget_s, max_evals, jacobian=jacobian)
+    names = [p.name for p in params]
+    x0 = np.array([float(p.start) for p in params])
+    lo = np.array([float(p.low) for p in params])
+    hi = np.array([float(p.high) for p in params])
+    sc = np.array([abs(float(p.scale)) or 1.0 for p in params])
+    obj = Objective(model, dataset, names, fixed, budget, jacobian=refinement.jacobian)
     cands = [x0]
     for st in starts or []:
         cands.append(np.array([float(st.get(n, v)) for n, v in zip(names, x0)]))
     scored = score_starts(obj, cands, lo, hi, absorb)
     if not scored:
         return failed_fit(names, x0, obj, "every starting point failed to simulate")
-    return finish(obj, *refine_or_keep(obj, scored[0][1], lo, hi, sc, max_nfev, tol), lo)
+    return finish(obj, *refine_or_keep(obj, scored[0][1], lo, hi, sc, refinement.max_nfev,
+                                       refinement.tol), lo)
 
 
 def refine_or_keep(obj, x, lo, hi, sc, max_nfev, tol):
@@ -382,7 +369,8 @@ def finish(obj, x, J, ok, message, lo):
     """The :class:`Fit` at ``x``: residuals there (:meth:`Objective.residuals_at`:
     the optimiser's own evaluation of ``x``, or a new one), the Jacobian
     reshaped, intervals (log intervals for positive parameters)."""
-    r, groups, signals = obj.residuals_at(x)
+    got = obj.residuals_at(x)
+    r, groups, signals = got.vector, got.groups, got.signals
     names = obj.names
     J = np.asarray(J)[:r.size].reshape(r.size, len(names)) if names else np.zeros((r.size, 0))
     out = Fit(names, dict(zip(names, np.asarray(x, float).tolist())), float(r @ r), r, J,

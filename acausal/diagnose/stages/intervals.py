@@ -22,9 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...studies.calibrate import FD_STEP
-from .fitting import Objective
+from .fitting import Budget, Objective
 from ..problem import NOMINAL
-from .chain import run_tasks
 from .tasks import dataset_of, model_of
 
 MAX_SIMS = 2400       # simulations per parameter's check and traced profile (budget):
@@ -90,8 +89,8 @@ def _setup(task: ProfileTask):
     J = jacobian_in_profile_variables(task.jacobian, x, log=log, scale=scale)
     ds = dataset_of(task.problem)
     obj = Objective(model_of(task.problem, task.candidate), ds, [p.name for p in ps],
-                    max_evals=budget_evals(len(ds.experiments)), penalty=task.penalty,
-                    backend=task.problem.settings.integrator)
+                    budget=Budget(evals=budget_evals(len(ds.experiments))),
+                    penalty=task.penalty, backend=task.problem.settings.integrator)
     return x, dict(coords=Coordinates(bounds, log, scale), jacobian=J), obj
 
 
@@ -170,10 +169,10 @@ def profile_tasks(problem, cal, rk) -> tuple:
     return cand.label, tasks
 
 
-def intervals(problem, cal, rk, ex, progress=True) -> Intervals:
+def intervals(ctx, problem, cal, rk) -> Intervals:
     """Stage: the checked or profiled 95 % intervals (module doc)."""
     label, tasks = profile_tasks(problem, cal, rk)
     if not tasks:
         return Intervals(label, {}, "no fitted parameter")
-    got = run_tasks(ex, profile_parameter, list(tasks), "profiles", progress)
+    got = ctx.run(profile_parameter, list(tasks), "profiles", checkpoint=False)
     return Intervals(label, {r.name: r for r in got})

@@ -32,7 +32,7 @@ from . import stats as st
 from .fitting import effective_k, heldout_rms, scaled_columns
 from ..library.generic import GENERIC, N_V, N_X, SMOOTH, hats, penalty, shape
 from ..problem import Candidate, Param
-from .chain import fit_tasks, run_tasks
+from .chain import fit_tasks
 from .tasks import dataset_of, fit_candidate, model_of, penalty_of
 
 MARGIN = 10.0    # AICc units by which the generic term must beat the library
@@ -154,12 +154,12 @@ def at_rest_row(ranges):
     return np.concatenate([np.zeros(N_X), hats(0.0, v_lo, v_hi, N_V)[0]])
 
 
-def _pinned(problem, cal, gens, ex, progress):
+def _pinned(ctx, problem, cal, gens):
     """The generic candidates with their degenerate directions pinned."""
     import dataclasses
     tasks = fit_tasks(problem, cal, [g[0] for g in gens])
     out = []
-    for g, (rows, s0) in zip(gens, run_tasks(ex, pin_rows, tasks, "pinning", progress)):
+    for g, (rows, s0) in zip(gens, ctx.run(pin_rows, tasks, "pinning", checkpoint=False)):
         rest = at_rest_row(g[1])
         if rest is not None and s0 > 0:
             rows = np.vstack([rows, PIN_WEIGHT * s0 * rest / np.linalg.norm(rest)])
@@ -179,7 +179,7 @@ def _term(r, n, c_hat, ranges, members):
                 dict(f.values))
 
 
-def locate(problem, cal, dec, rk, ex, progress=True, collect=None) -> Location:
+def locate(ctx, problem, cal, dec, rk) -> Location:
     """Fit the generic term at every body node (module doc)."""
     import time
     if not needed(dec, rk):
@@ -188,12 +188,12 @@ def locate(problem, cal, dec, rk, ex, progress=True, collect=None) -> Location:
     gens = generic_candidates(problem, cal.fit.n)
     if not gens:
         return Location(skipped="the model has no body node")
-    gens = _pinned(problem, cal, gens, ex, progress)
+    gens = _pinned(ctx, problem, cal, gens)
     # the term is linear in its weights: refined from zero weights (with the
     # calibrated free parameters) only; Latin-hypercube splines are random
     # wiggles that cost a refinement each and start nowhere useful
     tasks = fit_tasks(problem.one_start(), cal, [g[0] for g in gens])
-    results = run_tasks(ex, fit_candidate, tasks, "locating", progress, collect)
+    results = ctx.run(fit_candidate, tasks, "locating")
     n = cal.fit.n
     terms = sorted((_term(r, n, dec.c_hat, g[1], g[2]) for r, g in zip(results, gens) if r.ok),
                    key=lambda t: t.aicc)

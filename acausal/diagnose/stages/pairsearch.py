@@ -45,10 +45,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import stats as st
-from .fitting import Objective, finish, refine_or_keep, score_starts
+from .fitting import Budget, Objective, finish, refine_or_keep, score_starts
 from ..library.loader import family_index, load_library
 from ..problem import Candidate, Param, Problem, pair_of
-from .tasks import FitTask, _bounds, dataset_of, lhs_values, model_of
+from .tasks import FitTask, bounds_of, dataset_of, lhs_values, model_of
 
 SCREEN_LHS = 2        # Latin-hypercube starts of the partner besides its neutral value
 SCREEN_EVALS = 4      # residual evaluations per fitted parameter (+1) of a screening fit
@@ -99,11 +99,11 @@ def screen_pair(task: PairScreenTask) -> Screened:
     p, pair = task.problem, task.pair
     params = list(task.free) + list(pair.params)
     names = [q.name for q in params]
-    lo, hi, sc = _bounds(params)
+    lo, hi, sc = bounds_of(params)
     s = p.settings
     try:
         obj = Objective(model_of(p, pair), dataset_of(p), names, backend=s.integrator,
-                        max_evals=SCREEN_EVALS * (len(names) + 1))
+                        budget=Budget(evals=SCREEN_EVALS * (len(names) + 1)))
         n_first = len(pair.params) - len(pair.members()[1][2])
         scored = score_starts(obj, screen_starts(task, n_first), lo, hi, task.absorb)
         if not scored:

@@ -1,15 +1,17 @@
 """Finished fits of a diagnosis survive an interruption (even a kill).
 
-A :class:`FitStore` is the ``collect`` hook of :func:`.stages.run_tasks`:
+A :class:`FitStore` is the collector of the stages' :class:`.context.Context`:
 each fit result is appended to ``<report>/checkpoint/<hash>.jsonl``
 (:class:`acausal.checkpoint.Checkpoint`: one checksummed line per record)
 as soon as it arrives, and a task whose result is already there is not
 submitted again. A task is a picklable dataclass and its result depends
 only on it, so a record is keyed by a hash of the pickled task; the store
 itself is named by a hash of the model file (and its neighbours), the data
-folder and the diagnosis options, so changed inputs start afresh. The
-stored value is the pickled result (base64 text): the store is written and
-read only by this package, in the user's own report folder.
+folder and the diagnosis options
+(:meth:`acausal.diagnose.options.DiagnosisOptions.checkpoint_key`), so
+changed inputs start afresh. The stored value is the pickled result (base64
+text): the store is written and read only by this package, in the user's
+own report folder.
 """
 from __future__ import annotations
 

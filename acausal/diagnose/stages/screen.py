@@ -152,7 +152,7 @@ class Screen:
     unfitted: tuple = ()
 
 
-def screened(problem, cal, dec, cands, ex, run_tasks) -> Screen:
+def screened(ctx, problem, cal, dec, cands) -> Screen:
     """The candidates of ``cands`` whose predicted AICc comes within reach
     of the best row's, most promising first, each with the predicted step as
     a second start: its own parameters' (in the candidate) and the free
@@ -162,8 +162,8 @@ def screened(problem, cal, dec, cands, ex, run_tasks) -> Screen:
         return Screen()
     f0 = cal.fit
     free = tuple((n, f0.values[n]) for n in problem.free_names)
-    outs = run_tasks(ex, start_columns, [ScreenTask(problem, c, free) for c in cands],
-                     "screening family members", False)
+    outs = ctx.run(start_columns, [ScreenTask(problem, c, free) for c in cands],
+                   "screening family members", checkpoint=False, progress=False)
     best = dec.rows[0].aicc
     reach = best + max(MARGIN, SHARE * (dec.a0 - best))
     scored = []

@@ -53,11 +53,12 @@ by c instead of being read as overwhelming evidence.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from scipy import stats
 
-ALPHA = 0.01          # family significance level of the discrepancy decision
+from ..problem import ALPHA  # noqa: F401  (the discrepancy decision's level)
 EQUIVALENCE = 4.0     # candidates within this many AICc units of the best: one class
 EQUIVALENCE_HELDOUT = 7.0  # ... or within this many with a held-out error no worse
 STRONG = 10.0         # dAICc vs no extension below which the evidence is weak
@@ -251,17 +252,35 @@ def akaike_weights(aiccs) -> np.ndarray:
     return w / w.sum()
 
 
-def weak_evidence(*, n: int, k: int, d_null: float, d_runner: float | None,
-                  heldout_nominal: float, heldout_best: float, ci_rel: float | None,
-                  c_hat: float, coarse: float | None) -> list:
+@dataclass(frozen=True)
+class Evidence:
+    """What :func:`weak_evidence` judges a cause on: data count ``n``,
+    parameters of the best model ``k``, its dAICc below no extension
+    (``d_null``) and below the best candidate outside its class
+    (``d_runner``; None: no runner-up), held-out RMS of the nominal and of
+    the best (``heldout_nominal``, ``heldout_best``; noise-floor units), the
+    relative 95 % half-width of its main parameter (``ci_rel``: relative to
+    its distance from the neutral value; None: no parameter of its own), the
+    over-dispersion ``c_hat``, and the nominal misfit's RMS in resolution
+    steps (``coarse``; None if the data have no resolution)."""
+
+    n: int
+    k: int
+    d_null: float
+    d_runner: float | None
+    heldout_nominal: float
+    heldout_best: float
+    ci_rel: float | None
+    c_hat: float
+    coarse: float | None
+
+
+def weak_evidence(ev: Evidence) -> list:
     """Reasons (sentences with their numbers) why a named cause would not be
-    trustworthy; empty when the evidence is strong. Arguments: data count n,
-    parameters of the best model k, its dAICc below no extension (d_null) and
-    below the best candidate outside its class (d_runner), held-out RMS of the
-    nominal and of the best (noise-floor units), the relative 95 % half-width
-    of its main parameter (relative to its distance from the neutral value), the
-    over-dispersion, and the nominal misfit's RMS in
-    resolution steps (coarse; None if the data have no resolution)."""
+    trustworthy (:class:`Evidence`); empty when the evidence is strong."""
+    n, k, d_null, d_runner = ev.n, ev.k, ev.d_null, ev.d_runner
+    heldout_nominal, heldout_best, ci_rel = ev.heldout_nominal, ev.heldout_best, ev.ci_rel
+    c_hat, coarse = ev.c_hat, ev.coarse
     out = []
     if n < MIN_PER_PARAM * k:
         out.append(f"too few data: {n} values for {k} fitted parameters "

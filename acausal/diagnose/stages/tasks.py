@@ -29,12 +29,13 @@ import numpy as np
 from scipy.stats import qmc
 
 from ...studies.calibrate import model_dataset
-from ...data import Dataset, Experiment, Trace
+from ...data import Dataset, MeasuredExperiment, Trace
 from ...errors import AcausalError
 from ...infra.executor import worker_cache
 from ...modelfile import compile_file
-from .fitting import Fit, Objective, failed_fit, finish, linear_loo, penalty_cost, \
-    refine_or_keep, score_starts, subset, weighted_residuals
+from ...studies.residuals import subset
+from .fitting import Budget, Fit, Objective, failed_fit, finish, linear_loo, penalty_cost, \
+    refine_or_keep, residuals_of, score_starts
 from ..library.generic import GENERIC
 from ..library.generic import build as build_generic
 from ..library.loader import load_library
@@ -147,7 +148,7 @@ def window(ds: Dataset, frac: float) -> Dataset:
             t = e.trace.time
             keep = t <= t[0] + frac * (t[-1] - t[0]) * (1 + 1e-9)
             trace = Trace(t[keep], {k: v[keep] for k, v in e.trace.signals.items()})
-        out.append(Experiment(e.name, e.conditions, {}, trace, e.line, e.use))
+        out.append(MeasuredExperiment(e.name, e.conditions, {}, trace, e.line, e.use))
     return Dataset(ds.folder, out, ds.instrument)
 
 
@@ -200,7 +201,9 @@ def start_points(task: FitTask):
 
 
 # -- the fit of one candidate ---------------------------------------------------------------
-def _bounds(params):
+def bounds_of(params):
+    """(lower bounds, upper bounds, scales) of ``params`` (:class:`~..problem.Param`)
+    as arrays; a zero scale counts as 1."""
     lo = np.array([p.low for p in params])
     hi = np.array([p.high for p in params])
     sc = np.array([abs(p.scale) or 1.0 for p in params])
@@ -275,12 +278,12 @@ def _multistart(task: FitTask):
     s = p.settings
     params = list(task.free) + list(cand.params)
     names = [q.name for q in params]
-    lo, hi, sc = _bounds(params)
+    lo, hi, sc = bounds_of(params)
     ds = dataset_of(p)
     pair = model_of(p, cand)
     # starts are scored on the whole record: scored on the first window only,
     # the stop rig's pair case lost its drag's family head (power_drag named)
-    obj = Objective(pair, ds, names, budget_s=task.budget_s, penalty=penalty_of(cand),
+    obj = Objective(pair, ds, names, budget=Budget(task.budget_s), penalty=penalty_of(cand),
                     backend=s.integrator)
     pts = start_points(task)
     scored = score_starts(obj, [x for x, _ in pts], lo, hi, task.absorb)
@@ -304,7 +307,7 @@ def calibrate_nominal(task: FitTask) -> CandidateFit:
     p, s = task.problem, task.problem.settings
     params = list(task.free)
     names = [q.name for q in params]
-    lo, hi, sc = _bounds(params)
+    lo, hi, sc = bounds_of(params)
     ds = dataset_of(p)
     pair = model_of(p, task.candidate)
     windows = _windows(ds, s)
@@ -405,9 +408,9 @@ class Refiner:
         evaluation met a target."""
         s = self.settings
         full = s.evals_per_param * (len(self.names) + 1)
-        obj = Objective(self.pair, window(self.ds, w), self.names, budget_s=self.budget_s,
-                        penalty=self.penalty, backend=s.integrator, jacobian=s.jacobian,
-                        max_evals=full if w >= 1.0 else max(3, full // 3))
+        obj = Objective(self.pair, window(self.ds, w), self.names,
+                        budget=Budget(self.budget_s, full if w >= 1.0 else max(3, full // 3)),
+                        penalty=self.penalty, backend=s.integrator, jacobian=s.jacobian)
         tols = [agree_tolerance(t, self.names, self.sc, w >= 1.0) for t in targets]
         obj.watch = self._watch(targets, tols) if targets else None
         try:
@@ -460,7 +463,7 @@ class Refiner:
         whole record reached the truth."""
         if len(self.windows) < 2 or not np.isfinite(end.cost):
             return end, 0
-        obj = Objective(self.pair, self.ds, self.names, budget_s=self.budget_s,
+        obj = Objective(self.pair, self.ds, self.names, budget=Budget(self.budget_s),
                         penalty=self.penalty, backend=self.settings.integrator)
         try:
             r = obj(np.clip(np.asarray(x0, float), self.lo, self.hi))
@@ -512,12 +515,12 @@ def refit_without(task: LooTask) -> LooResult:
     pair = model_of(task.problem, task.candidate)
     train = subset(ds, [e.name for e in ds.experiments if e.name != task.held])
     names = [q.name for q in task.params]
-    lo, hi, sc = _bounds(task.params)
+    lo, hi, sc = bounds_of(task.params)
     s = task.problem.settings
-    obj = Objective(pair, train, names, budget_s=task.budget_s,
-                    max_evals=s.evals_per_param * (len(names) + 1) // 3, backend=s.integrator,
-                    jacobian=s.jacobian)
+    obj = Objective(pair, train, names,
+                    budget=Budget(task.budget_s, s.evals_per_param * (len(names) + 1) // 3),
+                    backend=s.integrator, jacobian=s.jacobian)
     x0 = np.array([q.start for q in task.params])
     f = finish(obj, *refine_or_keep(obj, x0, lo, hi, sc, task.max_nfev, LOO_TOL), lo)
-    r = weighted_residuals(pair, subset(ds, [task.held]), f.values, s.integrator)[0]
+    r = residuals_of(pair, subset(ds, [task.held]), f.values, s.integrator).vector
     return LooResult(task.candidate, task.held, r, f.values, f.n_sim)

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...studies.calibrate import _sigma
+from ...studies.residuals import sigma
 from ...errors import AcausalError
 from .fingerprints import fingerprints
 from ..library.loader import load_library
@@ -55,7 +55,7 @@ def raw_residuals(f, ds):
             m = (groups == e.name) & (sigs == s)
             vals = (e.trace.signals[s] if e.trace is not None and s in e.trace.signals
                     else np.atleast_1d(e.measures.get(s, 1.0)))
-            r = f.residuals[m] * _sigma(ds, s, vals)
+            r = f.residuals[m] * sigma(ds, s, vals)
             raw[e.name][s] = float(r[0]) if s in e.measures and r.size == 1 else r
     return raw
 
@@ -98,6 +98,6 @@ def views(problem, cal, ranking) -> Views:
     except Exception:  # noqa: BLE001 - a stand-in graph without bodies
         bodies = []
     fp = fingerprints(ds, raw0, {k: v for k, v in sims0.items() if v is not None}, bodies)
-    floors = {s: _sigma(ds, s, np.atleast_1d(_values_of(ds, s)))
+    floors = {s: sigma(ds, s, np.atleast_1d(_values_of(ds, s)))
               for s in dict.fromkeys(f0.signals)}
     return Views(raw0, raw1, _traces(ds, sims0), _traces(ds, sims1), floors, fp)

@@ -1,6 +1,6 @@
 """Rotational friction elements (MSL ``Modelica.Mechanics.Rotational.Components``:
 BearingFriction, Brake, Clutch, OneWayClutch, LossyGear), each a leaf of
-the shared mode machine :class:`acausal.mechanics.frictionmodes.FrictionModes`
+the shared mode machine :class:`acausal.mechanics.frictionmodes.PartialFrictionModes`
 (modes, events and their names: see that module).
 
 Sign convention: :mod:`acausal.lang.connectors`. A friction torque ``tau``
@@ -15,7 +15,7 @@ from sympy import Piecewise
 from acausal.errors import ParameterError
 from acausal.lang import Eq, Parameter, RealInput, Variable, der
 
-from ..frictionmodes import FrictionModes, PartialRotFriction, magnitude
+from ..frictionmodes import PartialFrictionModes, PartialRotFriction, magnitude
 from ..partials import (NonZeroParameter, PartialRotCompliantWithRelativeStates,
                         PartialRotElementaryTwoFlangesAndSupport2)
 from ..tables import Table, interpolate
@@ -194,7 +194,7 @@ class Clutch(_NormalForce, PartialRotCompliantWithRelativeStates, PartialRotFric
 EPS0 = 1e-4   # OneWayClutch: relative hysteresis of the break-away torque (MSL's eps0)
 
 
-class OneWayClutch(PartialRotCompliantWithRelativeStates, FrictionModes):
+class OneWayClutch(PartialRotCompliantWithRelativeStates, PartialFrictionModes):
     """A freewheel and a clutch in parallel (MSL ``OneWayClutch``): the
     relative rotation ``w_rel = der(flange_b.phi - flange_a.phi)`` cannot
     become negative (the freewheel locks and takes any torque that way);
@@ -291,7 +291,7 @@ class _LossTable(Table):
 IDEAL_LOSS_TABLE = ((0.0, 1.0, 1.0, 0.0, 0.0),)
 
 
-class LossyGear(PartialRotElementaryTwoFlangesAndSupport2, FrictionModes):
+class LossyGear(PartialRotElementaryTwoFlangesAndSupport2, PartialFrictionModes):
     """A gear with mesh efficiency and bearing friction, which may stick
     (MSL ``LossyGear``; Pelchen, Schweiger & Otter 2002, with Bertsch's
     2009 correction)::

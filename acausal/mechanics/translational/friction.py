@@ -1,6 +1,6 @@
 """Translational friction elements (MSL ``Modelica.Mechanics.Translational.Components``:
 SupportFriction, Brake, MassWithStopAndFriction), each a leaf of the shared
-mode machine :class:`acausal.mechanics.frictionmodes.FrictionModes` (modes,
+mode machine :class:`acausal.mechanics.frictionmodes.PartialFrictionModes` (modes,
 events and their names: see that module).
 
 Sign convention: :mod:`acausal.lang.connectors`. A friction force ``f`` is
