@@ -887,7 +887,7 @@ def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max
     from .infra.checkpoint import source_files
     from .infra.executor import default_workers, open_executor, terminate_on_sigterm
     from .modelfile import compile_file, sweep_task
-    from .studies.sweep import grid, parse_param, plot_sweep, run_sweep
+    from .studies.sweep import Journal, grid, parse_param, plot_sweep, run_sweep
     measures = _csv_list(",".join(measures))
     try:
         with _quiet_warnings():
@@ -922,9 +922,10 @@ def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max
             with terminate_on_sigterm(), _resumable(out), \
                     Watchdog(limit, max_wall, "the sweep"), \
                     open_executor(scheduler, workers) as ex:
+                journal = Journal(inputs=source_files(file), units=units,
+                                  on_resume=_say_resumed("points"))
                 rows = run_sweep(task, points, out, executor=ex, measures=measures,
-                                 progress=not no_progress, inputs=source_files(file),
-                                 units=units, on_resume=_say_resumed("points"))
+                                 progress=not no_progress, journal=journal)
             if plot:
                 fn = mf.measures[measures[0]]
                 y_unit, y_factor = units.get(measures[0]), 1.0
@@ -1014,11 +1015,13 @@ def tolerance(file, spec, n, sampling, seed, measures, out, plot_prefix, json_pa
             with terminate_on_sigterm(), _resumable(out + ".partial"), \
                     Watchdog(limit, max_wall, "the tolerance study"), \
                     open_executor(scheduler, workers) as ex:
+                run = tol.StudyRun(chunk=chunk, max_memory=max(per_worker, 50e6),
+                                   backend=None, on_resume=_say_resumed("sets"),
+                                   progress=not no_progress)
                 res = tol.run_tolerance(os.path.abspath(file), dists, n, executor=ex,
-                                        measures=measures, sampling=sampling, seed=seed,
-                                        out_csv=out, chunk=chunk, progress=not no_progress,
-                                        max_memory=max(per_worker, 50e6), backend=None,
-                                        on_resume=_say_resumed("sets"))
+                                        measures=measures,
+                                        sampling=tol.Sampling(sampling, seed),
+                                        out_csv=out, run=run)
             display = {m: _display(mf, m) for m in measures}
             if plot_prefix:
                 tol.plot_histograms(res, plot_prefix, display)

@@ -25,6 +25,7 @@ are matched between runs by these values.
 from __future__ import annotations
 
 import csv
+import dataclasses
 import itertools
 import json
 import math
@@ -43,7 +44,7 @@ import numpy as np
 from ..infra.checkpoint import Checkpoint, input_key
 from ..errors import UsageError
 
-__all__ = ["parse_param", "grid", "run_sweep", "plot_sweep", "SweepRows", "SweepAborted"]
+__all__ = ["parse_param", "grid", "run_sweep", "Journal", "plot_sweep", "SweepRows", "SweepAborted"]
 
 RESERVED = ("status", "error", "wall_s")
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*$")
@@ -479,6 +480,21 @@ def _collect_windowed(executor, todo: list, submit: Callable, on_row: Callable[[
         bar.close()
 
 
+@dataclasses.dataclass(frozen=True)
+class Journal:
+    """Where a sweep keeps its finished points and how it resumes (see
+    :func:`run_sweep`): ``checkpoint`` folder (default ``<out_csv>.partial``;
+    False: none), the ``inputs`` the results depend on, the CSV header's
+    ``units`` (column -> unit), ``on_resume(done, total)``, and ``window``,
+    the most points submitted and not yet finished."""
+
+    checkpoint: Any = None
+    inputs: Sequence[Any] = ()
+    units: Mapping[str, str] | None = None
+    on_resume: Callable[[int, int], None] | None = None
+    window: int | None = None
+
+
 def run_sweep(
     task: Callable[[dict], Mapping],
     points: Sequence[Mapping[str, float]],
@@ -487,11 +503,7 @@ def run_sweep(
     executor,
     measures: Sequence[str],
     progress: bool = True,
-    checkpoint: str | Path | None | bool = None,
-    inputs: Sequence[Any] = (),
-    units: Mapping[str, str] | None = None,
-    on_resume: Callable[[int, int], None] | None = None,
-    window: int | None = None,
+    journal: Journal = Journal(),
 ) -> SweepRows:
     """Run ``task(point)`` for every point not already in ``out_csv``.
 
@@ -536,6 +548,8 @@ def run_sweep(
     raised in a process-pool worker) stops the sweep and propagates; a broken
     executor raises :class:`SweepAborted`. Either way finished points are saved.
     """
+    checkpoint, inputs, units = journal.checkpoint, journal.inputs, journal.units
+    on_resume, window = journal.on_resume, journal.window
     points = [dict(p) for p in points]
     params = _param_names(points)
     measures = _check_measures(measures, params)

@@ -506,22 +506,45 @@ class ToleranceResult:
         return int(np.sum(self.status != "ok"))
 
 
+@dataclass(frozen=True)
+class Sampling:
+    """How the sets are drawn: ``kind`` 'lhs' (Latin hypercube) or 'sobol'
+    (Saltelli's design), with ``seed``."""
+
+    kind: str = "lhs"
+    seed: int | None = 0
+
+
+@dataclass(frozen=True)
+class StudyRun:
+    """How the sets run: ``chunk`` sets per task, ``max_memory`` bytes each
+    worker's simulation may store, the integrator ``backend`` ('compiled',
+    the default: generated C; None: the library's default),
+    ``on_resume(done, total)`` when sets were already done, and a
+    ``progress`` bar."""
+
+    chunk: int = CHUNK
+    max_memory: float | None = None
+    backend: str | None = "compiled"
+    on_resume: Callable[[int, int], None] | None = None
+    progress: bool = False
+
+
 def run_tolerance(model_path: str | os.PathLike, dists: Sequence[Dist], n: int, *,
-                  executor, measures: Sequence[str], sampling: str = "lhs",
-                  seed: int | None = 0, out_csv: str | os.PathLike | None = None,
-                  chunk: int = CHUNK, max_memory: float | None = None,
-                  backend: str | None = "compiled",
-                  on_resume: Callable[[int, int], None] | None = None,
-                  progress: bool = False) -> ToleranceResult:
+                  executor, measures: Sequence[str], sampling: Sampling = Sampling(),
+                  out_csv: str | os.PathLike | None = None,
+                  run: StudyRun = StudyRun()) -> ToleranceResult:
     """Run a tolerance study of the model file ``model_path`` (see the module
     doc). ``executor``: from :func:`acausal.infra.executor.open_executor`.
     Finished chunks are journaled in ``<out_csv>.partial/`` (or, without
     ``out_csv``, ``tolerance.partial/`` beside the model file) and the study
-    resumes from them; ``on_resume(done, total)`` is called when sets were
-    already done. ``out_csv`` receives one row per set (its parameters in
-    SI, its measures, status and error). ``max_memory``: bytes each
-    worker's simulation may store; ``backend``: the integrator ('compiled',
-    the default: generated C; None: the library's default)."""
+    resumes from them. ``out_csv`` receives one row per set (its parameters
+    in SI, its measures, status and error). ``sampling``: :class:`Sampling`;
+    ``run``: :class:`StudyRun`."""
+    seed = sampling.seed
+    chunk, max_memory, backend = run.chunk, run.max_memory, run.backend
+    on_resume, progress = run.on_resume, run.progress
+    sampling = sampling.kind
     from ..infra.checkpoint import Checkpoint, input_key, source_files
     t0 = time.perf_counter()
     measures = tuple(measures)

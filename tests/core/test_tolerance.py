@@ -173,7 +173,8 @@ def test_resume_after_a_kill_loses_and_repeats_no_set(oscillator, tmp_path, monk
         return real(path, names, rows, *args)
 
     monkeypatch.setattr(tol, "run_chunk", dying)
-    kw = dict(executor=None, measures=["s_end"], out_csv=out, chunk=8, backend=None)
+    kw = dict(executor=None, measures=["s_end"], out_csv=out,
+              run=tol.StudyRun(chunk=8, backend=None))
     with open_executor("serial") as ex, pytest.raises(KeyboardInterrupt):
         tol.run_tolerance(oscillator, dists, 40, **{**kw, "executor": ex})
     assert not out.exists() and len(calls) == 2
@@ -182,8 +183,9 @@ def test_resume_after_a_kill_loses_and_repeats_no_set(oscillator, tmp_path, monk
     monkeypatch.setattr(tol, "run_chunk", lambda *a: calls.append([i for i, _ in a[2]]) or real(*a))
     said = []
     with open_executor("serial") as ex:
-        res = tol.run_tolerance(oscillator, dists, 40, **{**kw, "executor": ex},
-                                on_resume=lambda done, total: said.append((done, total)))
+        run = tol.StudyRun(chunk=8, backend=None,
+                           on_resume=lambda done, total: said.append((done, total)))
+        res = tol.run_tolerance(oscillator, dists, 40, **{**kw, "executor": ex, "run": run})
     assert said == [(16, 40)] and res.resumed == 16
     assert sorted(i for c in calls for i in c) == list(range(16, 40))
     # the CSV holds each set once, and every value is the closed form's
@@ -210,7 +212,7 @@ def test_a_set_outside_the_parameter_bounds_fails_alone_and_is_counted(oscillato
     dists = [Dist("spring.c", "normal", 100.0, 5.0), Dist("mass.m", "normal", 0.05, 0.05)]
     with open_executor("serial") as ex:
         res = tol.run_tolerance(oscillator, dists, 32, executor=ex, measures=["s_end"],
-                                out_csv=tmp_path / "o.csv", backend=None)
+                                out_csv=tmp_path / "o.csv", run=tol.StudyRun(backend=None))
     bad = res.design.X[:, 1] <= 0
     assert bad.any() and res.n_failed == bad.sum()
     assert all("mass.m" in res.errors[i] for i in np.flatnonzero(bad))
