@@ -109,7 +109,7 @@ def _size(ctx, param, value):
     """``--max-memory``: bytes (``4GB``, ``512MB``, ``2e9``), or None."""
     if value is None:
         return None
-    from .budget import parse_size
+    from .infra.budget import parse_size
     try:
         return parse_size(value, f"--{param.name.replace('_', '-')}")
     except UsageError as exc:
@@ -282,7 +282,7 @@ def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, max_rows, max_wa
              max_memory, progress, backend):
     """Simulate a model file. Stopped by a limit, Ctrl-C or SIGTERM, it
     writes what it computed (--out, --plot, --json) and says where it stopped."""
-    from .budget import max_memory as memory_limit
+    from .infra.budget import max_memory as memory_limit
     from .modelfile import compile_file, measure_values
     res = error = None
     try:
@@ -489,7 +489,7 @@ def _plot(mf, res, path, partial=False):
 def animate(file, out, t_end, sets, fps, frames, max_wall, max_memory):
     """Simulate a planar model file and animate its mechanism."""
     from .viz.animate import animate as write_animation
-    from .budget import max_memory as memory_limit
+    from .infra.budget import max_memory as memory_limit
     from .modelfile import compile_file
     try:
         with _interruptible(), _quiet_warnings():
@@ -659,8 +659,8 @@ def calibrate(file, data, fit, method, experiments, profile, as_json, max_wall, 
     declares, a measured value is far from what the fitted model gives (a
     unit, a sign), or a fitted value ends at a bound of its range."""
     from .studies import calibrate as cal
-    from .budget import Watchdog
-    from .budget import max_memory as memory_limit
+    from .infra.budget import Watchdog
+    from .infra.budget import max_memory as memory_limit
     from .modelfile import compile_file
     try:
         with _quiet_warnings(), _resumable("nothing (a calibration keeps no partial result)"), \
@@ -882,8 +882,8 @@ def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max
     keeping the finished points."""
     import functools
 
-    from .budget import PROCESS_BYTES, Watchdog, check_estimate
-    from .budget import max_memory as memory_limit
+    from .infra.budget import PROCESS_BYTES, Watchdog, check_estimate
+    from .infra.budget import max_memory as memory_limit
     from .infra.checkpoint import source_files
     from .infra.executor import default_workers, open_executor, terminate_on_sigterm
     from .modelfile import compile_file, sweep_task
@@ -977,8 +977,8 @@ def tolerance(file, spec, n, sampling, seed, measures, out, plot_prefix, json_pa
     percentiles and each parameter's share of the variance. Budgets as
     sweep's: the number of simulations (--max-points) and their memory are
     checked before anything runs."""
-    from .budget import PROCESS_BYTES, Watchdog, check_estimate
-    from .budget import max_memory as memory_limit
+    from .infra.budget import PROCESS_BYTES, Watchdog, check_estimate
+    from .infra.budget import max_memory as memory_limit
     from .infra.executor import default_workers, open_executor, terminate_on_sigterm
     from .modelfile import compile_file, show_measure
     from .studies import tolerance as tol
@@ -1080,7 +1080,7 @@ def _say_resumed(what):
 def _resumable(where):
     """An interruption (Ctrl-C, SIGTERM) ends with one line saying where the
     finished work is, and exit code 130."""
-    from .budget import tripped
+    from .infra.budget import tripped
     from .infra.executor import exit_soon
     try:
         yield
@@ -1132,8 +1132,8 @@ def diagnose(file, data, json_path, report_dir, scheduler, workers, max_wall, ma
     extend the model and measure the gain. A long trace is thinned to what
     its instrument floor supports (said on stderr); past --max-memory or
     --max-wall, or at Ctrl-C or SIGTERM, it stops keeping its finished fits."""
-    from .budget import PROCESS_BYTES, Watchdog, check_estimate
-    from .budget import max_memory as memory_limit
+    from .infra.budget import PROCESS_BYTES, Watchdog, check_estimate
+    from .infra.budget import max_memory as memory_limit
     from .diagnose.problem import FitSettings
     from .diagnose.run import diagnose as run_diagnosis
     from .infra.executor import default_workers, terminate_on_sigterm

@@ -146,7 +146,7 @@ class _Finder:
         return sw.symbol
 
     def _new(self, kind, g, a, b, owner, text):
-        from .flatten import VarInfo
+        from .flat import VarInfo
         from ..lang.declare import Start
         k = len(self.switches)
         base = f"{owner}." if owner else ""

@@ -172,22 +172,22 @@ def _to_si(cm, name, unit_text, where):
 
 def _read_number(text, what):
     if not _NUMBER.match(text):
-        raise ValueError(f"{what} {text!r} is not a number")
+        raise UsageError(f"{what} {text!r} is not a number")
     value = float(text)
     if not math.isfinite(value):
-        raise ValueError(f"{what} {text!r} is not finite")
+        raise UsageError(f"{what} {text!r} is not finite")
     return value
 
 
 def _parse_row(cm, cells, path, line):
-    """A Dist from one row's cells, or a ValueError/AcausalError saying why not."""
+    """A Dist from one row's cells, or an AcausalError (UsageError, DataError) saying why not."""
     if len(cells) != 5:
-        raise ValueError(f"expected 5 fields 'name, distribution, a, b, unit', got {len(cells)}")
+        raise UsageError(f"expected 5 fields 'name, distribution, a, b, unit', got {len(cells)}")
     name, kind, a_text, b_text, unit = cells
     _check_name(cm, name)
     kind = kind.lower()
     if kind not in ("normal", "uniform"):
-        raise ValueError(f"{name}: distribution {kind!r} is not 'normal' or 'uniform'")
+        raise UsageError(f"{name}: distribution {kind!r} is not 'normal' or 'uniform'")
     scale, offset = _to_si(cm, name, unit, (str(path), line, None))
     if a_text.lower() == "nominal":
         a = (_nominal(cm, name) - offset) / scale       # in the row's unit
@@ -196,19 +196,19 @@ def _parse_row(cm, cells, path, line):
     if b_text.endswith("%"):
         p = _read_number(b_text[:-1].strip(), f"{name}: percentage") / 100.0
         if p < 0:
-            raise ValueError(f"{name}: a negative percentage {b_text!r}")
+            raise UsageError(f"{name}: a negative percentage {b_text!r}")
         a, b = (a, abs(a) * p) if kind == "normal" else (a - abs(a) * p, a + abs(a) * p)
     else:
         b = _read_number(b_text, f"{name}: {'standard deviation' if kind == 'normal' else 'high'}")
     if kind == "normal":
         if b < 0:
-            raise ValueError(f"{name}: a negative standard deviation {b_text} [{unit}]")
+            raise UsageError(f"{name}: a negative standard deviation {b_text} [{unit}]")
         if b == 0:
-            raise ValueError(f"{name}: a standard deviation of 0 (a fixed value: leave the row out)")
+            raise UsageError(f"{name}: a standard deviation of 0 (a fixed value: leave the row out)")
         return Dist(name, kind, a * scale + offset, b * abs(scale), _model_unit(cm, name) or "1",
                     ", ".join(cells))
     if not b > a:
-        raise ValueError(f"{name}: an empty range: high {b:g} is not above low {a:g} [{unit}]")
+        raise UsageError(f"{name}: an empty range: high {b:g} is not above low {a:g} [{unit}]")
     lo, hi = sorted((a * scale + offset, b * scale + offset))
     e = {p.name: p for p in cm.params}.get(name)
     if e is not None:
@@ -242,7 +242,7 @@ def parse_spec(path: str | os.PathLike, cm) -> list[Dist]:
             continue                                      # a header
         try:
             dist = _parse_row(cm, cells, path, line)
-        except (ValueError, AcausalError) as exc:
+        except AcausalError as exc:
             msg = exc.message if isinstance(exc, AcausalError) else str(exc)
             if isinstance(exc, DataError):
                 msg = f"{cells[0]}: {msg}"

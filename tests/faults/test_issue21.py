@@ -138,7 +138,7 @@ def test_an_interrupted_command_ends_within_its_grace_period():
 def test_a_memory_watchdog_stops_the_command_with_its_reason():
     r = run_py("""
         import sys
-        from acausal.budget import Watchdog, tripped
+        from acausal.infra.budget import Watchdog, tripped
         hog = []
         try:
             with Watchdog(max_memory=400e6, what="the test"):

@@ -15,7 +15,7 @@ from acausal.lang import Eq, Parameter, RealInput, Variable, der
 from acausal.lang.symbols import KnownDerivatives
 
 from ..partials import PartialRotElementaryOneFlangeAndSupport2
-from ..translational.kinematic import bessel_filter
+from ..shared import bessel_filter
 
 __all__ = ["Position", "Speed", "Accelerate", "Move"]
 

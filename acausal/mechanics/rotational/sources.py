@@ -10,7 +10,7 @@ from acausal.errors import ParameterError
 
 from ..partials import (PartialRotCompliant, PartialRotElementaryOneFlangeAndSupport2,
                         PartialSource, PartialTorque, SourceValue)
-from ..translational.sources import REGULARIZATIONS, regularized_sign
+from ..shared import REGULARIZATIONS, regularized_sign
 from .kinematic import Accelerate, Move, Position, Speed  # noqa: F401 (MSL's Sources)
 
 __all__ = ["Torque", "Torque2", "RelativeTorque", "ConstantTorque", "SignTorque",

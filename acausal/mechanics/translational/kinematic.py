@@ -16,19 +16,9 @@ from acausal.lang import Eq, Parameter, RealInput, Variable, der
 from acausal.lang.symbols import KnownDerivatives
 
 from ..partials import PartialElementaryOneFlangeAndSupport2
+from ..shared import BESSEL_AF, BESSEL_BF, bessel_filter  # noqa: F401  (public here too)
 
 __all__ = ["Position", "Speed", "Accelerate", "Move", "BESSEL_AF", "BESSEL_BF"]
-
-BESSEL_AF = 1.3617   # s coefficient of MSL's second-order Bessel filter
-BESSEL_BF = 0.6180   # s^2 coefficient
-
-
-def bessel_filter(a, ref, x, v, f_crit):
-    """MSL's second-order Bessel filter of ``ref`` realised on the states
-    ``x``, ``v = der(x)``: ``a = ((ref - x)*w_crit - af*v)*(w_crit/bf)``,
-    ``w_crit = 2*pi*f_crit``."""
-    w = 2 * sp.pi * f_crit
-    return Eq(a, ((ref - x) * w - BESSEL_AF * v) * (w / BESSEL_BF))
 
 
 class Position(PartialElementaryOneFlangeAndSupport2):

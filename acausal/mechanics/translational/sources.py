@@ -8,33 +8,13 @@ from sympy import Piecewise
 from acausal.lang import Eq, Flange, Parameter, time
 
 from .kinematic import Accelerate, Move, Position, Speed  # noqa: F401 (MSL's Sources)
+from ..shared import REGULARIZATIONS, regularized_sign  # noqa: F401  (public here too)
 from ..partials import (PartialCompliant, PartialElementaryOneFlangeAndSupport2, PartialForce,
                         PartialSource, SourceValue)
 
 __all__ = ["Force", "Force2", "RelativeForce", "ConstantForce", "SignForce",
            "QuadraticSpeedDependentForce", "LinearSpeedDependentForce", "ForceStep", "Position",
            "Speed", "Accelerate", "Move"]
-
-REGULARIZATIONS = ("Exp", "Sine", "Linear", "CoSine")
-
-
-def regularized_sign(x, x0, reg):
-    """MSL's ``Blocks.Types.Regularization`` of ``sign(x)`` below ``x0``
-    (a sympy expression, continuous in ``x``; no events)::
-
-        Exp:    2 / (1 + exp(-x / (0.01 x0))) - 1
-        Sine:   sign(x) if |x| >= x0 else sin(pi/2 x/x0)
-        Linear: sign(x) if |x| >= x0 else x/x0
-        CoSine: sign(x) if |x| >= x0 else sign(x) (1 - cos(pi/2 x/x0))
-    """
-    if reg == "Exp":
-        return 2 / (1 + sp.exp(-x / (sp.Rational(1, 100) * x0))) - 1
-    sgn = Piecewise((1, x >= 0), (-1, True))     # sign(x) without a DiracDelta derivative
-    inside = {"Sine": sp.sin(sp.pi / 2 * x / x0),
-              "Linear": x / x0,
-              "CoSine": sgn * (1 - sp.cos(sp.pi / 2 * x / x0))}[reg]
-    return Piecewise((1, x >= x0), (-1, x <= -x0), (inside, True))
-
 
 class Force(PartialSource, PartialElementaryOneFlangeAndSupport2):
     """A force ``f`` applied on ``flange`` along +s, reacting on the support

@@ -25,7 +25,7 @@ import sys
 import threading
 import time
 
-from .errors import BudgetError, UsageError
+from ..errors import BudgetError, UsageError
 
 GB = 1e9
 DEFAULT_MAX_MEMORY = 4 * GB
