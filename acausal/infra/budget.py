@@ -180,10 +180,12 @@ class Watchdog:
                 return
 
     def _trip(self, reason):
+        """Stop the command: Ctrl-C in its main thread, and its end armed
+        (whatever it is doing then: executor.exit_soon)."""
         self.reason = _LAST["reason"] = reason
-        from .infra.executor import exit_soon
-        exit_soon(3)
         _thread.interrupt_main(signal.SIGINT)
+        from .executor import exit_soon
+        exit_soon(3)
 
 
 _LAST = {"reason": None}

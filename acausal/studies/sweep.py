@@ -474,10 +474,23 @@ def _collect_windowed(executor, todo: list, submit: Callable, on_row: Callable[[
                     bar.set_postfix(failed=failed, refresh=False)
                 bar.update(1)
     except BaseException:
+        _keep_finished(inflight, on_row)
         executor.cancel(list(inflight))
         raise
     finally:
         bar.close()
+
+
+def _keep_finished(inflight: dict, on_row: Callable[[dict, dict], None]) -> None:
+    """On an interruption: record the points whose results have arrived but
+    were not yet taken (they would be computed again on resume)."""
+    for future, point in list(inflight.items()):
+        try:
+            if future.done() and not future.cancelled() and future.exception() is None:
+                on_row(point, future.result())
+                inflight.pop(future)
+        except BaseException:  # noqa: BLE001 - best effort while unwinding an interruption
+            return
 
 
 @dataclasses.dataclass(frozen=True)
