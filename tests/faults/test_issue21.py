@@ -156,12 +156,14 @@ def test_a_memory_watchdog_stops_the_command_with_its_reason():
 def test_a_sweep_past_its_wall_limit_stops_keeping_its_points(tmp_path):
     model = h.copy_model("osc_sweep_model.py", tmp_path / "model")
     out = tmp_path / "sweep.csv"
+    # 60 points of 1 s each on 2 workers need 30 s: well past the 8 s limit on
+    # any machine (at 0.3 s a point a quiet host finished the sweep in time)
     proc = h.cli(["sweep", model, "--param", "mass.m=1:2:60", "--measure", "s_end", "--out",
-                  out, "--workers", "2", "--no-progress", "--max-wall", "10"],
-                 h.env(tmp_path / "log", sleep=0.3))
+                  out, "--workers", "2", "--no-progress", "--max-wall", "8"],
+                 h.env(tmp_path / "log", sleep=1.0))
     _, stderr = proc.communicate(timeout=120)
     assert proc.returncode == 3, stderr
-    assert "more than the limit --max-wall 10 s" in stderr and "Traceback" not in stderr
+    assert "more than the limit --max-wall 8 s" in stderr and "Traceback" not in stderr
     rows = out.read_text().splitlines()[1:]
     assert 1 <= len(rows) < 60
     started = len(list((tmp_path / "log").iterdir()))   # points whose measure ran
