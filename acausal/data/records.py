@@ -60,11 +60,14 @@ class MeasuredExperiment:
 
 @dataclass
 class Dataset:
-    """Experiments and instrument description read from (or for) ``folder``."""
+    """Experiments and instrument description read from (or for) ``folder``;
+    ``notes``: one line for each change made to the data after reading (a
+    trace thinned by the diagnosis)."""
 
     folder: Optional[Path]
     experiments: list[MeasuredExperiment]
     instrument: dict[str, Instrument] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)   # what was done to the data (thinned)
 
     @property
     def condition_names(self) -> list[str]:

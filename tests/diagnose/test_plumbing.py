@@ -153,3 +153,44 @@ def test_the_context_runs_tasks_and_checkpoints_only_what_it_is_told():
         with clock.timing("b_s"):
             raise ValueError
     assert list(clock.times) == ["a_s"] and clock.elapsed() >= clock.times["a_s"]
+
+
+OSCILLATOR = '''
+from acausal import Experiment, Model
+from acausal.mechanics.translational import Fixed, Mass, Spring
+
+model = Model()
+model.mass = Mass(m=1.0, s=0.1, v=0.0)
+model.spring = Spring(c=100.0, s_rel0=0.0)
+model.ground = Fixed()
+model.connect(model.ground.flange, model.spring.flange_a)
+model.connect(model.spring.flange_b, model.mass.flange)
+experiment = Experiment(t_end=0.5, rtol=1e-8, atol=1e-10, output_step=1e-3)
+free_parameters = {"spring.c": (50.0, 200.0)}
+'''
+
+
+def test_the_workers_fit_the_same_thinned_traces_the_diagnosis_loads(tmp_path):
+    """A 5001-sample trace of a signal travelling 72 mm read in 1 mm steps
+    (floor 0.29 mm) supports about 250 samples: the dataset the stages load
+    and the one every worker task loads (dataset_of) are thinned alike
+    (main had thinned only the first: the fits saw every sample), and the
+    dataset's notes say so."""
+    import numpy as np
+
+    from acausal.data import Dataset, Instrument, MeasuredExperiment, Trace, write_dataset
+    from acausal.diagnose.stages.chain import load_problem
+    from acausal.diagnose.stages.tasks import dataset_of
+    (tmp_path / "osc.py").write_text(OSCILLATOR)
+    t = np.linspace(0.0, 0.5, 5001)
+    x = np.round(0.1 * np.cos(10.0 * t) / 1e-3) * 1e-3
+    write_dataset(tmp_path / "data", Dataset(None, [MeasuredExperiment(
+        "a", {"mass.m": 1.0}, {}, Trace(t, {"mass.s": x}))],
+        {"mass.s": Instrument("mass.s", resolution=1e-3)}))
+    problem, ds = load_problem(str(tmp_path / "osc.py"), str(tmp_path / "data"))
+    worker = dataset_of(problem)
+    n = len(ds.experiments[0].trace.time)
+    assert 200 < n < 5001 and len(ds.notes) == 1 and "5,001" in ds.notes[0]
+    np.testing.assert_array_equal(worker.experiments[0].trace.time,
+                                  ds.experiments[0].trace.time)
+    assert worker.notes == ds.notes

@@ -264,7 +264,8 @@ def test_a_resumed_sweep_says_so_and_writes_rows_in_grid_order(tmp_path):
 
 
 def test_a_long_trace_is_thinned_to_what_the_instrument_supports():
-    from acausal.data.records import Dataset, Experiment, Instrument, Trace
+    from acausal.data.records import Dataset, Instrument, Trace
+    from acausal.data.records import MeasuredExperiment as Experiment
     from acausal.diagnose.stages.chain import MAX_TRACE_SAMPLES, thin_traces
     n = 1_000_000
     t = np.linspace(0.0, 1.0, n)
@@ -291,7 +292,8 @@ def test_plausibility_warnings_are_one_line_each(capsys):
     from types import SimpleNamespace as NS
 
     from acausal.cli import _calibration_warnings, _condition_warnings
-    from acausal.data.records import Dataset, Experiment
+    from acausal.data.records import Dataset
+    from acausal.data.records import MeasuredExperiment as Experiment
     exps = [Experiment(f"E{k}", {"v": v}, {"t": m}, None)
             for k, (v, m) in enumerate([(1.0, 2e-3), (1.1, -2e-3), (4.0, 2.0)])]
     ds = Dataset(None, exps, {})

@@ -33,6 +33,7 @@ from ..library.loader import load_library
 from ..problem import NOMINAL, Candidate, FitSettings, Param, Problem, free_param, pair_of
 from .tasks import CandidateFit, FitTask, LooTask, Starts, calibrate_nominal, fit_candidate, \
     refit_without
+from .tasks import MAX_TRACE_SAMPLES, MIN_TRACE_SAMPLES, thin_traces  # noqa: F401 (re-exported)
 
 BUDGET_FACTOR = 12.0  # a candidate fit stops when it takes this many times the nominal fit
 BUDGET_MIN_S = 60.0   # ... but at least this long [s] (machine-dependent: rarely reached)
@@ -54,69 +55,13 @@ def load_problem(model_path, data_folder, library=None, settings=None):
                              column=exc.column) from None
     if not ds.experiments:
         raise DiagnosisError(f"{data_folder}: no experiments")
-    ds = thin_traces(ds)
+    ds = thin_traces(ds, say=True)
     if not any(e.measures or e.trace is not None for e in ds.experiments):
         raise DiagnosisError(f"{data_folder}: no measured values (no measures, no traces)")
     free = tuple(free_param(n, cm.params[cm.param_index(n)].default, lo, hi)
                  for n, (lo, hi) in mf.free.items())
     lib = load_library(library).name
     return Problem(model_path, data_folder, lib, free, settings or FitSettings()), ds
-
-
-MAX_TRACE_SAMPLES = 4000   # samples of one trace a diagnosis fits (each fit simulates them all)
-MIN_TRACE_SAMPLES = 200    # ... and at least this many, when the trace has them
-
-
-def thin_traces(ds, max_samples=MAX_TRACE_SAMPLES, notes=None):
-    """The dataset with each long trace thinned to what its instrument
-    floor supports, evenly (every k-th sample, the last one kept): about
-    one sample per floor the signal travels (its total variation over the
-    floor, the largest over its signals; independent noise makes every
-    sample count), at least ``MIN_TRACE_SAMPLES`` and at most
-    ``max_samples``. Samples closer than the floor are not independent
-    (the quantisation error of a slow signal is correlated: :mod:`.stats`)
-    and a fit's cost grows with them (a 5 M-sample trace). Each thinning is
-    said on stderr and kept in ``ds.notes``."""
-    notes = list(getattr(ds, "notes", []) if notes is None else notes)
-    experiments = []
-    for e in ds.experiments:
-        tr = e.trace
-        n = 0 if tr is None else len(tr.time)
-        if n <= MIN_TRACE_SAMPLES:
-            experiments.append(e)
-            continue
-        supported = 0
-        for name, y in tr.signals.items():
-            inst = ds.instrument.get(name)
-            floor = inst.floor() if inst is not None else 0.0
-            if not floor > 0:
-                supported = n
-                break
-            travel = float(np.sum(np.abs(np.diff(y))))
-            supported = max(supported, int(min(travel / floor, 1e15)) + 1)
-        keep = min(n, max(supported, MIN_TRACE_SAMPLES), max_samples)
-        if keep >= n:
-            experiments.append(e)
-            continue
-        step = -(-n // keep)
-        idx = np.arange(0, n, step)
-        if idx[-1] != n - 1:
-            idx = np.append(idx, n - 1)
-        why = ("the diagnosis's limit of "
-               f"{max_samples:,} samples per trace" if supported > max_samples else
-               "what the instrument floor supports (about one sample per floor the signal "
-               "travels)")
-        note = (f"{e.name}: trace thinned from {n:,} to {len(idx):,} samples (every "
-                f"{step:,}th): {why}")
-        notes.append(note)
-        import sys
-        print(f"acausal: note: {note}", file=sys.stderr, flush=True)
-        trace = dataclasses.replace(tr, time=tr.time[idx],
-                                    signals={k: v[idx] for k, v in tr.signals.items()})
-        experiments.append(dataclasses.replace(e, trace=trace))
-    out = dataclasses.replace(ds, experiments=experiments)
-    out.notes = notes
-    return out
 
 
 def _select(items, wanted, what):
