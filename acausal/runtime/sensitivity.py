@@ -17,9 +17,10 @@ principle: one graph, several backends, sensitivities from the same graph).
 The augmented unknowns are ordered states first (the states, then their
 sensitivities per parameter, then the algebraic unknowns and theirs), so
 everything that splits a DAE into states and algebraic unknowns works
-unchanged. The augmented system's Jacobian is block lower triangular; its
-iteration matrix keeps the diagonal blocks, each the base model's
-(:meth:`SensitivityModel._generate`: IDAS's simultaneous corrector).
+unchanged. The augmented system's Jacobian is block lower triangular
+(each diagonal block the base model's) and its iteration matrix is all of
+it, the blocks that couple a parameter's rows to the base unknowns included
+(:meth:`SensitivityModel._generate`).
 
 The run integrates it as one observer of the hybrid loop
 (:class:`acausal.runtime.sensitivity_run.SensitivityObserver`): at the
@@ -129,12 +130,10 @@ class SensitivityModel:
         yp_all = list(dae.yp) + [s for j in range(m) for s in Sp[j]]
         res_all = list(dae.residuals) + [rows[i][j] for j in range(m) for i in range(n)]
         org_all = list(dae.origins) + [dae.origins[i] for j in range(m) for i in range(n)]
-        block = self.order // n                   # block of each augmented position
-        same = [tuple(np.flatnonzero(block == b).tolist()) for b in range(m + 1)]
+        # the whole Jacobian (jacobian_columns None): see _generate
         self.dae = DAE([y_all[k] for k in self.order], [yp_all[k] for k in self.order],
                        ns * (1 + m), [res_all[k] for k in self.order],
-                       [org_all[k] for k in self.order], dae.explicit,
-                       tuple(frozenset(same[b]) for b in block))
+                       [org_all[k] for k in self.order], dae.explicit, None)
         self.disc_syms = list(cm.disc_syms) + self.sd_syms
         roots = [cm.resolve(e.expr) for e in cm.events] + \
             [cm.resolve(a.expr) for a in cm.assertions]
@@ -152,20 +151,23 @@ class SensitivityModel:
 
     def _generate(self, lin, roots):
         """The augmented system's generated callbacks (:func:`acausal.compiler.codegen.generate`):
-        its residuals, the diagonal blocks of its Jacobian (see below), the
-        base roots and the observed variables followed by their
-        sensitivities.
+        its residuals, its whole Jacobian (see below), the base roots and
+        the observed variables followed by their sensitivities.
 
-        The iteration matrix keeps only the diagonal blocks: each is the base
-        model's (``F_y + cj F_y'``), and the blocks coupling a parameter's
-        rows to the base unknowns (second derivatives of the residuals,
-        most of the generation's work) are left out, as IDAS's simultaneous
-        corrector does: Newton's error in the sensitivities then vanishes
-        one iteration after the base unknowns' (the neglected part is
-        nilpotent), and the sensitivities are those of the exact equations.
-        Where the coupling is needed (the algebraic rates after an event),
-        it is a directional difference
-        (:meth:`acausal.runtime.sensitivity_run.SensitivityObserver.rates`)."""
+        The iteration matrix is the whole augmented Jacobian: the diagonal
+        blocks (each the base model's ``F_y + cj F_y'``) and the blocks that
+        couple a parameter's rows to the base unknowns (``d/dy`` of
+        ``F_y s + F_y' s' + F_p``: second derivatives of the residuals).
+        Keeping only the diagonal blocks (IDAS's simultaneous corrector)
+        leaves the sensitivities one Newton iteration behind the base
+        unknowns: the second iteration then corrects them by the coupling
+        times the base unknowns' first correction, and IDA's convergence
+        test reads that as a diverging iteration (rate > 0.9) whenever the
+        coupling, weighted by the tolerances, exceeds the base block's:
+        ``m a + ... = 0`` with respect to ``m`` where ``|a| > |da/dm|`` (a
+        mass after a friction element's stop and break-away: 1.5 million
+        steps of 1e-7 s instead of 281). The exact Newton matrix has no such
+        ratio; the cost is the second derivatives at generation."""
         return generate(self.dae, self.base.param_syms, self.disc_syms, roots,
                         self.observed_exprs())
 
@@ -204,19 +206,18 @@ class SensitivityModel:
         variables, then their sensitivities per parameter."""
         return len(self.base.var_names) * (1 + self.m)
 
-    def block_solve(self, J, b, coupling):
-        """``A x = b`` for the augmented system's re-initialisation matrix
-        ``A``, block lower triangular: each parameter's block depends only
-        on its own sensitivities and the base unknowns, with the base
-        matrix on the diagonal. ``J``: its diagonal blocks (the generated
-        Jacobian, :func:`acausal.runtime.linalg.event_matrix`);
-        ``coupling(x0)``: the off-diagonal blocks times the base block's
-        solution ``x0`` (rows of the whole vector). Forward substitution
-        with the base block (every diagonal block is the base model's
-        matrix): one solve for the base block, one with a right-hand side
-        per parameter for the rest; a dense solve of the whole would also
-        mix blocks of very different scales (d/dp of a 1e-4 kg m^2
-        inertia; rcond 1e-16 on the breaker)."""
+    def block_solve(self, J, b):
+        """``J x = b`` for the augmented system's re-initialisation matrix
+        ``J`` (:func:`acausal.runtime.linalg.event_matrix` of the generated
+        Jacobian), block lower triangular: each parameter's block depends
+        only on its own sensitivities and the base unknowns, with the base
+        matrix on the diagonal. Forward substitution with the base block
+        (every diagonal block is the base model's matrix): one solve for
+        the base block, one with a right-hand side per parameter for the
+        rest, less the coupling blocks times the base block's solution; a
+        dense solve of the whole would also mix blocks of very different
+        scales (d/dp of a 1e-4 kg m^2 inertia; rcond 1e-16 on the
+        breaker)."""
         rows, cols = self.event_blocks()
         if not isinstance(J, np.ndarray):
             J = J.toarray()
@@ -224,7 +225,7 @@ class SensitivityModel:
         x = np.empty_like(b)
         x0 = solve_square(J0, b[rows[0]])
         x[cols[0]] = x0
-        c0 = coupling(x0)
+        c0 = J[:, cols[0]] @ x0
         X = solve_square(J0, np.column_stack([b[r] - c0[r] for r in rows[1:]]))
         for j, c in enumerate(cols[1:]):
             x[c] = X[:, j]

@@ -87,13 +87,9 @@ class SensitivityObserver(RunObserver):
             self.dtau[:] = run.schedule.time_sensitivity(point.t, d, self.sm.pidx)
             self.pending = {ev: self.dtau.copy() for ev in fired}
         elif kind == "recheck":
-            # NOTE: the instant's array itself, not a copy, as the loop has
-            # always passed it: such an event's entry in the result is the
-            # array's value when the result is made, zero after every instant
-            # (on_instant_end). Copying it would give the instant's dtau/dp,
-            # the event's true time derivative; kept as it is until that
-            # change is made on purpose (it moves sensitivity-based fits).
-            self.pending = {i: self.dtau for i in fired}
+            # the instant's dtau/dp (a copy: the array is zeroed when the
+            # instant ends, on_instant_end)
+            self.pending = {i: self.dtau.copy() for i in fired}
         else:
             self.pending = self.event_times(point, d, fired, current=kind == "instant")
 
@@ -168,13 +164,11 @@ class SensitivityObserver(RunObserver):
         """``YP`` with y' of every algebraic slot of the augmented system
         (callbacks ``cb``), as the initialisation's algebraic rates give it:
         ``J x = -(F_t + F_y(states) y'_states)`` for x = (y' of the
-        algebraic slots, y'' of the states), solved by blocks with the base
-        model's matrix ``J0``
-        (:meth:`acausal.runtime.sensitivity.SensitivityModel.block_solve`). The
-        right side, and the coupling of each parameter's rows to the base
-        block's solution, are directional central differences of the
-        augmented residual (the generated Jacobian has only the diagonal
-        blocks)."""
+        algebraic slots, y'' of the states), solved by blocks with the
+        generated Jacobian
+        (:meth:`acausal.runtime.sensitivity.SensitivityModel.block_solve`);
+        the right side is a central difference of the augmented residual
+        along the solution."""
         sm = self.sm
         N, nsa = len(sm.dae.y), sm.ns * (1 + sm.m)
         if N == nsa:
@@ -186,27 +180,11 @@ class SensitivityObserver(RunObserver):
         dt = 1e-6 * max(1.0, abs(t))
         saved = list(cb.count)
         rhs = -_central(lambda h: _residual(cb, t + h, Y + h * move, YP), dt)
-        x = sm.block_solve(J, rhs, lambda x0: self._coupling(cb, t, Y, YP, x0))
+        x = sm.block_solve(J, rhs)
         cb.count[:] = saved     # these are not solver step attempts
         if np.all(np.isfinite(x)):
             YP[nsa:] = x[:N - nsa]
         return YP
-
-    def _coupling(self, cb, t, Y, YP, x0):
-        """(rows of the parameters' blocks) the augmented residual's
-        derivative along the base block's unknowns moved by ``x0`` (its
-        re-initialisation columns: the algebraic slots' y, the states' y')."""
-        sm = self.sm
-        N, nsa = len(sm.dae.y), sm.ns * (1 + sm.m)
-        rows, cols = sm.event_blocks()
-        v = np.zeros(N)                              # event-matrix column space
-        v[cols[0]] = x0
-        dY, dYP = np.zeros(N), np.zeros(N)
-        dY[nsa:] = v[:N - nsa]
-        dYP[:nsa] = v[N - nsa:]
-        base = np.concatenate([Y[nsa:], YP[:nsa]])
-        h = 1e-7 * (1.0 + np.max(np.abs(base))) / max(np.max(np.abs(x0)), 1e-300)
-        return _central(lambda e: _residual(cb, t, Y + e * dY, YP + e * dYP), h)
 
     # -- events ------------------------------------------------------------------
     def polish(self, t, Y, YP, d_aug):
