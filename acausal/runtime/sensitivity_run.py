@@ -87,8 +87,10 @@ class SensitivityObserver(RunObserver):
             self.dtau[:] = run.schedule.time_sensitivity(point.t, d, self.sm.pidx)
             self.pending = {ev: self.dtau.copy() for ev in fired}
         elif kind == "recheck":
-            # the instant's dtau/dp (a copy: the array is zeroed when the
-            # instant ends, on_instant_end)
+            # an event found when the instant's event iteration rechecks the
+            # conditions happens at the instant's time: its time derivative
+            # is the instant's dtau/dp, copied (the array is zeroed when the
+            # instant ends: on_instant_end)
             self.pending = {i: self.dtau.copy() for i in fired}
         else:
             self.pending = self.event_times(point, d, fired, current=kind == "instant")
