@@ -130,7 +130,7 @@ class SensitivityModel:
         yp_all = list(dae.yp) + [s for j in range(m) for s in Sp[j]]
         res_all = list(dae.residuals) + [rows[i][j] for j in range(m) for i in range(n)]
         org_all = list(dae.origins) + [dae.origins[i] for j in range(m) for i in range(n)]
-        # the whole Jacobian (jacobian_columns None): see _generate
+        # the Jacobian's columns are chosen at generation (_generate)
         self.dae = DAE([y_all[k] for k in self.order], [yp_all[k] for k in self.order],
                        ns * (1 + m), [res_all[k] for k in self.order],
                        [org_all[k] for k in self.order], dae.explicit, None)
@@ -140,11 +140,15 @@ class SensitivityModel:
         key = _cache_key(cm, names, self.dae.residuals)
         hit = _cache_load(key)
         if hit is None:
+            columns = self._jacobian_columns()
+            self.dae = dataclasses.replace(self.dae, jacobian_columns=columns)
             gen = self._generate(lin, roots)
             self.source, self.sparsity = gen.source, gen.sparsity
-            _cache_store(key, self.source, self.sparsity)
+            _cache_store(key, self.source, self.sparsity, columns)
         else:
-            self.source, self.sparsity = hit
+            self.source, self.sparsity, columns = hit
+            # (the C generator reads them too: codegen_c)
+            self.dae = dataclasses.replace(self.dae, jacobian_columns=columns)
         self._make = load(self.source)[0]
         self.rootgrad = root_gradients(dae, cm.param_syms, cm.disc_syms, roots, P, self.dyn)
         self.inverse = np.argsort(self.order)
@@ -170,6 +174,32 @@ class SensitivityModel:
         ratio; the cost is the second derivatives at generation."""
         return generate(self.dae, self.base.param_syms, self.disc_syms, roots,
                         self.observed_exprs())
+
+    def _jacobian_columns(self):
+        """Per augmented residual, the slots its Jacobian row is taken over:
+        a base row its own block; a parameter's row its own block and each
+        base slot whose coupling entries (d/dy and d/dy' of the row) are
+        small expressions (at most :data:`COUPLING_NODES` tree nodes: a
+        parameter times an unknown, ``m a``, ``c x``, gives a constant).
+        Larger ones (the breaker's contact law differentiated twice: up to
+        1e5 operations an entry, which doubled the C build of a cold cache)
+        are left out, as all of them were before: the matrix is then a
+        modified Newton's there (the solution is that of the exact
+        equations either way)."""
+        dae, n = self.dae, self.n
+        block = self.order // n
+        base = [k for k in range(len(dae.y)) if block[k] == 0]
+        out = []
+        for i, r in enumerate(dae.residuals):
+            own = [k for k in range(len(dae.y)) if block[k] == block[i]]
+            if block[i] == 0:
+                out.append(frozenset(own))
+                continue
+            keep = [k for k in base
+                    if all(_size(diff(r, x), COUPLING_NODES + 1) <= COUPLING_NODES
+                           for x in (dae.y[k], dae.yp[k]) if x is not None and r.has(x))]
+            out.append(frozenset(own + keep))
+        return tuple(out)
 
     def observed_exprs(self):
         """The base model's observed variables, then their sensitivities per
@@ -270,6 +300,19 @@ class SensitivityModel:
         return self.pack(a, [a / s for s in scales])
 
 
+COUPLING_NODES = 64   # a coupling entry of at most this many tree nodes is generated
+
+
+def _size(expr, limit):
+    """Nodes of ``expr``'s tree, counting stops past ``limit``."""
+    count = 0
+    for _ in sp.preorder_traversal(expr):
+        count += 1
+        if count > limit:
+            break
+    return count
+
+
 def _cache_key(cm, names, residuals):
     """Key of a sensitivity model in the store: the base model's generated
     source (which fixes its DAE), the parameter names, the augmented
@@ -286,21 +329,23 @@ def _cache_key(cm, names, residuals):
 
 
 def _cache_load(key):
-    """(source, Sparsity) of a stored sensitivity model, or None."""
+    """(source, Sparsity, Jacobian columns) of a stored sensitivity model, or None."""
     data = store.read_bytes("sensitivity", f"sens_{key}.json")
     if data is None:
         return None
     try:
         data = json.loads(data)
-        return data["source"], Sparsity(**data["sparsity"])
+        columns = tuple(frozenset(c) for c in data["columns"])
+        return data["source"], Sparsity(**data["sparsity"]), columns
     except (ValueError, KeyError, TypeError):
         return None   # an unreadable entry is generated again
 
 
-def _cache_store(key, source, sparsity):
+def _cache_store(key, source, sparsity, columns):
     """Keep a sensitivity model in the store (atomically; nothing when the
     store is off or cannot be written: it is generated again next time)."""
-    text = json.dumps({"source": source, "sparsity": dataclasses.asdict(sparsity)})
+    text = json.dumps({"source": source, "sparsity": dataclasses.asdict(sparsity),
+                       "columns": [sorted(c) for c in columns]})
     store.write_bytes("sensitivity", f"sens_{key}.json", text.encode())
 
 
