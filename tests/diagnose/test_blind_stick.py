@@ -31,7 +31,7 @@ def _rows(res, name):
     return t[keep], y[keep]
 
 
-@pytest.mark.parametrize("backend", ["sundae", "compiled"])
+@pytest.mark.parametrize("backend", ["compiled", pytest.param("sundae", marks=pytest.mark.slow)])
 def test_stick_slip_hypothesis_follows_the_independent_truth(backend):
     """At the truth's level the extended model stops where and when the
     event-driven scipy truth does, and stays there: stop times within 1e-8
