@@ -93,3 +93,17 @@ def test_a_body_that_sticks_is_explained_by_stick_slip_friction(tmp_path, seed):
     assert floors > 50
     assert blind.named(out) == {("stick_slip_friction", "slider")}
     assert blind.values(out)["hyp_ssf.F"] == pytest.approx(F_TRUE, rel=0.10)
+
+
+@pytest.mark.slow
+def test_a_viscous_loss_at_a_joint_is_named_viscous_damping(tmp_path):
+    """A viscous loss in m2's guide of the two-mass chain (b = 0.05 N*s/m,
+    about 94 noise floors; the free damper acts at m1, so it cannot absorb
+    it): viscous_damping is named at m2 with b within 10 %."""
+    import two_mass_truth
+    model = os.path.join(HERE, "two_mass.py")
+    out, det, floors = blind.run_case(model, two_mass_truth, tmp_path, "m2_viscous", 0.05,
+                                      seed=11, name="two-mass m2_viscous 0.05")
+    assert floors > 50
+    assert blind.named(out) == {("viscous_damping", "m2")}
+    assert blind.values(out)["hyp_vd.b"] == pytest.approx(0.05, rel=0.10)

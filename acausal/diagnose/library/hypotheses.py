@@ -450,6 +450,8 @@ class FlexibleLink(Hypothesis):
         out = []
         for j in graph.joints:
             body = j.component
+            if not has_role(body, "body"):
+                continue        # a planar joint: no mass of its own to split
             seen = []
             for o in graph.at_node(body.flange):
                 if o is body:
