@@ -42,7 +42,10 @@ contact_damping_law       contact         e(v_i) = e - a v_i (clipped to [0.01, 
 Families (``FAMILIES``: cause class -> members, the head first; the other
 members are fitted where the head is competitive, :mod:`.families`):
 friction (``coulomb_viscous_friction``: + b v; ``stribeck_friction``:
-(F + dF exp(-(v/v_s)^2)) tanh(v/v_eps)), drag (``power_drag``: c v
+(F + dF exp(-(v/v_s)^2)) tanh(v/v_eps); ``stick_slip_friction``: F sign(v)
+sliding and held at rest within peak*F, by the friction mode machine's
+events, so a body that stops against its spring stays there;
+``viscous_damping``: b v), drag (``power_drag``: c v
 (v^2 + v_eps^2)^((n-1)/2) / v_ref^(n-2)), spring_nonlinearity
 (``bilinear_spring``: k2 (u - clip(u, -d, d)); ``dead_band_spring``: the
 spring's force c (u - clip(u, -b, b))), contact_damping
