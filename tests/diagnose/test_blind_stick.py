@@ -107,3 +107,27 @@ def test_a_viscous_loss_at_a_joint_is_named_viscous_damping(tmp_path):
     assert floors > 50
     assert blind.named(out) == {("viscous_damping", "m2")}
     assert blind.values(out)["hyp_vd.b"] == pytest.approx(0.05, rel=0.10)
+
+
+def test_stick_slip_yields_to_coulomb_within_the_parsimony_margin():
+    """On dry friction that never holds the body the two laws fit alike
+    (the torsion rig: 0.6 AICc units apart): the head, Coulomb friction, is
+    named; the stick-slip member only when it gains more than 2 units (a
+    body that sticks: 24000 units on the stick rig)."""
+    import dataclasses
+
+    from test_families import _row
+
+    from acausal.diagnose.stages.chain import Ranking
+    from acausal.diagnose.stages.families import family_index, prefer_simplest
+    rows = (_row("stick_slip_friction", "rotor", {"hyp_ssf.tau": 8e-3}),
+            _row("coulomb_friction", "rotor", {"hyp_cf.tau": 8e-3}),
+            _row("viscous_damping", "rotor", {"hyp_vd.b": 1e-4}))
+    index = family_index(None)
+    assert index.refines == {"stick_slip_friction"}
+    for gap, named in ((0.6, "coulomb_friction"), (1.9, "coulomb_friction"),
+                       (2.5, "stick_slip_friction")):
+        rs = tuple(dataclasses.replace(r, aicc=a) for r, a in zip(rows, (10.0, 10.0 + gap,
+                                                                        10.0 + gap + 0.1)))
+        got = prefer_simplest(Ranking(rs, [[0, 1, 2]], 0, 0, None, [], (), 1.0), index)
+        assert got.named.candidate.hypothesis == named, gap

@@ -114,6 +114,10 @@ class Hypothesis:
     #                     cause at a site moving the other way has the same sign
     #                     (acausal.diagnose.stages.kinematics.convert); False: a constant load
     relative_cost = 1.0  # a simulation's cost against the nominal model's (task ordering)
+    refines = None      # the head whose law this member equals outside a regime the data
+    #                     must show (stick_slip_friction: Coulomb friction, except that it
+    #                     holds a stopped body): within the parsimony margin the head is
+    #                     named (acausal.diagnose.stages.families.prefer_simplest)
 
     # -- interface ------------------------------------------------------------------
     def candidates(self, graph):
@@ -691,6 +695,7 @@ class StickSlipFriction(CoulombFriction):
     id = "stick_slip_friction"
     title = "Dry friction with stiction (stick-slip) at a joint"
     prefix = "hyp_ssf"
+    refines = "coulomb_friction"   # the same law while it slides
     fixed = {"peak": 1.0}
     # events at every stop and reversal (each a re-initialisation): on the stick
     # rig (tests/diagnose/stick_rig.py, compiled, loaded host) 22.8 ms a run at
