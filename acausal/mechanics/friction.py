@@ -167,7 +167,8 @@ class Friction(_CoulombViscous, PartialCompliant):
 
     Stuck -> sliding when ``f`` crosses ``+F_s`` (forward) or ``-F_s``
     (backward); sliding -> stuck when ``v_rel`` reaches 0 and the holding
-    force is at most ``F_s``, otherwise it slides the other way at once.
+    force is at most ``F_s``, otherwise it slides the other way (at once, or
+    when ``v_rel`` has crossed zero: MSL's start flags).
     A normal-force form is obtained by binding ``F_c = mu*N`` and
     ``F_s = mu_s*N`` to model parameters.
 
@@ -175,7 +176,9 @@ class Friction(_CoulombViscous, PartialCompliant):
     [N] break-away (static) friction force (>= F_c; F_c when not given),
     ``d`` [N*s/m] viscous coefficient (>= 0).
     States: ``s_rel`` [m], ``v_rel`` [m/s], ``a_rel`` [m/s^2], ``f`` [N];
-    discrete ``mode`` (-1 sliding backward, 0 stuck, +1 sliding forward).
+    the shared machine's (discrete ``mode``: 3 before the start, -1 sliding
+    backward, 0 stuck, +1 sliding forward; ``startForward``,
+    ``startBackward``; ``sa``, ``locked``, ``lossPower`` [W]).
     Connectors: ``flange_a``, ``flange_b``.
     """
 
@@ -202,8 +205,9 @@ class GroundFriction(_CoulombViscous, Component):
     Parameters: ``F_c`` [N] kinetic (Coulomb) friction force (>= 0), ``F_s``
     [N] break-away (static) friction force (>= F_c; F_c when not given),
     ``d`` [N*s/m] viscous coefficient (>= 0).
-    States: ``v_rel`` [m/s], ``a_rel`` [m/s^2], ``f`` [N]; discrete ``mode``
-    (-1 sliding backward, 0 stuck, +1 sliding forward).
+    States: ``v_rel`` [m/s], ``a_rel`` [m/s^2], ``f`` [N]; the shared
+    machine's (``mode`` 3 before the start, -1, 0, +1; ``startForward``,
+    ``startBackward``; ``sa``, ``locked``, ``lossPower`` [W]).
     Connectors: ``flange``.
     """
 
@@ -235,7 +239,9 @@ class RotFriction(_CoulombViscous, PartialRotCompliant):
     ``tau_s`` [N*m] break-away torque (>= tau_c; tau_c when not given), ``d``
     [N*m*s/rad] viscous coefficient (>= 0).
     States: ``phi_rel`` [rad], ``w_rel`` [rad/s], ``a_rel`` [rad/s^2],
-    ``tau`` [N*m]; discrete ``mode`` (-1, 0, +1).
+    ``tau`` [N*m]; the shared machine's (``mode`` 3 before the start, -1,
+    0, +1; ``startForward``, ``startBackward``; ``sa``, ``locked``,
+    ``lossPower`` [W]).
     Connectors: ``flange_a``, ``flange_b``.
     """
 
@@ -269,8 +275,10 @@ class BearingFriction(_CoulombViscous, Component):
     Parameters: ``tau_c`` [N*m] kinetic (Coulomb) friction torque (>= 0),
     ``tau_s`` [N*m] break-away torque (>= tau_c; tau_c when not given), ``d``
     [N*m*s/rad] viscous coefficient (>= 0).
-    States: ``w_rel`` [rad/s], ``a_rel`` [rad/s^2], ``tau`` [N*m]; discrete
-    ``mode`` (-1, 0, +1).
+    States: ``w_rel`` [rad/s], ``a_rel`` [rad/s^2], ``tau`` [N*m]; the
+    shared machine's (``mode`` 3 before the start, -1, 0, +1;
+    ``startForward``, ``startBackward``; ``sa``, ``locked``, ``lossPower``
+    [W]).
     Connectors: ``flange``.
     """
 
