@@ -93,7 +93,10 @@ def test_members_are_seeded_from_the_head_at_its_site_only():
     idx = family_index(prob.library)
     assert [r.candidate.hypothesis for r in heads(dec, idx)] == ["coulomb_friction"]
     got = {c.hypothesis: (c, head) for c, head in member_candidates(prob, dec, idx)}
-    assert set(got) == {"coulomb_viscous_friction", "stribeck_friction"}
+    assert set(got) == {"coulomb_viscous_friction", "stribeck_friction", "stick_slip_friction",
+                        "viscous_damping"}
+    ssf = {p.name: p for p in got["stick_slip_friction"][0].params}
+    assert ssf["hyp_ssf.F"].start == 2.5                                        # seeded
     cvf = {p.name: p for p in got["coulomb_viscous_friction"][0].params}
     assert cvf["hyp_cvf.F"].start == 2.5 and cvf["hyp_cvf.F"].prior == 0.0   # seeded
     assert cvf["hyp_cvf.b"].start == 0.0

@@ -51,7 +51,12 @@ def test_the_best_pair_is_refitted_with_its_simpler_mate_seeded_from_it():
                       {"k1.c": 2020.0, "d1.d": 1.2, "hyp_qd.c": 0.4, "hyp_sf.F": 0.03,
                        "hyp_sf.dF": 0.01, "hyp_sf.v_s": 0.1}, cost=400.0)
     tasks = simpler_tasks(_problem(), CAL, [worse, best], 1.0, 60.0)
-    assert [t.candidate.key for t in tasks] == [("quadratic_damping+coulomb_friction", "m1+m2")]
+    # every one-parameter member of the friction family (issue 24 added the
+    # stick-slip and the plain viscous members)
+    assert [t.candidate.key for t in tasks] == [("quadratic_damping+coulomb_friction", "m1+m2"),
+                                                ("quadratic_damping+stick_slip_friction",
+                                                 "m1+m2"),
+                                                ("quadratic_damping+viscous_damping", "m1+m2")]
     t = tasks[0]
     assert {p.name: p.start for p in t.candidate.params} == {"hyp_qd.c": 0.5, "hyp_cf.F": 0.02}
     assert all(p.prior == 0.0 for p in t.candidate.params)
@@ -60,7 +65,8 @@ def test_the_best_pair_is_refitted_with_its_simpler_mate_seeded_from_it():
     assert t.problem.settings.lhs == 0 and t.problem.settings.refine == 1
     # a pair already fitted is not fitted again
     assert simpler_tasks(_problem(), CAL, [best], 1.0, 60.0,
-                         done={("quadratic_damping+coulomb_friction", "m1+m2")}) == []
+                         done={(f"quadratic_damping+{m}", "m1+m2") for m in (
+                             "coulomb_friction", "stick_slip_friction", "viscous_damping")}) == []
 
 
 def test_simpler_mates_of_one_family_at_two_sites_keep_the_pair_naming():
@@ -72,12 +78,18 @@ def test_simpler_mates_of_one_family_at_two_sites_keep_the_pair_naming():
                       "hyp_cvf2.F": 0.02, "hyp_cvf2.b": 2e-6}, cost=100.0)
     got = {t.candidate.key: {p.name: p.start for p in t.candidate.params}
            for t in simpler_tasks(_problem(), CAL, [best], 1.0, 60.0)}
-    assert got == {
+    expected = {
         ("coulomb_viscous_friction+coulomb_friction", "m1+m2"):
             {"hyp_cvf.F": 0.01, "hyp_cvf.b": 1e-6, "hyp_cf.F": 0.02},
         ("coulomb_friction+coulomb_viscous_friction", "m1+m2"):
             {"hyp_cf.F": 0.01, "hyp_cvf.F": 0.02, "hyp_cvf.b": 2e-6},
-        ("coulomb_friction+coulomb_friction", "m1+m2"): {"hyp_cf.F": 0.01, "hyp_cf2.F": 0.02}}
+        ("coulomb_friction+coulomb_friction", "m1+m2"): {"hyp_cf.F": 0.01, "hyp_cf2.F": 0.02},
+        ("viscous_damping+viscous_damping", "m1+m2"): {"hyp_vd.b": 1e-6, "hyp_vd2.b": 2e-6},
+        ("stick_slip_friction+coulomb_friction", "m1+m2"): {"hyp_ssf.F": 0.01, "hyp_cf.F": 0.02}}
+    assert {k: got[k] for k in expected} == expected
+    # each of the two members, or both, replaced by one of its three simpler mates
+    # (Coulomb, stick-slip, viscous): 4 x 4 - 1 pairs
+    assert len(got) == 15
 
 
 def _row(fitted: CandidateFit, aicc, heldout):

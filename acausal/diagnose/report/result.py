@@ -176,7 +176,17 @@ def summary(d: Diagnosis) -> dict:
             d.next_experiment.to_dict()),
         profile_ci95={} if d.intervals is None else clean(d.intervals.to_dict()),
         cause_class=cause_class(d),
+        failed=failed(d),
     )
+
+
+def failed(d: Diagnosis) -> list:
+    """The candidates that could not be built or fitted, each with its
+    reason (a candidate the library offers but cannot compile at a site is
+    not silently dropped)."""
+    return [dict(cause=r.candidate.hypothesis, location=r.candidate.location,
+                 error=r.error or (r.fit.message if r.fit is not None else ""))
+            for r in d.decision.failed]
 
 
 def unexplained(d: Diagnosis) -> dict:
@@ -218,9 +228,7 @@ def details(d: Diagnosis) -> dict:
                          r.fit, dict(aicc=num(r.aicc), heldout_rmse=num(r.heldout_rmse),
                                      lr_p=num(r.lr_p), starts=_starts(r.starts)))
                     for r in rk.rows],
-        failed=[dict(cause=r.candidate.hypothesis, location=r.candidate.location,
-                     error=r.error or (r.fit.message if r.fit is not None else ""))
-                for r in dec.failed],
+        failed=failed(d),
         located=[dict(node=t.node, members=list(t.members), S=num(t.S), aicc=num(t.aicc),
                       heldout_rmse=num(t.heldout_rmse), values=t.values,
                       ranges=list(t.ranges))

@@ -152,7 +152,10 @@ def prefer_simplest(rk, index: FamilyIndex):
     mates = [i for i, r in enumerate(rk.rows) if _family_sites(r.candidate, index) == sites
              and r.aicc <= best.aicc + PARSIMONY and r.starts.tested
              and rk.heldout_no_worse(i, rk.after)]
-    pick = min(mates, key=lambda i: (rk.rows[i].k, rk.rows[i].aicc), default=rk.after)
+    # equal k: a member that only refines its head (stick-slip: Coulomb friction that
+    # also holds a stopped body) yields to the head within the margin (issue 24)
+    pick = min(mates, key=lambda i: (rk.rows[i].k, rk.rows[i].candidate.hypothesis
+                                     in index.refines, rk.rows[i].aicc), default=rk.after)
     if pick == rk.after:
         return rk
     return dataclasses.replace(rk, after=pick,
