@@ -18,9 +18,9 @@ The augmented unknowns are ordered states first (the states, then their
 sensitivities per parameter, then the algebraic unknowns and theirs), so
 everything that splits a DAE into states and algebraic unknowns works
 unchanged. The augmented system's Jacobian is block lower triangular
-(each diagonal block the base model's) and its iteration matrix is all of
-it, the blocks that couple a parameter's rows to the base unknowns included
-(:meth:`SensitivityModel._generate`).
+(each diagonal block the base model's); its iteration matrix has the
+diagonal blocks and the small entries of the blocks that couple a
+parameter's rows to the base unknowns (:meth:`SensitivityModel._generate`).
 
 The run integrates it as one observer of the hybrid loop
 (:class:`acausal.runtime.sensitivity_run.SensitivityObserver`): at the
@@ -158,10 +158,10 @@ class SensitivityModel:
         its residuals, its whole Jacobian (see below), the base roots and
         the observed variables followed by their sensitivities.
 
-        The iteration matrix is the whole augmented Jacobian: the diagonal
-        blocks (each the base model's ``F_y + cj F_y'``) and the blocks that
-        couple a parameter's rows to the base unknowns (``d/dy`` of
-        ``F_y s + F_y' s' + F_p``: second derivatives of the residuals).
+        The iteration matrix has the diagonal blocks (each the base model's
+        ``F_y + cj F_y'``) and the small entries of the blocks that couple a
+        parameter's rows to the base unknowns (``d/dy`` of ``F_y s + F_y' s'
+        + F_p``: second derivatives of the residuals; :meth:`_jacobian_columns`).
         Keeping only the diagonal blocks (IDAS's simultaneous corrector)
         leaves the sensitivities one Newton iteration behind the base
         unknowns: the second iteration then corrects them by the coupling
@@ -170,8 +170,8 @@ class SensitivityModel:
         coupling, weighted by the tolerances, exceeds the base block's:
         ``m a + ... = 0`` with respect to ``m`` where ``|a| > |da/dm|`` (a
         mass after a friction element's stop and break-away: 1.5 million
-        steps of 1e-7 s instead of 281). The exact Newton matrix has no such
-        ratio; the cost is the second derivatives at generation."""
+        steps of 1e-7 s instead of 287). With the coupling in the matrix
+        there is no such ratio."""
         return generate(self.dae, self.base.param_syms, self.disc_syms, roots,
                         self.observed_exprs())
 
