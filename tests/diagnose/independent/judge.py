@@ -24,30 +24,35 @@ def _sites(cause):
         yield eq["location"], dict(eq.get("parameters") or {})
 
 
-def _param(params, short):
+def _param(params, names):
     for k, v in params.items():
-        if k.rpartition(".")[2] == short:
+        if k.rpartition(".")[2] in names:
             return v.get("value") if isinstance(v, dict) else v
     return None
 
 
 def match(cause, expect, laws, nodes=None):
     """Relative error of ``cause`` against ``expect`` (cases.Expect), or
-    None when it is not that cause (another law, another site)."""
+    None when it is not that cause (another law, another site). A cause
+    shown at a site tied to the truth's (``nodes``) is compared through its
+    value converted to the truth's site (``equivalent_sites``); with no
+    such value it is the right cause with an unknown error (inf)."""
     if cause["cause"] not in expect.ids:
         return None
     truth = abs(laws[expect.law].values[expect.key])
     ok_sites = set(nodes or (expect.site,)) | {expect.site}
+    if cause["location"] not in ok_sites:
+        return None
     best = None
-    for loc, params in _sites(cause):
-        if loc not in ok_sites:
+    for loc, params in _sites(cause):     # the value as at the truth's own site
+        if loc != expect.site:
             continue
         v = _param(params, expect.param)
         if v is None:
             continue
         err = abs(abs(float(v)) - truth) / truth
         best = err if best is None else min(best, err)
-    return best
+    return float("inf") if best is None else best
 
 
 def judge(case, laws, out, tied=None):
