@@ -7,6 +7,7 @@ already there is skipped: the table resumes) and the table to ``--out``.
 
     PYTHONPATH=. python benchmarks/independent_cases.py --effects 30 --seeds 0
     PYTHONPATH=. python benchmarks/independent_cases.py --cases gear_null,cam_detent
+    PYTHONPATH=. python benchmarks/independent_cases.py --table-only
 
 Columns: case, truth (the hidden laws as scaled), effect (noise-free RMS
 change of the data, floors), seed, verdict, named cause and location,
@@ -16,7 +17,6 @@ wall (s) and simulations.
 """
 import argparse
 import json
-import os
 import sys
 import tempfile
 import time
@@ -107,6 +107,8 @@ def main(argv=None):
     ap.add_argument("--log", default=str(HERE.parent / "docs" / "independent_cases.jsonl"))
     ap.add_argument("--out", default=str(HERE.parent / "docs" / "independent_cases.md"))
     ap.add_argument("--label", default="", help="a heading for the table (code version)")
+    ap.add_argument("--table-only", action="store_true",
+                    help="only write the table from the runs already in --log")
     a = ap.parse_args(argv)
     log = Path(a.log)
     done = set()
@@ -117,7 +119,7 @@ def main(argv=None):
             if r.get("label", "") == a.label:
                 done.add((r["case"], r.get("target"), r["seed"]))
                 rows.append(r)
-    for name in a.cases.split(","):
+    for name in ([] if a.table_only else a.cases.split(",")):
         case = C.CASES[name]
         effects = [float(e) for e in a.effects.split(",")] if case.scale and case.laws else [None]
         for eff in effects:
