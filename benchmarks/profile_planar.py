@@ -64,6 +64,8 @@ def main(argv=None):
     ap.add_argument("--data", default=os.path.join(tempfile.gettempdir(), "acausal_planar"))
     ap.add_argument("--profile", default=None)
     ap.add_argument("--json", default=None)
+    ap.add_argument("--no-profile", action="store_true",
+                    help="time only (cProfile slows sympy's model building 3-8x)")
     a = ap.parse_args(argv)
     from acausal.diagnose.run import diagnose
     from acausal.diagnose.synth import synthesize
@@ -84,14 +86,15 @@ def main(argv=None):
     ch0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     load0, c0, t0 = os.getloadavg(), cpu_s(), time.perf_counter()
     with tempfile.TemporaryDirectory() as out:
-        prof.enable()
+        if not a.no_profile:
+            prof.enable()
         res = diagnose(PLANAR, a.data, out_dir=out, progress=False, plots=False,
                        scheduler="serial")
-        prof.disable()
+        if not a.no_profile:
+            prof.disable()
         timing = json.loads(open(os.path.join(out, "candidates.json")).read())["timing"]
     wall, cpu, load1 = time.perf_counter() - t0, cpu_s() - c0, os.getloadavg()
-    st = pstats.Stats(prof)
-    buckets = split(st)
+    buckets = {} if a.no_profile else split(pstats.Stats(prof))
     ch1 = resource.getrusage(resource.RUSAGE_CHILDREN)
     buckets["C compiler processes (cc, CPU of children)"] = (
         ch1.ru_utime + ch1.ru_stime - ch0.ru_utime - ch0.ru_stime)
@@ -104,7 +107,7 @@ def main(argv=None):
     print(counter.table())
     for k, v in buckets.items():
         print(f"{k}: {v:.1f} s")
-    if a.profile:
+    if a.profile and not a.no_profile:
         prof.dump_stats(a.profile + ".prof")
         with open(a.profile, "w") as f:
             s = pstats.Stats(prof, stream=f)
