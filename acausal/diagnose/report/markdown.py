@@ -455,7 +455,16 @@ def _class_lines(d):
         L.append("- the experiments that would tell them apart:")
         for hid in dict.fromkeys(h for r in [best] + others for h, _, _ in r.candidate.members()):
             L.append(f"  - {hid}: {lib.HYPOTHESES[hid].distinguishing_experiment}")
-    if rk.weak:
-        L.append("- **evidence is weak**:")
-        L += [f"  - {w}" for w in rk.weak]
+    v = d.verdict
+    if v.kind == "weak" and v.reasons:
+        L.append("- **evidence is weak** (the data cannot decide):")
+        L += [f"  - {r.text} [`{r.code}`]" for r in v.reasons]
+    elif v.kind == "not_explained":
+        L.append("- **not explained by the library** (never \"weak\" in this case):")
+        L += [f"  - {r.text} [`{r.code}`]" for r in v.reasons]
+        L += [f"  - a mixture of laws? {x.text}" for x in v.laws if x.text not in
+              " ".join(r.text for r in v.reasons)]
+    if v.threshold is not None:
+        L.append(f"- held-out threshold: {fmt(v.threshold.rms, 4)} floors "
+                 f"({v.threshold.sentence()})")
     return L
