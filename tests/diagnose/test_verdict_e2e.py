@@ -3,7 +3,12 @@ independent scipy simulator (hand-written equations, no code shared with
 the project's models): a force the library has no law for (a detent:
 periodic in the position, several cycles over the stroke) is "not
 explained by the library", not "weak"; the same slider without it stays
-"no discrepancy". (A strong single cause that must still be named: the
+"no discrepancy"; drag that is viscous and quadratic at once, fitted by
+the power law alone, is "not explained" with the exponent flagged as a
+mixture of laws; plain viscous damping fitted by Coulomb + viscous
+friction is named with the Coulomb level flagged as undetermined (each
+parameter judged against its own neutral value). Each of these was "weak"
+before issue 24. (A strong single cause that must still be named: the
 slider of tests/diagnose/test_outputs.py, whose verdict kind is checked
 there.)"""
 import json
@@ -29,45 +34,48 @@ LIGHT = FitSettings(max_nfev=20, lhs=1, refine=1, windows=(1.0,), evals_per_para
 HYPS = ["coulomb_friction", "constant_load", "quadratic_damping"]
 
 
-def truth(s0, detent, times):
-    """m s'' = -k s + A sin(2 pi s / lam): a detent of amplitude A [N] and
-    pitch lam [m] (``detent`` = (A, lam), or None), released at rest."""
+def detent(A, lam):
+    """A detent of amplitude A [N] and pitch lam [m]: A sin(2 pi s / lam)."""
+    return lambda s, v: A * np.sin(2 * np.pi * s / lam)
+
+
+def truth(s0, force, times):
+    """m s'' = -k s + force(s, v) (``force`` None: nothing more), released
+    at rest from s0."""
     def f(_, y):
-        force = -STIFF * y[0]
-        if detent is not None:
-            A, lam = detent
-            force += A * np.sin(2 * np.pi * y[0] / lam)
-        return [y[1], force / MASS]
+        extra = 0.0 if force is None else force(y[0], y[1])
+        return [y[1], (-STIFF * y[0] + extra) / MASS]
     sol = integrate.solve_ivp(f, (0.0, times[-1]), [s0, 0.0], t_eval=times, method="DOP853",
                               rtol=1e-11, atol=1e-13)
     return sol.y[0]
 
 
-def _data(folder, detent, seed):
+def _data(folder, force, seed, starts=STARTS):
     rng = np.random.default_rng(seed)
     exps = [MeasuredExperiment(name, dict(s0=s0, v0=0.0), {},
-                               Trace(TIMES, {"mass.s": truth(s0, detent, TIMES)
+                               Trace(TIMES, {"mass.s": truth(s0, force, TIMES)
                                              + FLOOR * rng.standard_normal(TIMES.size)}))
-            for name, s0 in STARTS]
+            for name, s0 in starts]
     write_dataset(folder, Dataset(str(folder), exps,
                                   {"mass.s": Instrument("mass.s", 0.0, FLOOR)}))
 
 
-def _diagnose(tmp_path, detent, seed):
-    _data(tmp_path / "data", detent, seed)
+def _diagnose(tmp_path, force, seed, hypotheses=HYPS, starts=STARTS):
+    _data(tmp_path / "data", force, seed, starts)
     res = run_stages(SLIDER, tmp_path / "data", out_dir=tmp_path / "out", scheduler="serial",
-                     progress=False, hypotheses=HYPS, settings=LIGHT, generic=False,
+                     progress=False, hypotheses=hypotheses, settings=LIGHT, generic=False,
                      pairs=False, families=False, profile=False, design=False, views=False)
     return res, json.loads(json.dumps(summary(res)))
 
 
+@pytest.mark.slow
 def test_a_detent_outside_the_library_is_not_explained_not_weak(tmp_path):
     """A 0.5 N detent of 10 mm pitch: the best library candidate leaves the
     held-out data well beyond the threshold noise alone reaches, so the
     verdict is "not explained by the library" with the candidates and their
     held-out errors, and no weak reason. (Before issue 24 this case was
     "evidence weak".)"""
-    res, out = _diagnose(tmp_path, (0.5, 0.01), 3)
+    res, out = _diagnose(tmp_path, detent(0.5, 0.01), 3)
     v = out["verdict"]
     print(f"\nverdict {v['kind']}: {[r['text'] for r in v['reasons']]}; "
           f"held-out {out['gain']['before']['heldout']:.3f} -> "
@@ -95,6 +103,44 @@ def test_the_same_slider_without_the_detent_stays_without_discrepancy(tmp_path):
     assert out["unexplained"]["value"] is False and out["cause"] is None
     # the held-out error of data the model explains is within the threshold
     assert out["gain"]["before"]["heldout"] <= out["verdict"]["heldout_threshold"]["rms"]
+
+
+@pytest.mark.slow
+def test_two_drag_laws_at_once_are_a_mixture_not_a_power_law(tmp_path):
+    """f = -0.5 v - 3 v|v| over starts of 0.1, 0.03 and 0.01 m (speeds over
+    a 10:1 range): the power law fits the training data to 4.7 floors with
+    n = 1.59 [1.53, 1.65], away from both standard laws, and misses the
+    held-out experiments (15.7 floors): not explained, "a mixture of laws?"
+    (before: "weak", the best leaving 4.8x the floor)."""
+    res, out = _diagnose(tmp_path, lambda s, v: -0.5 * v - 3.0 * v * abs(v), 5,
+                         ["power_drag", "quadratic_damping", "coulomb_friction"],
+                         (("a", 0.1), ("b", 0.03), ("c", 0.01)))
+    v = out["verdict"]
+    assert v["kind"] == "not_explained" and out["cause"] is None
+    (law,) = v["laws"]
+    assert law["cause"] == "power_drag" and law["parameter"] == "hyp_pd.n"
+    lo, hi = law["ci95"]
+    assert 1.0 < lo < hi < 2.0 and "mixture of laws" in v["reasons"][0]["text"]
+    assert v["heldout_rmse"] > 3 * v["heldout_threshold"]["rms"]
+    assert "A mixture of laws?" in markdown(res)
+
+
+def test_viscous_damping_is_named_with_its_coulomb_level_flagged(tmp_path):
+    """Plain viscous damping, b = 0.8 N*s/m (12 floors), with Coulomb +
+    viscous friction in the library: b is determined to about 1 % and the
+    Coulomb level F ~ 0 is not. Judged parameter by parameter, the cause is
+    named and F flagged undetermined (before: "poorly determined, 332 %",
+    from F alone)."""
+    res, out = _diagnose(tmp_path, lambda s, v: -0.8 * v, 5,
+                         ["coulomb_viscous_friction", "constant_load"])
+    v = out["verdict"]
+    assert v["kind"] == "named" and out["cause"] == "coulomb_viscous_friction"
+    assert out["parameters"]["hyp_cvf.b"]["value"] == pytest.approx(0.8, rel=0.03)
+    (flag,) = v["undetermined"]
+    assert flag["name"] == "hyp_cvf.F" and flag["neutral"] == 0.0
+    assert flag["ci95"][0] < 0.0 < flag["ci95"][1]
+    assert out["gain"]["after"]["heldout"] <= v["heldout_threshold"]["rms"]
+    assert "Undetermined" in markdown(res)
 
 
 if __name__ == "__main__":    # pragma: no cover
