@@ -254,5 +254,7 @@ def prefer_simplest(rk, index: FamilyIndex):
     pick = min(mates, key=lambda i: (rk.rows[i].k, rk.rows[i].aicc), default=rk.after)
     if pick == rk.after:
         return rk
-    return dataclasses.replace(rk, after=pick,
-                               cause=pick if rk.cause is not None else None)
+    v = rk.verdict
+    return dataclasses.replace(rk, after=pick, cause=pick if rk.cause is not None else None,
+                               verdict=v if v is None else dataclasses.replace(
+                                   v, heldout=rk.rows[pick].heldout_rmse))
