@@ -11,7 +11,6 @@
 * every screened plausible rival fitted (a short fit beyond the budget);
 * the pair search goes on when the best single misses the held-out data.
 """
-import dataclasses
 from types import SimpleNamespace as NS
 
 import numpy as np
