@@ -14,7 +14,7 @@ what a right diagnosis says:
 ``stick`` cases are not scaled: their friction is fixed strong enough that
 the mechanism stops and sticks within the record (``events`` say where).
 """
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 try:
     from . import cam_truth, gear_truth
