@@ -81,9 +81,9 @@ def pairs_searched(ctx: Context, s: State) -> State:
     if not (s.options.pairs and stages.pairs_needed(s.decision)):
         return s
     with ctx.clock.timing("pairs_s"):
-        got, screen_n_sim = stages.search_pairs(ctx, s.problem, s.calibration, s.decision)
-        s = decided(ctx, dataclasses.replace(s, fits=s.fits + tuple(got),
-                                             pair_screen_n_sim=screen_n_sim))
+        got = stages.search_pairs(ctx, s.problem, s.calibration, s.decision)
+        s = decided(ctx, dataclasses.replace(s, fits=s.fits + got.fits, pair_search=got,
+                                             pair_screen_n_sim=got.screen_n_sim))
         again = stages.member_refit_tasks(s.problem, s.calibration, s.decision)
         if again:
             refits = ctx.run(fit_candidate, again, "refitting the pair's members")
@@ -100,7 +100,8 @@ def cross_validated(ctx: Context, s: State) -> State:
 def ranked(ctx: Context, s: State) -> State:
     """The ranking and the verdict (:func:`.stages.chain.rank`)."""
     return dataclasses.replace(s, ranking=stages.rank(s.dataset, s.calibration, s.decision,
-                                                      s.cv, s.members.unfitted))
+                                                      s.cv, s.members.unfitted
+                                                      + s.pair_search.unfitted))
 
 
 def shown(ctx: Context, s: State) -> State:
@@ -200,6 +201,10 @@ def _timing(s: State, clock: Clock, t_fit: float, t_cv: float) -> dict:
     extra = dict(clock.times)
     if s.pair_screen_n_sim is not None:
         extra["pair_screen_n_sim"] = s.pair_screen_n_sim
+        ps = s.pair_search
+        extra["pair_screen"] = dict(pairs=ps.screened, within_reach=ps.within_reach,
+                                    fitted=ps.fitted, share=ps.share,
+                                    unfitted=[u.label for u in ps.unfitted])
     return dict(fit_s=t_fit, cv_s=t_cv, n_candidates=len(s.candidates), n_sim=s.n_sim,
                 total_s=clock.elapsed(), **extra)
 
