@@ -350,19 +350,18 @@ def tied_candidates(problem, kin: Kinematics, rows, allowed=None) -> list:
 
 def _moved(lib, graph, row, k, site, ratio):
     """Member ``k`` of ``row`` as a single candidate at ``site``, seeded
-    from the row's fit, converted through ``ratio`` (None: the same site)."""
+    from the row's fit, converted through ``ratio`` (None: the same site).
+    A hypothesis's parameters correspond by position between sites (a
+    friction force F on a body is a torque tau on a shaft)."""
     h, loc, names = row.candidate.members()[k]
     hyp = lib.HYPOTHESES[h]
-    fitted = {n.partition(".")[2]: row.fit.values[n] for n in names}
     dom = domain_name(graph.components[loc]) if ratio is not None else None
-    here = {sp_.name.partition(".")[2]: sp_ for sp_ in hyp.params(graph, loc)}
+    odd = getattr(hyp, "odd", True)
     params = []
-    for spec in hyp.params(graph, site):
-        short = spec.name.partition(".")[2]
-        v = fitted.get(short)
+    for here, spec, name in zip(hyp.params(graph, loc), hyp.params(graph, site), names):
+        v = row.fit.values.get(name)
         if v is not None and ratio is not None:
-            unit = here[short].unit if short in here else spec.unit
-            v = convert(v, unit, dom, ratio, getattr(hyp, "odd", True))
+            v = convert(v, here.unit, dom, ratio, odd)
         params.append(Param.from_spec(spec, v))
     return Candidate(h, site, tuple(params))
 
