@@ -27,12 +27,14 @@ class State:
     the stages set them: the nominal fit (``calibration``), every candidate
     fit so far (``fits``), the ``decision``, the family ``members``, the
     simulations the pair screen spent (``pair_screen_n_sim``; None: the pair
-    search did not run) and the pair search's outcome (``pair_search``), the exact leave-one-out refits (``cv``), the
-    ``ranking``, the tied sites (``kinematics``), the located discrepancy
-    (``location``), the profile ``intervals``, the ``extended_model`` file,
-    the named cause's kinematically ``tied`` sites, the library's
-    ``families``, the ``next_experiment`` and the report's ``views``. A
-    stage that did not run leaves its field at its default."""
+    search did not run) and the pair search's outcome (``pair_search``),
+    the tied sites (``kinematics``, before the fits at tied sites), the
+    exact leave-one-out refits (``cv``), the ``ranking``, the located
+    discrepancy (``location``), the profile ``intervals``, the
+    ``extended_model`` file, the named cause's kinematically ``tied``
+    sites, the library's ``families``, the ``next_experiment`` and the
+    report's ``views``. A stage that did not run leaves its field at its
+    default."""
 
     problem: Problem
     dataset: Dataset
