@@ -309,7 +309,9 @@ def search_pairs(ctx: Context, problem: Problem, cal: NominalFit, dec: Decision)
     simpler = ps.simpler_tasks(problem, cal, fits, dec.c_hat, budget,
                                {t.candidate.key for t in tasks})
     fits += ctx.run(fit_candidate, simpler, "fitting simpler mates") if simpler else []
-    reach = {p.key for p in first + more + list(left)}
+    got = {_pair_key(r.candidate) for r in fits if r.ok}
+    left = [p for p in left if p.key not in got]        # a simpler mate may be one of them
+    reach = {p.key for p in first + more + left}
     return PairSearch(tuple(fits), sum(r.n_sim for r in screened), len(preds),
                       len(reach), len(first) + len(more), share,
                       tuple(Unfitted(p.label, p.aicc) for p in left))

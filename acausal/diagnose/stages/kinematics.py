@@ -357,11 +357,13 @@ def _moved(lib, graph, row, k, site, ratio):
     hyp = lib.HYPOTHESES[h]
     dom = domain_name(graph.components[loc]) if ratio is not None else None
     odd = getattr(hyp, "odd", True)
+    here, there = hyp.params(graph, loc), hyp.params(graph, site)
+    same = len(here) == len(there) == len(names)
     params = []
-    for here, spec, name in zip(hyp.params(graph, loc), hyp.params(graph, site), names):
-        v = row.fit.values.get(name)
+    for i, spec in enumerate(there):
+        v = row.fit.values.get(names[i]) if same else None
         if v is not None and ratio is not None:
-            v = convert(v, here.unit, dom, ratio, odd)
+            v = convert(v, here[i].unit, dom, ratio, odd)
         params.append(Param.from_spec(spec, v))
     return Candidate(h, site, tuple(params))
 
