@@ -211,18 +211,3 @@ def test_a_cause_at_a_tied_site_is_fitted_at_the_other_site_too():
     assert [q.start for q in p.params] == pytest.approx([0.004, 0.3])
     assert tied_candidates(problem, Kinematics(), [cf]) == []
 
-
-def test_pairs_are_searched_when_the_best_single_fails_on_held_out_data():
-    """A free drag exponent fits dry friction + drag to 1.15 floors on the
-    training data (S/(n-k) under 2) but not held out: the pairs are
-    searched; a best single that predicts the held-out data is not."""
-    from acausal.diagnose.stages.chain import PAIR_HELDOUT, pairs_needed
-
-    def dec(held, c_hat=1.1, discrepancy=True):
-        row = SimpleNamespace(heldout_rmse=held)
-        return SimpleNamespace(discrepancy=discrepancy, rows=(row,), c_hat=c_hat)
-    assert pairs_needed(dec(1.77)) and pairs_needed(dec(1.0, c_hat=3.0))
-    assert not pairs_needed(dec(1.0)) and not pairs_needed(dec(PAIR_HELDOUT))
-    assert not pairs_needed(dec(5.0, discrepancy=False))
-    assert not pairs_needed(dec(float("nan")))
-    assert st.OVERDISPERSION == 2.0
