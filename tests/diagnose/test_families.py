@@ -132,8 +132,14 @@ def test_a_pair_uses_one_hypothesis_at_two_sites(tmp_path):
     row = dataclasses.replace(row, candidate=pair)
     path = extend(Problem(str(f), "", "acausal.diagnose.library.hypotheses", ()),
                   Ranking((row,), [[0]], 0, 0, None, [], (), 1.0), tmp_path / "out")
-    assert ".renamed('hyp_cl2')" in open(path).read()
+    text = open(path).read()
+    assert ".renamed('hyp_cl2')" in text
+    # both hypotheses documented, both parameters free (issue 24)
+    doc = text.split('"""')[1]
+    assert "'constant_load' at 'm1'" in doc and "'constant_load' at 'm2'" in doc
+    assert "hyp_cl.F = 1" in doc and "hyp_cl2.F = 2" in doc
     mf2, cm2 = compile_file(path)
+    assert {"hyp_cl.F", "hyp_cl2.F"} <= set(mf2.free)
     res2 = cm2.simulate(**mf2.experiment.run_options(dense=True))
     np.testing.assert_allclose(res2["m2.s"], 2.0 / 50.0 * (1 - np.cos(w * res2.t)), atol=1e-6)
 
