@@ -304,6 +304,14 @@ def search_pairs(ctx: Context, problem: Problem, cal: NominalFit, dec: Decision)
                         "fitting pairs within the screen's reach")
         fitted.update({_pair_key(r.candidate): st.aicc(r.fit.cost, n, r.fit.k, dec.c_hat)
                        for r in fits if r.ok})
+    if left:   # within reach beyond MAX_FITS: a short fit from the step's point each
+        # (issue 24: no plausible rival is left unfitted for a budget)
+        short = dataclasses.replace(problem.from_fit(), settings=dataclasses.replace(
+            problem.from_fit().settings, evals_per_param=pscreen.SHORT_EVALS))
+        fits += ctx.run(fit_candidate, [_predicted_task(short, cal, p, budget) for p in left],
+                        "fitting the other pairs within reach, briefly")
+        fitted.update({_pair_key(r.candidate): st.aicc(r.fit.cost, n, r.fit.k, dec.c_hat)
+                       for r in fits if r.ok})
     share = pscreen.observed_share(preds, fitted) if preds else pscreen.SHARE
     simpler = ps.simpler_tasks(problem, cal, fits, dec.c_hat, budget,
                                {t.candidate.key for t in tasks})
