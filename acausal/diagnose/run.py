@@ -2,7 +2,7 @@
 cause, an extended model and the measured gain.
 
 :func:`diagnose` chains the stages (calibrate -> fit -> decide -> family
-members -> pairs -> cross-validate -> rank -> shown row and tied sites ->
+members -> pairs -> tied sites fitted -> cross-validate -> rank -> shown row ->
 locate -> intervals -> extend -> next experiment -> views), each a function
 ``stage(ctx, state) -> state`` of this module: ``ctx`` (a
 :class:`~.stages.context.Context`) holds the executor, the progress
@@ -32,7 +32,8 @@ from .stages.chain import DiagnosisError
 from .stages.context import Clock, Context
 from .stages.families import family_index, fit_members, prefer_simplest
 from .stages.intervals import intervals
-from .stages.kinematics import Kinematics, equivalents, kinematics, prefer_site
+from .stages.kinematics import Kinematics, equivalents, kinematics, prefer_site, \
+    tied_candidates
 from .stages.locate import Location, locate
 from .stages.nextexp import next_experiment
 from .stages.resume import FitStore
@@ -81,14 +82,39 @@ def pairs_searched(ctx: Context, s: State) -> State:
     if not (s.options.pairs and stages.pairs_needed(s.decision)):
         return s
     with ctx.clock.timing("pairs_s"):
-        got, screen_n_sim = stages.search_pairs(ctx, s.problem, s.calibration, s.decision)
-        s = decided(ctx, dataclasses.replace(s, fits=s.fits + tuple(got),
-                                             pair_screen_n_sim=screen_n_sim))
+        got = stages.search_pairs(ctx, s.problem, s.calibration, s.decision)
+        s = decided(ctx, dataclasses.replace(s, fits=s.fits + got.fits, pair_search=got,
+                                             pair_screen_n_sim=got.screen_n_sim))
         again = stages.member_refit_tasks(s.problem, s.calibration, s.decision)
         if again:
             refits = ctx.run(fit_candidate, again, "refitting the pair's members")
             s = decided(ctx, dataclasses.replace(s, fits=s.fits + tuple(refits)))
     return s
+
+
+def tied_fitted(ctx: Context, s: State) -> State:
+    """The tied sites read from the calibrated nominal runs
+    (:func:`.stages.kinematics.kinematics`) and, when a discrepancy is found,
+    each of the best rows fitted with a member moved to a site tied to its
+    own, where it was not (:func:`.stages.kinematics.tied_candidates`), then
+    the decision again: a cause is compared at both tied sites before either
+    is shown."""
+    d = s.decision
+    if d is None or not d.discrepancy or not d.rows:
+        return s
+    with ctx.clock.timing("kinematics_s"):
+        kin = kinematics(s.problem, s.calibration)
+    s = dataclasses.replace(s, kinematics=kin)
+    locs = s.options.locations
+    allowed = None if locs is None else (
+        lambda loc: any(loc == w or loc.startswith(w + ".") for w in locs))
+    cands = tied_candidates(s.problem, kin, d.rows, allowed)
+    if not cands:
+        return s
+    with ctx.clock.timing("tied_s"):
+        got = ctx.run(fit_candidate, stages.fit_tasks(s.problem, s.calibration, cands),
+                      "fitting at tied sites")
+    return decided(ctx, dataclasses.replace(s, fits=s.fits + tuple(got)))
 
 
 def cross_validated(ctx: Context, s: State) -> State:
@@ -100,7 +126,8 @@ def cross_validated(ctx: Context, s: State) -> State:
 def ranked(ctx: Context, s: State) -> State:
     """The ranking and the verdict (:func:`.stages.chain.rank`)."""
     return dataclasses.replace(s, ranking=stages.rank(s.dataset, s.calibration, s.decision,
-                                                      s.cv, s.members.unfitted))
+                                                      s.cv, s.members.unfitted
+                                                      + s.pair_search.unfitted))
 
 
 def shown(ctx: Context, s: State) -> State:
@@ -114,8 +141,10 @@ def shown(ctx: Context, s: State) -> State:
     if rk.after is None:
         return dataclasses.replace(s, ranking=rk,
                                    kinematics=Kinematics(message="no cause to place"))
-    with ctx.clock.timing("kinematics_s"):
-        kin = kinematics(s.problem, s.calibration)
+    kin = s.kinematics
+    if kin is None:
+        with ctx.clock.timing("kinematics_s"):
+            kin = kinematics(s.problem, s.calibration)
     return dataclasses.replace(s, ranking=prefer_site(rk, kin), kinematics=kin)
 
 
@@ -184,7 +213,8 @@ def run_stages(model_path, data_folder, options: DiagnosisOptions | None = None,
         ctx = Context(ex, opts.progress, collect, clock)
         s = fitted(ctx, calibrated(ctx, s))
         t_fit = clock.elapsed()
-        for stage in (decided, members_fitted, pairs_searched, cross_validated, ranked, shown,
+        for stage in (decided, members_fitted, pairs_searched, tied_fitted, cross_validated,
+                      ranked, shown,
                       located, profiled):
             s = stage(ctx, s)
     ctx = Context(None, opts.progress, collect, clock)   # the stages below submit no task
@@ -200,6 +230,10 @@ def _timing(s: State, clock: Clock, t_fit: float, t_cv: float) -> dict:
     extra = dict(clock.times)
     if s.pair_screen_n_sim is not None:
         extra["pair_screen_n_sim"] = s.pair_screen_n_sim
+        ps = s.pair_search
+        extra["pair_screen"] = dict(pairs=ps.screened, within_reach=ps.within_reach,
+                                    fitted=ps.fitted, share=ps.share,
+                                    unfitted=[u.label for u in ps.unfitted])
     return dict(fit_s=t_fit, cv_s=t_cv, n_candidates=len(s.candidates), n_sim=s.n_sim,
                 total_s=clock.elapsed(), **extra)
 

@@ -116,9 +116,17 @@ def test_stick_slip_yields_to_coulomb_within_the_parsimony_margin():
     body that sticks: 24000 units on the stick rig)."""
     import dataclasses
 
-    from test_families import _row
+    from acausal.diagnose.problem import Candidate, Param
+    from acausal.diagnose.stages.chain import Ranking, Row
+    from acausal.diagnose.stages.fitting import Fit
+    from acausal.diagnose.stages.tasks import Starts
 
-    from acausal.diagnose.stages.chain import Ranking
+    def _row(hid, loc, values):
+        cand = Candidate(hid, loc, tuple(Param(k, 0.0, 0.0, 10.0, 1.0, 0.0) for k in values))
+        fit = Fit(list(values), dict(values), 1.0, np.zeros(3), np.zeros((3, len(values))),
+                  [], [])
+        return Row(cand, fit, Starts(tested=True), {}, 0.0, 1.0, 1.0)
+
     from acausal.diagnose.stages.families import family_index, prefer_simplest
     rows = (_row("stick_slip_friction", "rotor", {"hyp_ssf.tau": 8e-3}),
             _row("coulomb_friction", "rotor", {"hyp_cf.tau": 8e-3}),

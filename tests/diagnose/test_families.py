@@ -132,8 +132,14 @@ def test_a_pair_uses_one_hypothesis_at_two_sites(tmp_path):
     row = dataclasses.replace(row, candidate=pair)
     path = extend(Problem(str(f), "", "acausal.diagnose.library.hypotheses", ()),
                   Ranking((row,), [[0]], 0, 0, None, [], (), 1.0), tmp_path / "out")
-    assert ".renamed('hyp_cl2')" in open(path).read()
+    text = open(path).read()
+    assert ".renamed('hyp_cl2')" in text
+    # both hypotheses documented, both parameters free (issue 24)
+    doc = text.split('"""')[1]
+    assert "'constant_load' at 'm1'" in doc and "'constant_load' at 'm2'" in doc
+    assert "hyp_cl.F = 1" in doc and "hyp_cl2.F = 2" in doc
     mf2, cm2 = compile_file(path)
+    assert {"hyp_cl.F", "hyp_cl2.F"} <= set(mf2.free)
     res2 = cm2.simulate(**mf2.experiment.run_options(dense=True))
     np.testing.assert_allclose(res2["m2.s"], 2.0 / 50.0 * (1 - np.cos(w * res2.t)), atol=1e-6)
 
@@ -283,10 +289,19 @@ def test_an_uninformative_extra_parameter_does_not_take_the_name():
     rk = Ranking(rows, [[0, 1, 2]], 0, 0, None, [], (), 1.0)
     got = prefer_simplest(rk, family_index(None))
     assert got.named.candidate.hypothesis == "coulomb_friction" and got.after == 1
-    # 2.5 units: the viscous term earns its place
+    # 2.5 units ahead but b without an interval that excludes 0 and no better
+    # held-out error (issue 24): the simpler member still takes the name
     rows2 = (rows[0], dataclasses.replace(rows[1], aicc=12.5), rows[2])
     assert prefer_simplest(Ranking(rows2, [[0, 1, 2]], 0, 0, None, [], (), 1.0),
-                           family_index(None)).after == 0
+                           family_index(None)).after == 1
+    # b determined (0.01 [0.009, 0.011]) and the held-out error 20 % better:
+    # the viscous term earns its place
+    e = np.random.default_rng(1).standard_normal(300)
+    sure = dataclasses.replace(rows[0], fit=dataclasses.replace(
+        rows[0].fit, ci95={"hyp_cvf.b": (0.009, 0.011), "hyp_cvf.F": (1.9, 2.1)}))
+    rk3 = Ranking((sure,) + rows2[1:], [[0, 1, 2]], 0, 0, None, [], (), 1.0,
+                  (e, 1.2 * e, 1.2 * e))
+    assert prefer_simplest(rk3, family_index(None)).after == 0
     # the constant load is another class of cause: never swapped in
     assert prefer_simplest(Ranking(rows[2:] + rows[:2], [[0]], 0, 0, None, [], (), 1.0),
                            family_index(None)).after == 0

@@ -239,3 +239,28 @@ def test_written_model_file_runs_and_equals_build_extended(hid, loc, values, tmp
     mf0, cm0 = compile_file(BREAKER)
     nominal = evaluate_measures(mf0, cm0.simulate(**mf0.experiment.run_options()))
     assert abs(got["thrt"] / nominal["thrt"] - 1) > 1e-4        # the values took effect
+
+
+def test_position_dependent_force_at_an_msl_torque_source():
+    """MSL's ConstantTorque (no ``quantity``; its value is PartialTorque's
+    ``tau``) is a source site: the hypothesis reads its torque for the
+    bounds (|k| = tau / travel) and, added with k, changes the steady twist
+    of the spring as the closed form says: the static balance
+    c*phi = tau + k*phi gives phi = tau / (c - k)."""
+    import os
+
+    from acausal.diagnose.library.hypotheses import build_extended
+    from acausal.diagnose.run import candidates
+    path = os.path.join(os.path.dirname(__file__), "constant_torque_model.py")
+    _, _, cands = candidates(path, hypotheses=["position_dependent_force"])
+    assert [(h, loc) for h, loc, _ in cands] == [("position_dependent_force", "drive")]
+    (spec,) = cands[0][2]
+    assert spec.low < 0 < spec.high
+    _, cm = build_extended(path, "position_dependent_force", "drive", {"hyp_pf.k": 10.0})
+    res = cm.simulate(t_end=3.0, params={"body.J": 0.01, "spring.c": 50.0},
+                      output_step=1e-2)
+    # the free oscillation about phi* = 2 / (50 - 10) = 0.05 rad: mean over whole periods
+    period = 2 * np.pi / np.sqrt((50.0 - 10.0) / 0.01)
+    n = int(3.0 / period) * period
+    m = res.t <= n
+    assert abs(np.trapezoid(res["body.phi"][m], res.t[m]) / res.t[m][-1] - 0.05) < 2e-3

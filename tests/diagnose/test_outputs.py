@@ -72,6 +72,9 @@ def test_json_has_the_issue_11_keys_filled(slider):
     F = [v["value"] for k, v in c["parameters"].items()]
     assert F[0] == pytest.approx(FRICTION, rel=0.05)
     assert out["unexplained"]["value"] is False
+    # issue 24: a strong single cause is still named, explaining the held-out data
+    assert out["verdict"]["kind"] == "named" and out["verdict"]["reasons"] == []
+    assert out["gain"]["after"]["heldout"] <= out["verdict"]["heldout_threshold"]["rms"]
     cls = out["cause_class"]
     assert cls["location"] == "mass" and cls["within_floor"] is True
     assert cls["leftover_floors"] < 1.3

@@ -16,6 +16,7 @@ from acausal.diagnose.stages.pairsearch import (
     keep,
     screen_starts,
 )
+from acausal.diagnose.library.loader import FamilyIndex
 from acausal.diagnose.problem import Candidate, Param, Problem
 from acausal.diagnose.stages.chain import Row, _acted_in, partners
 from acausal.diagnose.stages.tasks import Starts
@@ -34,7 +35,7 @@ class _Dec:
         self.rows, self.failed = tuple(rows), ()
 
 
-def test_the_best_single_meets_every_candidate_at_another_site():
+def test_the_best_single_meets_every_candidate_but_its_own_family_at_its_site():
     dec = _Dec([_row("constant_load", "m1", {"k.c": 52.0, "hyp_cl.F": 1.5}, tested=False),
                 _row("position_dependent_force", "coil", {"k.c": 51.0, "hyp_pf.k": 3.0}),
                 _row("coulomb_friction", "m1", {"k.c": 55.0, "hyp_cf.F": 0.0}, tested=False),
@@ -42,10 +43,19 @@ def test_the_best_single_meets_every_candidate_at_another_site():
                 _row("constant_load", "m2", {"k.c": 50.0, "hyp_cl.F": 4.0}),
                 _row("a+b", "m1+m2", {"k.c": 50.0, "hyp_a.x": 1.0, "hyp_b.y": 1.0})])
     got = partners(dec, done={("position_dependent_force+constant_load", "coil+m2")})
-    # the best *tested* single leads; the same site and pairs already done are left out
+    # the best *tested* single leads; pairs already done are left out; another
+    # family at the best single's own site is a partner (issue 24)
     assert [(c.hypothesis, c.location) for c in got] == [
         ("position_dependent_force+constant_load", "coil+m1"),
-        ("position_dependent_force+coulomb_friction", "coil+m1")]
+        ("position_dependent_force+coulomb_friction", "coil+m1"),
+        ("position_dependent_force+quadratic_damping", "coil+coil")]
+    # ... but not a member of its own family there
+    index = FamilyIndex({"position_dependent_force": ("force", 0),
+                         "quadratic_damping": ("force", 1)},
+                        {"force": ("position_dependent_force", "quadratic_damping")})
+    got_f = partners(dec, done=set(), index=index)
+    assert ("position_dependent_force+quadratic_damping", "coil+coil") not in [
+        (c.hypothesis, c.location) for c in got_f]
     first, second = got[1].params
     assert (first.name, first.start, first.prior) == ("hyp_pf.k", 3.0, 0.0)  # seeded from its fit
     assert (second.name, second.start) == ("hyp_cf.F", 0.0)                # partner at neutral

@@ -560,7 +560,10 @@ class PositionDependentForce(Hypothesis):
     def params(self, graph, location):
         src = graph.site("source", location).component
         dom = domain_of(src)
-        q = src.quantity[0]
+        # the source's value: a leaf of PartialSource names it (``quantity``);
+        # MSL's force and torque laws (ConstantTorque, SignForce, ...) carry it
+        # in the variable named after the domain's through variable (f, tau)
+        q = getattr(src, "quantity", (dom.through,))[0]
         f = graph._series(f"{location}.{q}")
         if f is not None:
             F = float(max(abs(f).max(), 0.0))

@@ -10,7 +10,7 @@ from ...data import Dataset
 from ..library.loader import FamilyIndex
 from ..options import DiagnosisOptions
 from ..problem import Problem
-from .chain import CrossValidation, Decision, NominalFit, Ranking
+from .chain import CrossValidation, Decision, NominalFit, PairSearch, Ranking
 from .families import Members
 from .intervals import Intervals
 from .kinematics import Kinematics
@@ -27,12 +27,14 @@ class State:
     the stages set them: the nominal fit (``calibration``), every candidate
     fit so far (``fits``), the ``decision``, the family ``members``, the
     simulations the pair screen spent (``pair_screen_n_sim``; None: the pair
-    search did not run), the exact leave-one-out refits (``cv``), the
-    ``ranking``, the tied sites (``kinematics``), the located discrepancy
-    (``location``), the profile ``intervals``, the ``extended_model`` file,
-    the named cause's kinematically ``tied`` sites, the library's
-    ``families``, the ``next_experiment`` and the report's ``views``. A
-    stage that did not run leaves its field at its default."""
+    search did not run) and the pair search's outcome (``pair_search``),
+    the tied sites (``kinematics``, before the fits at tied sites), the
+    exact leave-one-out refits (``cv``), the ``ranking``, the located
+    discrepancy (``location``), the profile ``intervals``, the
+    ``extended_model`` file, the named cause's kinematically ``tied``
+    sites, the library's ``families``, the ``next_experiment`` and the
+    report's ``views``. A stage that did not run leaves its field at its
+    default."""
 
     problem: Problem
     dataset: Dataset
@@ -44,6 +46,7 @@ class State:
     decision: Decision | None = None
     members: Members = field(default_factory=Members)
     pair_screen_n_sim: int | None = None
+    pair_search: PairSearch = field(default_factory=PairSearch)
     cv: CrossValidation | None = None
     ranking: Ranking | None = None
     kinematics: Kinematics | None = None
