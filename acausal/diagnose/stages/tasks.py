@@ -37,8 +37,8 @@ from ...modelfile import compile_file
 from ...studies.residuals import subset
 from .fitting import Budget, Fit, Objective, failed_fit, finish, linear_loo, penalty_cost, \
     refine_or_keep, residuals_of, score_starts
-from ..library.generic import GENERIC
-from ..library.generic import build as build_generic
+from ..library.generic import carries_generic, members as generic_members, \
+    model_for as generic_model
 from ..library.loader import load_library
 from ..problem import LOO_TOL, Candidate, Problem
 
@@ -124,9 +124,11 @@ def dataset_of(problem: Problem):
 def model_of(problem: Problem, candidate: Candidate):
     if candidate.hypothesis is None:
         return compile_file(problem.model_path)
-    if candidate.hypothesis == GENERIC.id:
-        return worker_cache(("diagnose-generic", _stamp(problem.model_path), candidate.location),
-                            lambda: build_generic(problem.model_path, candidate.location))
+    if carries_generic(candidate):           # the generic term, alone or beside a cause
+        return worker_cache(("diagnose-generic", _stamp(problem.model_path), problem.library,
+                             generic_members(candidate)), lambda: generic_model(
+                                 problem.model_path, candidate,
+                                 load_library(problem.library).HYPOTHESES))
     if "+" in candidate.hypothesis:          # a pair: "h1+h2" at "l1+l2"
         pair = tuple(zip(candidate.hypothesis.split("+"), candidate.location.split("+")))
         return worker_cache(("diagnose-pair", _stamp(problem.model_path), problem.library,
