@@ -130,3 +130,29 @@ def test_location_is_the_best_held_out_and_says_if_it_reaches_the_floor():
     assert not far.reaches_floor and far.heldout == pytest.approx(3.0)
     tied = L._verdict([_term("a", 1.0, 1.0), _term("b", 1.0005, 2.0)], _Dec(), _Rk(), 1000)
     assert tied.tied_nodes == ("b",)
+
+
+def test_term_beside_a_cause_builds_and_its_penalty_covers_only_the_weights():
+    """The term beside a named cause (candidate ``h+generic_force`` at
+    ``site+node``): built with both sub-models, the cause's parameters
+    first; with zero weights and zero friction it is the model file's own
+    run, and the smoothing penalty's scales are the weights' only."""
+    import os
+    from acausal.diagnose.library import hypotheses as hy
+    from acausal.diagnose.problem import Candidate, Param
+    from acausal.diagnose.stages.tasks import penalty_of
+    from acausal.modelfile import compile_file
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "slider_model.py")
+    mf, cm = gen.build_at(path, "mass", 9, 9, ("coulomb_friction", "mass"), hy.HYPOTHESES)
+    ref = compile_file(path)[1].simulate(t_end=0.25)
+    res = cm.simulate(t_end=0.25)
+    assert np.max(np.abs(res["mass.s"] - np.interp(res.t, ref.t, ref["mass.s"]))) < 1e-9
+    moved = cm.simulate(t_end=0.25, params={f"{gen.GENERIC.prefix}.a{i}": 1.0 for i in range(9)})
+    assert np.max(np.abs(moved["mass.s"] - np.interp(moved.t, ref.t, ref["mass.s"]))) > 1e-4
+    own = (Param("hyp_cf.tau", 0.1, 0.0, 10.0, 0.5, 0.0),)
+    w = tuple(Param(f"gen.a{i}", 0.0, -1, 1, 0.25, 0.0) for i in range(9)) + tuple(
+        Param(f"gen.b{j}", 0.0, -1, 1, 0.25, 0.0) for j in range(9))
+    cand = Candidate("coulomb_friction+generic_force", "mass+mass", own + w, gen.penalty(9, 9))
+    assert gen.members(cand) == (("coulomb_friction", "mass"), "mass", 9, 9)
+    P, sc = penalty_of(cand)
+    assert P.shape[1] == sc.size == 18 and np.all(sc == 0.25)

@@ -388,11 +388,13 @@ def calibrate_nominal(task: FitTask) -> CandidateFit:
 
 
 def penalty_of(cand):
-    """(rows P, scales) of a candidate's penalty on its own parameters (the
-    generic term's smoothing and pins), or None."""
+    """(rows P, scales) of a candidate's penalty on its last P.shape[1]
+    parameters (the generic term's smoothing and pins; a term fitted beside
+    a cause has the cause's parameters first), or None."""
     if cand.penalty is None:
         return None
-    return np.asarray(cand.penalty, float), np.array([abs(p.scale) or 1.0 for p in cand.params])
+    P = np.asarray(cand.penalty, float)
+    return P, np.array([abs(p.scale) or 1.0 for p in cand.params[len(cand.params) - P.shape[1]:]])
 
 
 AGREE_X = 1e-2      # two refinements meet: every parameter within this many scales,
