@@ -675,8 +675,9 @@ def calibrate(file, data, fit, method, experiments, profile, as_json, max_wall, 
 
 def _calibrate(cal, compile_file, file, data, fit, method, experiments, profile):
     """The calibration's work: (result, dataset fitted, ModelFile, CompiledModel)."""
+    from .data.thinning import thin_traces
     mf, cm = compile_file(file)
-    ds = cal.model_dataset(file, data)
+    ds = thin_traces(cal.model_dataset(file, data), say=True)
     _condition_warnings(mf, ds)
     chosen = None
     if experiments is not None:

@@ -4,6 +4,7 @@ Read with ``ast`` (nothing is imported): every import, the lazy ones inside
 functions included, resolved to the module it names.
 """
 import ast
+import functools
 from collections import defaultdict
 from pathlib import Path
 
@@ -47,11 +48,22 @@ def _modules():
 MODULES = _modules()
 
 
+@functools.lru_cache(maxsize=None)
+def _tree(path):
+    """A module's syntax tree, parsed once for all the rules."""
+    return ast.parse(path.read_text())
+
+
+@functools.lru_cache(maxsize=None)
 def _imports(name):
     """(line, imported module, imported names) of every import in a module."""
+    return tuple(_walk_imports(name))
+
+
+def _walk_imports(name):
     path, is_pkg = MODULES[name]
     package = name if is_pkg else name.rsplit(".", 1)[0]
-    tree = ast.parse(path.read_text())
+    tree = _tree(path)
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):
             for a in node.names:
@@ -185,7 +197,7 @@ def test_no_module_level_import_circle():
     graph = defaultdict(set)
     for name, (path, is_pkg) in MODULES.items():
         package = name if is_pkg else name.rsplit(".", 1)[0]
-        for node in ast.parse(path.read_text()).body:
+        for node in _tree(path).body:
             if isinstance(node, ast.ImportFrom) and (node.level or (node.module or "").startswith("acausal")):
                 base = package.split(".")
                 if node.level:
@@ -220,7 +232,7 @@ def test_public_functions_take_at_most_eight_parameters(limit):
     is not."""
     bad = []
     for name, (path, _) in MODULES.items():
-        tree = ast.parse(path.read_text())
+        tree = _tree(path)
         exempt = set()
         for node in ast.walk(tree):
             if isinstance(node, ast.ClassDef) and _is_component_class(node):

@@ -87,13 +87,11 @@ class SensitivityObserver(RunObserver):
             self.dtau[:] = run.schedule.time_sensitivity(point.t, d, self.sm.pidx)
             self.pending = {ev: self.dtau.copy() for ev in fired}
         elif kind == "recheck":
-            # NOTE: the instant's array itself, not a copy, as the loop has
-            # always passed it: such an event's entry in the result is the
-            # array's value when the result is made, zero after every instant
-            # (on_instant_end). Copying it would give the instant's dtau/dp,
-            # the event's true time derivative; kept as it is until that
-            # change is made on purpose (it moves sensitivity-based fits).
-            self.pending = {i: self.dtau for i in fired}
+            # an event found when the instant's event iteration rechecks the
+            # conditions happens at the instant's time: its time derivative
+            # is the instant's dtau/dp, copied (the array is zeroed when the
+            # instant ends: on_instant_end)
+            self.pending = {i: self.dtau.copy() for i in fired}
         else:
             self.pending = self.event_times(point, d, fired, current=kind == "instant")
 

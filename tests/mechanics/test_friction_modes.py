@@ -148,7 +148,7 @@ def test_clutch_engages_and_locks_at_the_momentum_time():
     assert np.min(p) > -1e-9
 
 
-@pytest.mark.parametrize("backend", ["sundae", "compiled"])
+@pytest.mark.parametrize("backend", ["sundae", pytest.param("compiled", marks=pytest.mark.slow)])
 def test_lock_time_sensitivity_to_the_normal_force(backend):
     """The event-time sensitivity of the lock through the mode machine's
     roots: t_lock = t_on + (w1 - w2)/(cgeo*mu*fn_max*(1/J1 + 1/J2)), so

@@ -622,7 +622,7 @@ def test_torque_input_from_a_signal_and_torque2():
 def test_translational_sensors_on_a_driven_mass():
     """Power, multi and relative-acceleration sensors on a sine-driven mass:
     power = the rate of the kinetic energy downstream, MultiSensor's f is
-    the force sensor's (tension positive) and power = -f v."""
+    the driving force (MSL's sign, f = flange_a.f) and power = f v."""
     m, A, W = 0.5, 4.0, 6.0
     model = Model()
     model.drive = T.Force(A * sp.sin(W * time))
@@ -646,7 +646,7 @@ def test_translational_sensors_on_a_driven_mass():
     assert rel(res["mass.v"], v) < 1e-8
     assert rel(res["power.power"], f * v) < 1e-8
     assert rel(res["multi.power"], f * v) < 1e-8
-    assert rel(res["multi.f"], -f) < 1e-8
+    assert rel(res["multi.f"], f) < 1e-8
     assert rel(res["multi.v"], v) < 1e-8
     assert rel(res["speed.v_rel"], v) < 1e-8
     assert rel(res["pos.s_rel"], res["mass.s"]) < 1e-12
@@ -670,7 +670,7 @@ def test_rotational_power_and_multi_sensors():
     tau = A * np.sin(W * res.t)
     w = A / (J * W) * (1 - np.cos(W * res.t))
     assert rel(res["power.power"], tau * w) < 1e-8
-    assert rel(res["multi.tau"], -tau) < 1e-8
+    assert rel(res["multi.tau"], tau) < 1e-8
     assert rel(res["multi.w"], w) < 1e-8
     assert rel(res["multi.power"], tau * w) < 1e-8
     assert rel(res["acc.a_rel"], tau / J) < 1e-6

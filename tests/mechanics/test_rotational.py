@@ -156,7 +156,7 @@ def test_torque_constant_is_a_runtime_parameter():
 def test_angle_source_and_sensors():
     """A shaft driven at phi = A sin(W t) twists a spring to an inertia;
     the sensors read angle, speed, acceleration, relative motion and the
-    transmitted torque (a spring's sign)."""
+    transmitted torque (MSL's sign)."""
     J, c, A, W = 0.01, 4.0, 0.2, 9.0
     model = Model()
     model.drive = Angle(phi=A * sp.sin(W * time))
@@ -185,8 +185,9 @@ def test_angle_source_and_sensors():
     assert maxerr(res, "acc.a", c / J * (drive - phi)) < REL
     assert maxerr(res, "rel.phi_rel", phi - drive) < REL
     assert maxerr(res, "relw.w_rel", dphi - A * W * np.cos(W * t)) < REL
-    assert maxerr(res, "ts.tau", c * (phi - drive)) < REL
-    assert maxerr(res, "ts.tau", res["spring.tau"]) < 1e-12
+    # MSL's sign (tau = flange_a.tau): the opposite of the spring's torque
+    assert maxerr(res, "ts.tau", -c * (phi - drive)) < REL
+    assert maxerr(res, "ts.tau", -res["spring.tau"]) < 1e-12
 
 
 def test_validation_names_the_parameter():

@@ -212,8 +212,9 @@ def test_position_source_through_spring():
     exact = A * w**2 / (w**2 - W**2) * (np.sin(W * t) - W / w * np.sin(w * t))
     assert maxerr(res, "mass.s", exact) < REL
     assert maxerr(res, "drive.s", A * np.sin(W * t)) < 1e-12
-    assert maxerr(res, "sensor.f", c * (exact - A * np.sin(W * t))) < REL
-    assert maxerr(res, "sensor.f", res["spring.f"]) < REL
+    # MSL's sign: the force on the sensor at flange_a, -spring.f in series
+    assert maxerr(res, "sensor.f", -c * (exact - A * np.sin(W * t))) < REL
+    assert maxerr(res, "sensor.f", -res["spring.f"]) < REL
 
 
 def test_sensors_read_the_right_values():
@@ -246,9 +247,9 @@ def test_sensors_read_the_right_values():
     assert maxerr(res, "acc.a", -w * w * s) < REL
     assert maxerr(res, "rel.s_rel", s + 0.5) < REL
     assert maxerr(res, "relv.v_rel", v) < REL
-    # tension positive: same sign as the spring's force
-    assert maxerr(res, "fs.f", c * s) < REL
-    assert maxerr(res, "fs.f", res["spring.f"]) < REL
+    # MSL's sign (f = flange_a.f): the opposite of the spring's force
+    assert maxerr(res, "fs.f", -c * s) < REL
+    assert maxerr(res, "fs.f", -res["spring.f"]) < REL
 
 
 # -- validation ------------------------------------------------------------------

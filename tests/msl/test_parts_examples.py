@@ -75,8 +75,8 @@ def test_sensors_example_reads_the_mass():
     """Translational.Sensors: the sensors on the mass read its flange_a
     (s - 1/2), its flange_b (s + 1/2), its speed and acceleration; the
     force and multi sensors, in series with the force, read the driving
-    force, tension-positive (-f of the source), and the power entering
-    the mass (exactly: the forces are the residual's)."""
+    force (MSL's sign, f = flange_a.f) and the power entering the mass
+    (exactly: the forces are the residual's)."""
     _, res = simulate("Translational.Sensors", "sundae")
     s, v = res["mass.s"], res["mass.v"]
     f = 10 * np.sin(2 * np.pi * 4 * res.t)
@@ -86,7 +86,7 @@ def test_sensors_example_reads_the_mass():
     # the acceleration is der(v) from IDA's interpolating polynomial at the
     # output points (measured 8.8e-5 N/kg at rtol 1e-6), not the residual's
     assert np.max(np.abs(res["accSensor1.a"] - f)) < 2e-4
-    assert np.max(np.abs(res["forceSensor.f"] + f)) < 1e-9
-    assert np.max(np.abs(res["multiSensor.f"] + f)) < 1e-9
+    assert np.max(np.abs(res["forceSensor.f"] - f)) < 1e-9
+    assert np.max(np.abs(res["multiSensor.f"] - f)) < 1e-9
     assert np.max(np.abs(res["multiSensor.v"] - v)) < 1e-12
     assert np.max(np.abs(res["multiSensor.power"] - f * v)) < 1e-9

@@ -5,11 +5,10 @@ signals where MSL has them, named as in MSL, and are read from a result
 under the same names (``res["ang.phi"]``). Sign convention:
 :mod:`acausal.lang.connectors`.
 
-One deliberate difference from MSL: a torque sensor's ``tau`` is the
-torque at ``flange_b`` (the sign of a
-:class:`~.components.TorsionSpring`'s ``tau`` in the same place); MSL's
-``tau`` is ``flange_a.tau``, the opposite sign. ``power`` is MSL's: the
-power entering at ``flange_a``.
+Signs are MSL's: a torque sensor's ``tau`` is ``flange_a.tau``, the
+torque on the sensor at ``flange_a`` (in place of a twisted
+:class:`~.components.TorsionSpring` it reads ``-spring.tau``); ``power``
+is the power entering at ``flange_a``.
 """
 
 from acausal.lang import Eq, Variable, der
@@ -64,17 +63,19 @@ class AccSensor(PartialRotAbsoluteSensor):
 
 class TorqueSensor(PartialRotFlowSensor):
     """Measures the torque transmitted between its two flanges, which it
-    joins rigidly (MSL ``TorqueSensor``): ``tau = flange_b.tau``, the same
-    sign as a :class:`~.components.TorsionSpring`'s ``tau`` in the same
-    place (MSL's ``tau`` is ``flange_a.tau``, the opposite sign).
+    joins rigidly (MSL ``TorqueSensor``): ``tau = flange_a.tau =
+    -flange_b.tau``, the torque acting on the sensor at ``flange_a`` (MSL's
+    sign: a source driving ``flange_a`` with ``tau > 0`` reads ``tau``; in
+    place of a twisted spring it reads ``-spring.tau``).
 
     Connectors: ``flange_a``, ``flange_b``, ``tau`` [N*m] (RealOutput).
     """
 
-    tau = RealOutput("transmitted torque flange_b.tau (as a spring's tau)", "N*m")
+    tau = RealOutput("torque in flange_a and flange_b (tau = flange_a.tau = -flange_b.tau)",
+                     "N*m")
 
     def equations(self):
-        return [Eq(self.tau, self.flange_b.tau)]
+        return [Eq(self.tau, self.flange_a.tau)]
 
 
 class PowerSensor(PartialRotFlowSensor):
@@ -93,21 +94,22 @@ class PowerSensor(PartialRotFlowSensor):
 
 class MultiSensor(PartialRotFlowSensor):
     """Measures torque, angular velocity and power at once (MSL
-    ``MultiSensor``): ``tau = flange_b.tau`` (as :class:`TorqueSensor`),
-    ``w = der(flange_a.phi)``, ``power = flange_a.tau * w`` (MSL's: the
-    power entering at ``flange_a``; ``power = -tau * w``).
+    ``MultiSensor``): ``tau = flange_a.tau`` (as :class:`TorqueSensor`),
+    ``w = der(flange_a.phi)``, ``power = tau * w`` (the power entering at
+    ``flange_a``).
 
     Connectors: ``flange_a``, ``flange_b``, ``tau`` [N*m], ``w`` [rad/s],
     ``power`` [W] (RealOutputs).
     """
 
-    tau = RealOutput("transmitted torque flange_b.tau (as a spring's tau)", "N*m")
+    tau = RealOutput("torque in flange_a and flange_b (tau = flange_a.tau = -flange_b.tau)",
+                     "N*m")
     w = RealOutput("absolute angular velocity of the flanges", "rad/s")
-    power = RealOutput("power entering at flange_a, flange_a.tau * w", "W")
+    power = RealOutput("power entering at flange_a, tau * w", "W")
 
     def equations(self):
-        return [Eq(self.tau, self.flange_b.tau), Eq(self.w, der(self.flange_a.phi)),
-                Eq(self.power, self.flange_a.tau * self.w)]
+        return [Eq(self.tau, self.flange_a.tau), Eq(self.w, der(self.flange_a.phi)),
+                Eq(self.power, self.tau * self.w)]
 
 
 class RelAngleSensor(PartialRotRelativeSensor):

@@ -5,10 +5,11 @@ signals where MSL has them (``connect(sensor.v, block.u)``), named as in
 MSL, and are read from a result under the same names (``res["ps.s"]``).
 Sign convention: :mod:`acausal.lang.connectors`.
 
-One deliberate difference from MSL: a force sensor's ``f`` is the force
-at ``flange_b`` (tension positive, as a :class:`~.components.Spring`'s
-``f`` in the same place); MSL's ``f`` is ``flange_a.f``, the opposite
-sign. ``power`` is MSL's: the power entering at ``flange_a``.
+Signs are MSL's: a force sensor's ``f`` is ``flange_a.f``, the force on
+the sensor at ``flange_a`` (a source pushing on ``flange_a`` reads
+positive; in series in place of a :class:`~.components.Spring` under
+tension it reads ``-spring.f``); ``power`` is the power entering at
+``flange_a``.
 """
 
 from acausal.lang import Eq, Variable, der
@@ -62,18 +63,18 @@ class AccSensor(PartialAbsoluteSensor):
 
 class ForceSensor(PartialFlowSensor):
     """Measures the force transmitted between its two flanges, which it
-    joins rigidly (MSL ``ForceSensor``): ``f = flange_b.f``, tension
-    positive, the same sign as a :class:`~.components.Spring`'s ``f`` in the
-    same place (MSL's ``f`` is ``flange_a.f = -flange_b.f``, the opposite
-    sign).
+    joins rigidly (MSL ``ForceSensor``): ``f = flange_a.f = -flange_b.f``,
+    the force acting on the sensor at ``flange_a`` (MSL's sign: a source
+    pushing on ``flange_a`` with ``f > 0`` reads ``f``; in place of a
+    spring under tension it reads ``-spring.f``).
 
     Connectors: ``flange_a``, ``flange_b``, ``f`` [N] (RealOutput).
     """
 
-    f = RealOutput("transmitted force flange_b.f (tension positive)", "N")
+    f = RealOutput("force in flange_a and flange_b (f = flange_a.f = -flange_b.f)", "N")
 
     def equations(self):
-        return [Eq(self.f, self.flange_b.f)]
+        return [Eq(self.f, self.flange_a.f)]
 
 
 class PowerSensor(PartialFlowSensor):
@@ -93,21 +94,20 @@ class PowerSensor(PartialFlowSensor):
 
 class MultiSensor(PartialFlowSensor):
     """Measures force, velocity and power at once (MSL ``MultiSensor``):
-    ``f = flange_b.f`` (tension positive, as :class:`ForceSensor`),
-    ``v = der(flange_a.s)``, ``power = flange_a.f * v`` (MSL's: the power
-    entering at ``flange_a``; ``power = -f * v``).
+    ``f = flange_a.f`` (as :class:`ForceSensor`), ``v = der(flange_a.s)``,
+    ``power = f * v`` (the power entering at ``flange_a``).
 
     Connectors: ``flange_a``, ``flange_b``, ``f`` [N], ``v`` [m/s],
     ``power`` [W] (RealOutputs).
     """
 
-    f = RealOutput("transmitted force flange_b.f (tension positive)", "N")
+    f = RealOutput("force in flange_a and flange_b (f = flange_a.f = -flange_b.f)", "N")
     v = RealOutput("absolute velocity of the flanges", "m/s")
-    power = RealOutput("power entering at flange_a, flange_a.f * v", "W")
+    power = RealOutput("power entering at flange_a, f * v", "W")
 
     def equations(self):
-        return [Eq(self.f, self.flange_b.f), Eq(self.v, der(self.flange_a.s)),
-                Eq(self.power, self.flange_a.f * self.v)]
+        return [Eq(self.f, self.flange_a.f), Eq(self.v, der(self.flange_a.s)),
+                Eq(self.power, self.f * self.v)]
 
 
 class RelPositionSensor(PartialRelativeSensor):

@@ -18,6 +18,7 @@ CRANK = os.path.join(ROOT, "models", "examples", "slider_crank.py")
 R, L = 0.05, 0.2          # the model file's crank and rod, written out here
 
 
+@pytest.mark.slow
 def test_animate_command_writes_gif_and_slider_follows_crank(tmp_path):
     out = tmp_path / "crank.gif"
     r = CliRunner().invoke(main, ["animate", CRANK, "--out", str(out), "--t-end", "0.4",
