@@ -29,7 +29,7 @@ held-out error, and it reaches closer to the instrument floor.
 :class:`Location` carries the best term's held-out error and whether it
 reaches the floor (``FLOOR_REACH``).
 
-Degenerate directions are pinned before the fit (:func:`pin_rows`): the
+Degenerate directions are pinned before the fit (:func:`pins_of`): the
 spline reproduces constants and straight lines exactly, so its constant
 and linear parts can do what a free parameter acting at the node does (a
 spring's stiffness, a damper's coefficient), and its position and
