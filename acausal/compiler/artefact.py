@@ -417,6 +417,37 @@ class Artefact:
             return names
         return self._memoised("slot names", None, make)
 
+    def scaled_slot_of(self, name):
+        """(slot, gain) when variable ``name`` is ``gain*y[slot] + offset``
+        (``gain`` a non-zero number, ``offset`` free of unknowns: an alias
+        with a sign, a scale or an offset), else None. A variable that is
+        (a multiple of) a state's derivative ``y'_k`` is followed through
+        the state's row to the unknown that row equates ``y'_k`` with
+        (``w = der(phi)``: the unknown ``w``), when it is one."""
+        def make():
+            e = self.resolve(sp.Symbol(name))
+            hit = _linear_in_one(e, self._memoised("unknown index", None, self._unknown_index))
+            if hit is None:
+                return None
+            (kind, k), gain = hit
+            if kind == "y":
+                return k, gain
+            row = self.dae.residuals[k]
+            c = sp.diff(row, self.dae.yp[k])
+            if not (c.is_number and c != 0):
+                return None
+            rest = _linear_in_one(-row.xreplace({self.dae.yp[k]: 0}) / c,
+                                  self._memoised("unknown index", None, self._unknown_index))
+            if rest is None or rest[0][0] != "y":
+                return None
+            return rest[0][1], gain * rest[1]
+        return self._memoised("scaled slot", name, make)
+
+    def _unknown_index(self):
+        index = {s: ("y", i) for i, s in enumerate(self.dae.y)}
+        index.update({s: ("yp", i) for i, s in enumerate(self.dae.yp) if s is not None})
+        return index
+
     def dynamic_discretes(self):
         """Indices of the discrete values the residual equations use."""
         def make():
@@ -450,3 +481,16 @@ def _unsigned(e):
     if isinstance(e, sp.Mul) and len(e.args) == 2 and e.args[0] == -1:
         return e.args[1], -1.0
     return e, 1.0
+
+
+def _linear_in_one(e, index):
+    """((kind, slot), gain) when ``e`` is ``gain*u + rest`` with ``u`` the only
+    unknown of ``index`` in it and ``gain`` a non-zero number, else None."""
+    e = sp.sympify(e)
+    hits = [s for s in e.free_symbols if s in index]
+    if len(hits) != 1:
+        return None
+    gain = sp.diff(e, hits[0])
+    if not gain.is_number or gain == 0:
+        return None
+    return index[hits[0]], float(gain)

@@ -1,12 +1,10 @@
-"""Coulomb + viscous friction with stick/slip modes switched by events.
-
-MSL's friction elements (normal-force inputs, friction tables, the free
-mode, startForward/startBackward, hard stops, lossy gears) are in
-:mod:`acausal.mechanics.rotational` and :mod:`acausal.mechanics.translational`,
-on the shared mode machine :mod:`acausal.mechanics.frictionmodes`. The four
-elements here keep this module's machine: their tests fix behaviour that
-MSL's machine does differently at exact ties (docs/components.md,
-"Friction elements").
+"""Coulomb + viscous friction with stick/slip modes (not MSL components:
+MSL's friction elements with normal-force inputs, friction tables, the free
+mode, hard stops and lossy gears are in :mod:`acausal.mechanics.rotational`
+and :mod:`acausal.mechanics.translational`). The four elements here run on
+the same mode machine, :mod:`acausal.mechanics.frictionmodes` (MSL's
+``PartialFriction``), with a constant kinetic level ``F_c``, a break-away
+level ``F_s >= F_c`` and a viscous term.
 
 Sign convention: :mod:`acausal.connectors` (through variables positive INTO
 the component). Every element here has a relative motion ``x_rel`` (the
@@ -14,36 +12,26 @@ position/angle of flange_b relative to flange_a, or of the flange relative
 to the fixed ground), its rate ``v_rel`` and a friction force/torque ``f``
 (``tau``) counted like a damper's: ``f`` is what the outside applies on the
 element at flange_b, so the element pushes flange_b's body with ``-f``
-(and flange_a's body with ``+f``). Friction therefore reads, with
-``mode = sign(v_rel)``::
+(and flange_a's body with ``+f``)::
 
-    sliding (mode = +1 or -1):  f = F_c*mode + d*v_rel       (opposes v_rel)
-    stuck   (mode = 0):         der(v_rel) = 0                 (f is whatever holds)
+    sliding forward/backward (mode = +1/-1):  f = +-F_c + d*v_rel   (opposes v_rel)
+    stuck (mode = 0):                           der(v_rel) = 0, |f| <= F_s
 
-The mode machine is Modelica's (Forward / Stuck / Backward, see
-Modelica.Mechanics.Rotational.UsersGuide.ModelingOfFriction), with events:
+The machine's levels: break-away at ``|f| > F_s`` (``break_forward``,
+``break_backward``), a start is kept while the holding force stays at or
+above ``F_c`` (else ``abort_*``), and ``slide_stop`` when a sliding
+``v_rel`` reaches 0, after which the break-away tests run again at the same
+instant: the body stays stuck (``|f| <= F_s``) or slides the other way
+(at once when ``v_rel`` is at or past zero that way, else as soon as
+``v_rel`` crosses zero: ``slide_forward``/``slide_backward``). ``mode``
+is 3 before the start, then ``initial_mode`` sets it by the sign of
+``v_rel`` (0 at rest: the break-away tests follow at once). Event names
+carry the component's path (``fr.slide_stop``). Other events, states and
+the exact-tie rules: :mod:`acausal.mechanics.frictionmodes`.
 
-* ``slide_stop``: while sliding, ``mode*v_rel`` falls through 0 -> mode 0.
-* ``break_forward`` / ``break_backward`` (re-checked after every event):
-  while stuck, ``f`` rises above ``F_s`` / falls below ``-F_s`` -> mode +1 /
-  -1. Right after ``slide_stop`` the model is re-initialised stuck, the
-  holding force is computed, and these re-checks decide at the same instant
-  whether the body stays stuck (|f| <= F_s) or slides the other way. Since
-  sliding starts with ``|f_hold| > F_s >= F_c``, the relative acceleration
-  right after a break-away points away from zero velocity, so a mode never
-  flips back at the same instant (no chattering).
-* ``initial_mode`` (fires once, in the initial event iteration): a relative
-  velocity that is not exactly zero at the initial point sets
-  ``mode = sign(v_rel)``; a run starting with ``v_rel = 0`` starts stuck
-  (and the break-away checks that follow at the same instant let it slide
-  at once if the holding force exceeds ``F_s``).
-* ``F_s < F_c`` is rejected when the component is built and again when a
-  run starts with overridden parameter values (a ParameterError naming
-  ``F_s``). Giving only ``F_c`` at construction sets ``F_s = F_c``.
-
-Event names carry the component's path (``fr.slide_stop``), so that a model
-with several friction elements can tell their events apart in
-``result.events``.
+``F_s < F_c`` is rejected when the component is built and again when a run
+starts with overridden parameter values (a ParameterError naming ``F_s``).
+Giving only ``F_c`` at construction sets ``F_s = F_c``.
 
 The element needs inertia on the sliding side (a mass or inertia at the
 flange, or on the node): a massless node with d = 0 leaves the sliding
@@ -60,11 +48,12 @@ velocity reached at the ``slide_stop`` root, which IDA locates to about
 starts at rest stays exactly at rest while stuck.
 """
 import sympy as sp
-from sympy import Ne, Piecewise
+from sympy import Piecewise
 
-from acausal.lang import Component, Discrete, Eq, Event, Flange, Parameter, RotFlange, Variable, der
+from acausal.lang import Component, Eq, Event, Flange, Parameter, RotFlange, Variable, der
 from acausal.errors import ParameterError
 
+from .frictionmodes import PartialFrictionModes
 from .partials import PartialCompliant, PartialRotCompliant
 
 
@@ -83,14 +72,11 @@ def _param_value(state, sym):
     return f"{value} (bound to {bound})" if bound is not None else value
 
 
-class _StickSlip:
-    """The mode machine shared by the friction elements (a mixin: it adds no
-    declarations and no ``equations``; the leaves call its helpers).
-
-    A leaf sets ``_names = (kinetic, static, viscous)`` parameter names and
-    declares ``v_rel``, ``a_rel``, ``mode``, ``init`` and its force/torque
-    ``_force_name``.
-    """
+class _CoulombViscous(PartialFrictionModes):
+    """The law of the four elements on the shared mode machine (a partial:
+    it adds no declarations; the leaves declare the parameters named in
+    ``_names = (kinetic, static, viscous)``, ``v_rel``, ``a_rel`` and the
+    force/torque ``_force_name``)."""
 
     _names = ("F_c", "F_s", "d")
     _force_name = "f"
@@ -118,40 +104,43 @@ class _StickSlip:
     def _unit_of(self, name):
         return f"[{self.declarations()[name].unit}]"
 
-    # -- the law ----------------------------------------------------------------
-    def _sym(self, name):
-        return getattr(self, name)
+    # -- the law on the shared machine --------------------------------------------
+    def _levels(self):
+        kin, sta, visc = self._names
+        return getattr(self, kin), getattr(self, sta), getattr(self, visc)
 
-    def _law(self):
-        kin, _, visc = self._names
-        F_c, d = self._sym(kin), self._sym(visc)
-        v, a, f, mode = self.v_rel, self.a_rel, self._sym(self._force_name), self.mode
-        return [Eq(0, Piecewise((a, Eq(mode, 0)),
-                                (f - F_c * mode - d * v, True)))]
+    def friction_motion(self):
+        return self.v_rel, self.a_rel
 
-    def _mode_events(self):
+    def friction_force(self):
+        return getattr(self, self._force_name)
+
+    def sliding_force(self, direction):
+        F_c, _, d = self._levels()
+        return direction * F_c + d * self.v_rel
+
+    def break_level(self, direction):
+        return direction * self._levels()[1]
+
+    def hold_level(self, direction):
+        F_c, F_s, _ = self._levels()
+        return direction * (F_c - F_s)
+
+    def slide_offset(self, direction):
+        # sa = the relative acceleration while sliding or starting (offset 0),
+        # so the hold level is F_c - F_s in those terms: a start is dropped
+        # when the acceleration falls below (F_c - F_s)/(unit mass), as MSL's
+        # sa < f0 with its offset f0_max. Not the break-away level: sa of the
+        # size of F_s would carry eps*F_s of round-off into the acceleration,
+        # which IDA's error test then sees at tight tolerances (stick_slip.py
+        # at rtol 1e-12, atol 1e-15: too many steps at the slip's speed peak)
+        return 0
+
+    def events(self):
         kin, sta, _ = self._names
-        F_c, F_s = self._sym(kin), self._sym(sta)
-        v, f, mode, init = self.v_rel, self._sym(self._force_name), self.mode, self.init
-        stuck = Eq(mode, 0) & Eq(init, 0)
-        me = self
+        F_c, F_s, _ = self._levels()
         label = f"{self.path}.{sta}" if self.path else sta
         pre = f"{self.path}." if self.path else ""
-
-        def stop(state):
-            state[me.mode] = 0
-
-        def forward(state):
-            state[me.mode] = 1
-
-        def backward(state):
-            state[me.mode] = -1
-
-        def initial(state):
-            v0 = state[me.v_rel]
-            if v0 != 0:
-                state[me.mode] = 1 if v0 > 0 else -1
-            state[me.init] = 0
 
         def invalid(state):
             raise ParameterError(
@@ -159,22 +148,12 @@ class _StickSlip:
                 f"{self._unit_of(sta)}) must be >= {kin} = {_param_value(state, F_c)}: the "
                 "static friction level cannot be below the kinetic (Coulomb) one")
 
-        return [
-            Event(pre + "slide_stop", Piecewise((mode * v, Ne(mode, 0)), (1, True)), -1, stop),
-            Event(pre + "break_forward", Piecewise((f - F_s, stuck), (-1, True)), 1, forward,
-                  recheck=True),
-            Event(pre + "break_backward", Piecewise((-F_s - f, stuck), (-1, True)), 1, backward,
-                  recheck=True),
-            # piecewise-constant roots: they only act in the initial event
-            # iteration (a constant 1 or -1 never crosses zero while integrating)
-            Event(pre + "initial_mode", Piecewise((1, Eq(init, 1)), (-1, True)), 1, initial,
-                  recheck=True),
-            Event(pre + "check_" + sta, Piecewise((1, F_s < F_c), (-1, True)), 1, invalid,
-                  recheck=True),
-        ]
+        # a piecewise-constant root: it only acts in the initial event iteration
+        return [Event(pre + "check_" + sta, Piecewise((1, F_s < F_c), (-1, True)), 1, invalid,
+                      recheck=True)]
 
 
-class Friction(_StickSlip, PartialCompliant):
+class Friction(_CoulombViscous, PartialCompliant):
     """Coulomb + viscous friction between two translational flanges, with
     stiction (e.g. a block on a moving belt: flange_a = belt, flange_b =
     block).
@@ -188,7 +167,8 @@ class Friction(_StickSlip, PartialCompliant):
 
     Stuck -> sliding when ``f`` crosses ``+F_s`` (forward) or ``-F_s``
     (backward); sliding -> stuck when ``v_rel`` reaches 0 and the holding
-    force is at most ``F_s``, otherwise it slides the other way at once.
+    force is at most ``F_s``, otherwise it slides the other way (at once, or
+    when ``v_rel`` has crossed zero: MSL's start flags).
     A normal-force form is obtained by binding ``F_c = mu*N`` and
     ``F_s = mu_s*N`` to model parameters.
 
@@ -196,7 +176,9 @@ class Friction(_StickSlip, PartialCompliant):
     [N] break-away (static) friction force (>= F_c; F_c when not given),
     ``d`` [N*s/m] viscous coefficient (>= 0).
     States: ``s_rel`` [m], ``v_rel`` [m/s], ``a_rel`` [m/s^2], ``f`` [N];
-    discrete ``mode`` (-1 sliding backward, 0 stuck, +1 sliding forward).
+    the shared machine's (discrete ``mode``: 3 before the start, -1 sliding
+    backward, 0 stuck, +1 sliding forward; ``startForward``,
+    ``startBackward``; ``sa``, ``locked``, ``lossPower`` [W]).
     Connectors: ``flange_a``, ``flange_b``.
     """
 
@@ -205,17 +187,12 @@ class Friction(_StickSlip, PartialCompliant):
     d = Parameter(0.0, "N*s/m", "viscous friction coefficient", min=0.0)
     v_rel = Variable(0.0, "m/s", "relative velocity der(s_rel)")
     a_rel = Variable(0.0, "m/s^2", "relative acceleration der(v_rel)")
-    mode = Discrete(0, "1", "-1 sliding backward, 0 stuck, +1 sliding forward")
-    init = Discrete(1, "1", "1 until the initial mode decision at the start of a run")
 
     def equations(self):
-        return [Eq(self.v_rel, der(self.s_rel)), Eq(self.a_rel, der(self.v_rel))] + self._law()
-
-    def events(self):
-        return self._mode_events()
+        return [Eq(self.v_rel, der(self.s_rel)), Eq(self.a_rel, der(self.v_rel))]
 
 
-class GroundFriction(_StickSlip, Component):
+class GroundFriction(_CoulombViscous, Component):
     """Coulomb + viscous friction of a body sliding on the fixed ground (a
     block on a table): :class:`Friction` with flange_a fixed.
 
@@ -228,8 +205,9 @@ class GroundFriction(_StickSlip, Component):
     Parameters: ``F_c`` [N] kinetic (Coulomb) friction force (>= 0), ``F_s``
     [N] break-away (static) friction force (>= F_c; F_c when not given),
     ``d`` [N*s/m] viscous coefficient (>= 0).
-    States: ``v_rel`` [m/s], ``a_rel`` [m/s^2], ``f`` [N]; discrete ``mode``
-    (-1 sliding backward, 0 stuck, +1 sliding forward).
+    States: ``v_rel`` [m/s], ``a_rel`` [m/s^2], ``f`` [N]; the shared
+    machine's (``mode`` 3 before the start, -1, 0, +1; ``startForward``,
+    ``startBackward``; ``sa``, ``locked``, ``lossPower`` [W]).
     Connectors: ``flange``.
     """
 
@@ -240,18 +218,13 @@ class GroundFriction(_StickSlip, Component):
     v_rel = Variable(0.0, "m/s", "velocity of the flange der(flange.s)")
     a_rel = Variable(0.0, "m/s^2", "acceleration der(v_rel)")
     f = Variable(0.0, "N", "force into the element at the flange")
-    mode = Discrete(0, "1", "-1 sliding backward, 0 stuck, +1 sliding forward")
-    init = Discrete(1, "1", "1 until the initial mode decision at the start of a run")
 
     def equations(self):
         return [Eq(self.v_rel, der(self.flange.s)), Eq(self.a_rel, der(self.v_rel)),
-                Eq(self.flange.f, self.f)] + self._law()
-
-    def events(self):
-        return self._mode_events()
+                Eq(self.flange.f, self.f)]
 
 
-class RotFriction(_StickSlip, PartialRotCompliant):
+class RotFriction(_CoulombViscous, PartialRotCompliant):
     """Coulomb + viscous friction between two rotational flanges (a clutch
     that stays engaged, a bearing between shaft and a moving housing).
 
@@ -266,7 +239,9 @@ class RotFriction(_StickSlip, PartialRotCompliant):
     ``tau_s`` [N*m] break-away torque (>= tau_c; tau_c when not given), ``d``
     [N*m*s/rad] viscous coefficient (>= 0).
     States: ``phi_rel`` [rad], ``w_rel`` [rad/s], ``a_rel`` [rad/s^2],
-    ``tau`` [N*m]; discrete ``mode`` (-1, 0, +1).
+    ``tau`` [N*m]; the shared machine's (``mode`` 3 before the start, -1,
+    0, +1; ``startForward``, ``startBackward``; ``sa``, ``locked``,
+    ``lossPower`` [W]).
     Connectors: ``flange_a``, ``flange_b``.
     """
 
@@ -278,22 +253,16 @@ class RotFriction(_StickSlip, PartialRotCompliant):
     d = Parameter(0.0, "N*m*s/rad", "viscous friction coefficient", min=0.0)
     w_rel = Variable(0.0, "rad/s", "relative angular velocity der(phi_rel)")
     a_rel = Variable(0.0, "rad/s^2", "relative angular acceleration der(w_rel)")
-    mode = Discrete(0, "1", "-1 sliding backward, 0 stuck, +1 sliding forward")
-    init = Discrete(1, "1", "1 until the initial mode decision at the start of a run")
 
     @property
     def v_rel(self):
         return self.w_rel
 
     def equations(self):
-        return [Eq(self.w_rel, der(self.phi_rel)), Eq(self.a_rel, der(self.w_rel))] + \
-            self._law()
-
-    def events(self):
-        return self._mode_events()
+        return [Eq(self.w_rel, der(self.phi_rel)), Eq(self.a_rel, der(self.w_rel))]
 
 
-class BearingFriction(_StickSlip, Component):
+class BearingFriction(_CoulombViscous, Component):
     """Coulomb + viscous friction of a shaft in a fixed housing (a bearing):
     :class:`RotFriction` with flange_a fixed.
 
@@ -306,8 +275,10 @@ class BearingFriction(_StickSlip, Component):
     Parameters: ``tau_c`` [N*m] kinetic (Coulomb) friction torque (>= 0),
     ``tau_s`` [N*m] break-away torque (>= tau_c; tau_c when not given), ``d``
     [N*m*s/rad] viscous coefficient (>= 0).
-    States: ``w_rel`` [rad/s], ``a_rel`` [rad/s^2], ``tau`` [N*m]; discrete
-    ``mode`` (-1, 0, +1).
+    States: ``w_rel`` [rad/s], ``a_rel`` [rad/s^2], ``tau`` [N*m]; the
+    shared machine's (``mode`` 3 before the start, -1, 0, +1;
+    ``startForward``, ``startBackward``; ``sa``, ``locked``, ``lossPower``
+    [W]).
     Connectors: ``flange``.
     """
 
@@ -321,8 +292,6 @@ class BearingFriction(_StickSlip, Component):
     w_rel = Variable(0.0, "rad/s", "angular velocity der(flange.phi)")
     a_rel = Variable(0.0, "rad/s^2", "angular acceleration der(w_rel)")
     tau = Variable(0.0, "N*m", "torque into the element at the flange")
-    mode = Discrete(0, "1", "-1 sliding backward, 0 stuck, +1 sliding forward")
-    init = Discrete(1, "1", "1 until the initial mode decision at the start of a run")
 
     @property
     def v_rel(self):
@@ -330,7 +299,4 @@ class BearingFriction(_StickSlip, Component):
 
     def equations(self):
         return [Eq(self.w_rel, der(self.flange.phi)), Eq(self.a_rel, der(self.w_rel)),
-                Eq(self.flange.tau, self.tau)] + self._law()
-
-    def events(self):
-        return self._mode_events()
+                Eq(self.flange.tau, self.tau)]

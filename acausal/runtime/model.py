@@ -119,6 +119,11 @@ class CompiledModel:
         """The column of y that variable ``name`` is, else None."""
         return self.artefact.y_column(name)
 
+    def scaled_slot_of(self, name):
+        """(slot, gain) when variable ``name`` is ``gain*y[slot] + offset``
+        (a state's derivative followed to the unknown it equals), else None."""
+        return self.artefact.scaled_slot_of(name)
+
     def slot_names(self):
         """For each solver unknown, the names that denote it up to sign."""
         return self.artefact.slot_names()

@@ -2,7 +2,9 @@
 
 A variable declared with ``nominal=x`` (:class:`acausal.lang.declare.Variable`,
 ``Component.with_nominal``) gets the absolute tolerance ``rtol * |x|`` on
-the solver unknown it is (up to sign), in place of the run's ``atol``:
+the solver unknown it is (up to a sign, a numeric scale and an offset; a
+state's derivative is the unknown its state row equates it with: see
+:func:`nominal_slots`), in place of the run's ``atol``:
 the Modelica Specification's recommendation (section 4.8.7, non-normative:
 an integrator tolerance ``rtol*(|nominal| + |x|)``), which OpenModelica
 applies to IDA and DASSL. IDA's error weight for the unknown is then
@@ -18,17 +20,25 @@ _SLOTS = weakref.WeakKeyDictionary()   # compiled model -> {solver slot: nominal
 
 
 def nominal_slots(cm):
-    """Solver slot -> nominal value (the smallest of the variables that
-    are, up to sign, that slot), made once per model."""
+    """Solver slot -> nominal value, made once per model. A variable with a
+    nominal value ``x`` reaches the unknown it is up to a gain and an
+    offset (``v = gain*y + offset``: an alias, its sign, an offset, a
+    scale), with the nominal ``|x/gain|``; a variable that is a state's
+    derivative (``w_rel = der(phi_rel)``) reaches the unknown the state's
+    row equates that derivative with. A slot reached by several takes the
+    smallest. Variables computed from several unknowns set none."""
     out = _SLOTS.get(cm)
     if out is None:
         out = {}
-        variables = cm.flat.variables
-        for i, names in enumerate(cm.slot_names()):
-            noms = [variables[n].nominal for n in names
-                    if n in variables and variables[n].nominal is not None]
-            if noms:
-                out[i] = min(noms)
+        for name, var in cm.flat.variables.items():
+            if var.nominal is None:
+                continue
+            hit = cm.scaled_slot_of(name)
+            if hit is None:
+                continue
+            slot, gain = hit
+            nom = abs(float(var.nominal) / gain)
+            out[slot] = min(out.get(slot, nom), nom)
         _SLOTS[cm] = out
     return out
 

@@ -66,7 +66,10 @@ def test_block_slides_to_rest_coulomb():
     assert abs(stops[0] - t_stop) / t_stop < 1e-6
     fin = res.final()
     assert abs(fin["mass.s"] - s_stop) / s_stop < 1e-6
-    assert fin["fr.mode"] == 0 and fin["mass.v"] == 0.0
+    # stuck at the velocity of the stop root: |v| ~ a * IDA's root location
+    # (100 eps (t + h)), measured 5e-14 m/s here; not exactly 0, which the old
+    # machine gave here by the luck of its steps (v0 = 3.1: -6.5e-14 m/s on it)
+    assert fin["fr.mode"] == 0 and abs(fin["mass.v"]) < mu * G * 1e-12
     # while sliding: v = v0 - mu g t exactly (constant deceleration)
     sl = res.t < t_stop * 0.999
     assert np.max(np.abs(res["mass.v"][sl] - (v0 - mu * G * res.t[sl]))) < 1e-8
@@ -245,8 +248,9 @@ def test_stick_slip_belt_period_and_dwell():
     assert np.max(np.abs(per - period)) / period < 1e-7
     assert np.max(np.abs(slip - t_slip)) / t_slip < 1e-7
     assert np.max(np.abs(dwell - t_stick)) / t_stick < 1e-6
-    # while stuck the block moves with the belt and the friction holds the spring
-    stuck = res["fr.mode"] == 0
+    # while stuck (locked: mode 0 and not starting, MSL's `locked`) the block
+    # moves with the belt and the friction holds the spring
+    stuck = res["fr.locked"] == 1
     assert np.max(np.abs(res["block.v"][stuck] - V)) < 1e-12
     assert np.max(np.abs(res["fr.f"][stuck] + k * res["block.s"][stuck])) < 1e-9
     # the slip ends at x = (2 Fc - Fs)/k

@@ -303,6 +303,46 @@ def test_zero_backlash_is_a_spring_damper():
     assert rel(res["eb"]["body.phi"], res["sd"]["body.phi"]) < 1e-12
 
 
+_LOADED_BACKLASH = {}
+
+
+@pytest.mark.parametrize("cls", [R.ElastoBacklash, R.ElastoBacklash2])
+@pytest.mark.parametrize("load, phi0", [
+    (2.0, 3 * 2.0 / 100.0),            # |load| <= c*b/4: on the line (c/3)*phi_diff
+    (-2.0, -3 * 2.0 / 100.0),
+    (20.0, 20.0 / 100.0 + 0.1),        # beyond 1.5*b/2: the contact law, c*(phi_diff - b/2)
+])
+def test_backlash_initialises_on_msls_initial_characteristic(cls, load, phi0):
+    """An inertia at rest under a constant load, its acceleration fixed at
+    0: the initialisation must invert the backlash's characteristic, which
+    is flat in the gap (singular). MSL replaces it while initializing by a
+    strictly rising one (c/3 slope inside 1.5*b/2, the contact law
+    outside): phi_rel = 3*load/c inside, load/c + b/2 beyond. The run then
+    goes on with the true law (in the gap: no torque, the load accelerates
+    the inertia at load/J)."""
+    c, b, J = 100.0, 0.2, 1.0
+    if cls not in _LOADED_BACKLASH:             # one compile per class; the load is a parameter
+        model = Model()
+        model.ground = R.Fixed()
+        model.eb = cls(c=c, d=1.0, b=b)
+        model.body = R.Inertia(J=J, w=0.0, a=0.0)
+        model.load = R.ConstantTorque(tau_constant=1.0)
+        model.connect(model.ground.flange, model.eb.flange_a)
+        model.connect(model.eb.flange_b, model.body.flange_a)
+        model.connect(model.body.flange_b, model.load.flange)
+        _LOADED_BACKLASH[cls] = compile_model(model)
+    res = _LOADED_BACKLASH[cls].simulate(t_end=0.01, rtol=1e-10, atol=1e-12,
+                                         params={"load.tau_constant": load})
+    assert res["eb.phi_rel"][0] == pytest.approx(phi0, rel=1e-12, abs=1e-14)
+    assert res.final()["eb.initializing"] == 0
+    if abs(phi0) < 0.1:           # in the gap after the start: free flight under the load
+        t = res.t
+        assert rel(res["eb.phi_rel"], phi0 + load / J * t ** 2 / 2) < 1e-8
+    else:                         # in contact: at rest, holding the load
+        assert np.max(np.abs(res["eb.phi_rel"] - phi0)) < 1e-9
+        assert np.max(np.abs(res["eb.tau"] - load)) < 1e-6
+
+
 def test_disc_turns_its_right_flange_by_delta_phi_and_relative_states_read_it():
     """A Disc between a motor-driven inertia and a spring-loaded one: a
     rigid offset deltaPhi, the torque passes unchanged; RelativeStates

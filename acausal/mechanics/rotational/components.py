@@ -154,11 +154,17 @@ class _PartialBacklash(PartialRotCompliantWithRelativeStates):
     edge), so that a run starting exactly at the edge starts in contact
     (IDA cannot see a root function that starts at zero).
 
-    MSL changes the characteristic during initialisation (a monotone line
-    inside ``1.5 * b/2``) so that an initialisation that must invert it is
-    not singular; here the initial equations use the law as it is, so give
-    fixed start values to the angles of a model whose initial state is in
-    the gap.
+    During initialisation the characteristic is MSL's strictly rising one,
+    so that an initialisation that must invert it (a torque given, the
+    angle sought) is not singular::
+
+        tau_c = c*(phi_diff - b/2)   phi_diff > 1.5*b/2
+                c*(phi_diff + b/2)   phi_diff < -1.5*b/2
+                (c/3)*phi_diff       otherwise;      tau = tau_c + tau_d
+
+    (continuous at ``+-1.5*b/2``); the run's first event iteration switches
+    to the law above (discrete ``initializing``: 1 until then), keeping the
+    states the initialisation found, as MSL does after ``initial()``.
     """
 
     c = Parameter(1e5, "N*m/rad", "spring constant (> 0)", min=0.0, min_open=True)
@@ -169,6 +175,7 @@ class _PartialBacklash(PartialRotCompliantWithRelativeStates):
     tau_d = Variable(0.0, "N*m", "damping torque d * w_rel")
     lossPower = Variable(0.0, "W", "dissipated power")
     region = Discrete(0, "1", "+1: phi_diff > b/2, -1: phi_diff < -b/2, 0: in the gap")
+    initializing = Discrete(1, "1", "1 during the initialisation (MSL's initial()), then 0")
 
     def _contact_torque(self, side):
         """``tau`` in contact on ``side`` (+1 upper, -1 lower), and the
@@ -182,14 +189,20 @@ class _PartialBacklash(PartialRotCompliantWithRelativeStates):
         up, low = Eq(self.region, 1), Eq(self.region, -1)
         tau_up, loss_up = self._contact_torque(+1)
         tau_low, loss_low = self._contact_torque(-1)
+        init = Eq(self.initializing, 1)
+        # MSL's initial characteristic: strictly rising, continuous at 1.5*b/2
+        tau_init = Piecewise((self.c * (diff - half), diff > 1.5 * half),
+                             (self.c * (diff + half), diff < -1.5 * half),
+                             (self.c / 3 * diff, True))
+        plain = init | linear
         return [
-            Eq(self.tau_c, Piecewise((self.c * diff, linear),
+            Eq(self.tau_c, Piecewise((tau_init, init), (self.c * diff, linear),
                                      (self.c * PosPow(diff - half, 1), up),
                                      (-self.c * PosPow(-half - diff, 1), low), (0, True))),
             Eq(self.tau_d, self.d * self.w_rel),
-            Eq(self.tau, Piecewise((self.tau_c + self.tau_d, linear), (tau_up, up),
+            Eq(self.tau, Piecewise((self.tau_c + self.tau_d, plain), (tau_up, up),
                                    (tau_low, low), (0, True))),
-            Eq(self.lossPower, Piecewise((self.tau_d * self.w_rel, linear), (loss_up, up),
+            Eq(self.lossPower, Piecewise((self.tau_d * self.w_rel, plain), (loss_up, up),
                                          (loss_low, low), (0, True))),
         ]
 
@@ -205,9 +218,16 @@ class _PartialBacklash(PartialRotCompliantWithRelativeStates):
                 s[region] = value
             return action
 
+        def initialized(s):
+            s[me.initializing] = 0
+
+        me = self
         # each function is > 0 where its region must change (recheck) and
         # crosses zero where the change happens
         return [
+            # piecewise constant: acts in the run's first event iteration only
+            Event(f"{p}.initialized", Piecewise((1, Eq(self.initializing, 1)), (-1, True)), +1,
+                  initialized, recheck=True, log=False),
             Event(f"{p}.upper_contact", Piecewise((diff - half, gated & free), (-1, True)), +1,
                   setter(1), recheck=True),
             Event(f"{p}.lower_contact", Piecewise((-half - diff, gated & free), (-1, True)), +1,
