@@ -71,9 +71,13 @@ NULL_TOL = 1e-6  # directions of the weights with no effect on the data (singula
                  # constant is pinned by construction (at_rest_row)
 PIN_WEIGHT = 1e3  # pin rows' size relative to the term's largest singular value
 STEP = 1e-4      # finite-difference step (of each weight's / free parameter's scale)
-SMOOTH_GRID = (1e-5, 1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0)  # smoothing weights per data
-                 # value tried for each part (generic.SMOOTH is 1): from a term free to
-                 # follow 8 cycles over the stroke to one close to straight lines
+SMOOTH_GRID = tuple(10.0 ** np.arange(-5, 6))  # smoothing weights per data value tried
+                 # for each part (generic.SMOOTH is 1): from a term free to follow 8
+                 # cycles over the stroke to one close to straight lines. The penalty is
+                 # on weights over their scale (a third of the node's typical force), so
+                 # a force far below that scale needs a large weight to be smoothed: on
+                 # the two-mass detent (0.04 N against a scale of newtons) both parts
+                 # chose 10, the top of a grid that ended there
 CV_TIE = 2e-3    # resolutions and weights whose linearised held-out RMS is within one
                  # standard error of the best (1/sqrt(2n) of it, for n values of unit
                  # variance; at least this fraction) are ties: the coarsest of them (fewest knots: the
