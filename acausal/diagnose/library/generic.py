@@ -73,7 +73,7 @@ def refine_matrix(n_coarse, n_fine):
     spline on the same range exactly, w_fine = T w_coarse (the coarse knots
     are a subset of the fine ones: (n_fine - 1) a multiple of (n_coarse - 1))."""
     if (n_fine - 1) % (n_coarse - 1):
-        raise ValueError(f"{n_coarse} knots are not a subset of {n_fine}")
+        raise ValueError(f"{n_coarse} knots are not a subset of {n_fine}")  # internal
     return hats(np.linspace(0.0, 1.0, n_fine), 0.0, 1.0, n_coarse)
 
 
