@@ -518,36 +518,97 @@ def animate(file, out, t_end, sets, fps, frames, max_wall, max_memory):
     click.echo(f"wrote {out}: {len(ks)} frames, t = {res.t[0]:g} .. {res.t[-1]:g} s")
 
 
+def _state_names(cm):
+    """Names of the variables that are a state of the run up to sign and a
+    constant offset (a joint angle that is its body's angle, a speed that
+    is der(state)): the solver integrates them."""
+    import sympy as sp
+    y = list(cm.dae.y[:cm.dae.n_states])
+    ys, params = set(y), set(cm.param_syms)
+    out = {s.name for s in y}
+    for name in cm.var_names:
+        try:
+            e = sp.sympify(cm.resolve(sp.Symbol(name)))
+        except Exception:  # noqa: BLE001 - a name the compiled model cannot resolve
+            continue
+        hit = e.free_symbols & ys
+        if len(hit) == 1 and e.free_symbols - ys <= params:
+            (x,) = hit
+            if e.diff(x) in (1, -1):
+                out.add(name)
+    return out
+
+
+POSITION_UNITS = ("m", "rad", "mm", "deg")   # what an encoder or a displacement sensor gives
+
+
+def _name_filter(pattern):
+    """A predicate on names: a glob (``hook.*``, ``*.phi``) or, without
+    wildcards, a substring; None: everything."""
+    import fnmatch
+    if pattern is None:
+        return lambda name: True
+    if any(c in pattern for c in "*?["):
+        return lambda name: fnmatch.fnmatchcase(name, pattern)
+    return lambda name: pattern in name
+
+
 @main.command()
 @click.argument("file", type=click.Path(dir_okay=False))
-def variables(file):
-    """List parameters and variables with units and defaults."""
+@click.option("--states", "only_states", is_flag=True,
+              help="only the states (the unknowns the integrator carries): the usual "
+                   "names of a measured trace")
+@click.option("--match", "pattern", metavar="PATTERN",
+              help="only names matching PATTERN: a glob ('hook.*', '*.phi') or, without "
+                   "wildcards, a substring")
+def variables(file, only_states, pattern):
+    """List parameters and variables with units and defaults. Variables are
+    marked ``state`` (integrated) and ``position`` (a length or an angle:
+    what an encoder or a displacement sensor measures); a trace in the data
+    names one of them as its column."""
     from .modelfile import compile_file
     try:
         mf, cm = compile_file(file)
     except AcausalError as exc:
         _fail(exc)
-    click.echo("PARAMETERS (settable with --set)")
-    for p in cm.params:
-        click.echo(f"  {p.name:32s} = {p.default:<12.6g} [{p.unit}]  {p.decl.desc}")
-    for name, val in cm.structural.items():
-        click.echo(f"  {name:32s} = {val!r:<12} (structural)")
-    for name, val in cm.bound.items():
-        click.echo(f"  {name:32s} = {val} (bound)")
-    click.echo("VARIABLES (a fixed start value is settable with --set)")
-    states = {s.name for s in cm.dae.y[:cm.dae.n_states]}
+    keep = _name_filter(pattern)
+    shown = total = 0
+    if not only_states:
+        click.echo("PARAMETERS (settable with --set)")
+        for p in cm.params:
+            if keep(p.name):
+                click.echo(f"  {p.name:32s} = {p.default:<12.6g} [{p.unit}]  {p.decl.desc}")
+        for name, val in cm.structural.items():
+            if keep(name):
+                click.echo(f"  {name:32s} = {val!r:<12} (structural)")
+        for name, val in cm.bound.items():
+            if keep(name):
+                click.echo(f"  {name:32s} = {val} (bound)")
+    click.echo("STATES (integrated; name one in a trace)" if only_states else
+               "VARIABLES (a fixed start value is settable with --set; marked: state, "
+               "position = a length or angle a sensor measures)")
+    states = _state_names(cm)
     for name in cm.var_names:
         info = cm.flat.variables[name]
         if info.internal:
             continue
-        st = info.start
-        kind = "state" if name in states else ""
-        start = f"start {st.value}{' (fixed)' if st.fixed else ''}"
-        click.echo(f"  {name:32s} [{info.unit}] {info.desc}; {start} {kind}")
-    for d in cm.discretes:
-        if d.internal:
+        total += 1
+        if (only_states and name not in states) or not keep(name):
             continue
-        click.echo(f"  {d.symbol.name:32s} [{d.unit}] {d.desc}; discrete, start {d.start.value}")
+        shown += 1
+        st = info.start
+        marks = " ".join(m for m, on in (("state", name in states),
+                                         ("position", info.unit in POSITION_UNITS)) if on)
+        start = f"start {st.value}{' (fixed)' if st.fixed else ''}"
+        click.echo(f"  {name:32s} [{info.unit}] {info.desc}; {start} {marks}".rstrip())
+    if not only_states:
+        for d in cm.discretes:
+            if d.internal or not keep(d.symbol.name):
+                continue
+            click.echo(f"  {d.symbol.name:32s} [{d.unit}] {d.desc}; discrete, start "
+                       f"{d.start.value}")
+    if only_states or pattern is not None:
+        click.echo(f"({shown} of {total} variables shown)")
 
 
 @main.command()
@@ -651,9 +712,12 @@ def _parse_at(text):
               help="profile-likelihood 95% intervals (lsq): for the parameters whose "
                    "linearised interval is not trustworthy (auto), every one, or none")
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object")
+@click.option("--json-file", "json_file", type=click.Path(dir_okay=False), metavar="FILE",
+              help="also write that JSON object to FILE (as diagnose --json-file)")
 @click.option("--max-wall", type=POSITIVE, metavar="SECONDS", help="stop after this wall time")
 @click.option("--max-memory", callback=_size, metavar="SIZE", help=MAX_MEMORY_HELP)
-def calibrate(file, data, fit, method, experiments, profile, as_json, max_wall, max_memory):
+def calibrate(file, data, fit, method, experiments, profile, as_json, json_file, max_wall,
+              max_memory):
     """Fit parameters of a model file to a measured dataset. Warns (one line
     each) when a condition of the data lies outside the range the model
     declares, a measured value is far from what the fitted model gives (a
@@ -663,6 +727,8 @@ def calibrate(file, data, fit, method, experiments, profile, as_json, max_wall, 
     from .infra.budget import max_memory as memory_limit
     from .modelfile import compile_file
     try:
+        if json_file:
+            _check_output(json_file, "--json-file")
         with _quiet_warnings(), _resumable("nothing (a calibration keeps no partial result)"), \
                 Watchdog(memory_limit(max_memory), max_wall, "the calibration"):
             out, ds, held, mf, cm = _calibrate(cal, compile_file, file, data, fit, method,
@@ -670,6 +736,9 @@ def calibrate(file, data, fit, method, experiments, profile, as_json, max_wall, 
     except (AcausalError, click.BadParameter) as exc:
         _fail(exc)
     _calibration_warnings(mf, cm, ds, held, out)
+    if json_file:
+        with open(json_file, "w") as f:
+            json.dump(out.to_dict(), f, indent=1, default=float)
     _print_calibration(out, ds, mf, file, data, as_json)
 
 
@@ -1107,8 +1176,12 @@ def _csv_list(text):
 @main.command()
 @click.argument("file", type=click.Path(dir_okay=False))
 @click.argument("data", type=click.Path(file_okay=False))
-@click.option("--json", "json_path", type=click.Path(dir_okay=False),
-              help="write the summary as one JSON object to this file")
+@click.option("--json", "json_opt", is_flag=False, flag_value="-", default=None,
+              metavar="", help="print the summary as one JSON object (as calibrate --json, "
+                               "simulate --json); the old form --json FILE still writes FILE, "
+                               "deprecated: use --json-file FILE")
+@click.option("--json-file", "json_file", type=click.Path(dir_okay=False), metavar="FILE",
+              help="write the summary as one JSON object to FILE")
 @click.option("--report", "report_dir", type=click.Path(file_okay=False), default="diagnosis",
               show_default=True, help="folder for report.md, plots and the extended model; "
                                       "finished fits are checkpointed in REPORT/checkpoint/ as "
@@ -1130,8 +1203,8 @@ def _csv_list(text):
               help="best starts refined per fit (their agreement is reported)")
 @click.option("--no-progress", is_flag=True)
 @click.option("--library", hidden=True, help="module standing in for the hypothesis library")
-def diagnose(file, data, json_path, report_dir, scheduler, workers, max_wall, max_memory,
-             hypotheses, locations, alpha, starts, refine, no_progress, library):
+def diagnose(file, data, json_opt, json_file, report_dir, scheduler, workers, max_wall,
+             max_memory, hypotheses, locations, alpha, starts, refine, no_progress, library):
     """Show what a model gets wrong against measured data, name the cause,
     extend the model and measure the gain. A long trace is thinned to what
     its instrument floor supports (said on stderr); past --max-memory or
@@ -1141,9 +1214,19 @@ def diagnose(file, data, json_path, report_dir, scheduler, workers, max_wall, ma
     from .diagnose.problem import FitSettings
     from .diagnose.run import diagnose as run_diagnosis
     from .infra.executor import default_workers, terminate_on_sigterm
+    as_json = json_opt == "-"
+    json_path = json_file
+    if json_opt not in (None, "-"):      # the old form: --json FILE
+        click.echo(f"acausal diagnose: --json FILE is deprecated: --json alone prints the "
+                   f"JSON (as calibrate --json does); use --json-file {json_opt} (writing "
+                   f"{json_opt} now)", err=True)
+        if json_file:
+            _fail(UsageError(f"--json {json_opt} and --json-file {json_file}: give one file"))
+        json_path = json_opt
     try:
         with _quiet_warnings():
-            _check_output(json_path, "--json")
+            if json_path:
+                _check_output(json_path, "--json-file")
             _check_output(os.path.join(report_dir, "report.md"), "--report", create=True)
             limit = memory_limit(max_memory)
             n_workers = workers or (default_workers() if scheduler is None else 1)
@@ -1165,6 +1248,9 @@ def diagnose(file, data, json_path, report_dir, scheduler, workers, max_wall, ma
                     json.dump(out, f, indent=1)
     except (AcausalError, click.BadParameter) as exc:
         _fail(exc)
+    if as_json:
+        click.echo(json.dumps(out, indent=1))
+        return
     g = out["gain"]
     if not out["discrepancy"]:
         click.echo("no significant discrepancy between the calibrated model and the data")

@@ -77,6 +77,12 @@ def _run(path):
         if isinstance(exc, ModuleNotFoundError):
             hint = (" (a model file's imports are searched in " + ", ".join(model_path(path))
                     + " and ACAUSAL_MODEL_PATH)")
+        elif isinstance(exc, TypeError) and "convert expression to" in str(exc):
+            hint = (" (a model parameter is a sympy symbol, not a number: a start value or "
+                    "guess that depends on one, such as a loop's assembly at a release angle "
+                    "that is a condition, is written with sympy functions, e.g. "
+                    "sympy.asin(r*sympy.sin(theta0)/l), not math.asin or float(); "
+                    "docs/planar.md, 'Writing a planar model file')")
         raise _error(path, line, f"{type(exc).__name__}: {exc}{hint}") from None
 
 

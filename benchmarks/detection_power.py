@@ -85,6 +85,7 @@ def run_case(model, hyp, effect, seed, library, quick):
                 named=hyp is not None and out["cause"] == hyp and out["location"] == loc,
                 right=bool(right and out["discrepancy"]),
                 weak=out["discrepancy"] and out["cause"] is None,
+                verdict=(out.get("verdict") or {}).get("kind"),
                 cause=out["cause"], cause_location=out["location"],
                 same_law=[f"{h} at {l}" for h, l in same], wall_s=time.perf_counter() - t0,
                 cpu_s=time.process_time() - c0)

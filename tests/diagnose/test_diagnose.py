@@ -31,7 +31,7 @@ LIGHT = FitSettings(lhs=2, refine=1)
 LIGHT_CLI = ["--starts", "2", "--refine", "1"]
 KEYS = {"discrepancy", "cause", "location", "equivalent_causes", "parameters", "ranking",
         "gain", "extended_model", "causes", "unexplained", "next_experiment", "profile_ci95",
-        "cause_class", "notes"}
+        "cause_class", "notes", "failed", "verdict"}
 
 
 def _latch_data(folder, seed, **kw):

@@ -93,7 +93,10 @@ def test_members_are_seeded_from_the_head_at_its_site_only():
     idx = family_index(prob.library)
     assert [r.candidate.hypothesis for r in heads(dec, idx)] == ["coulomb_friction"]
     got = {c.hypothesis: (c, head) for c, head in member_candidates(prob, dec, idx)}
-    assert set(got) == {"coulomb_viscous_friction", "stribeck_friction"}
+    assert set(got) == {"coulomb_viscous_friction", "stribeck_friction", "stick_slip_friction",
+                        "viscous_damping"}
+    ssf = {p.name: p for p in got["stick_slip_friction"][0].params}
+    assert ssf["hyp_ssf.F"].start == 2.5                                        # seeded
     cvf = {p.name: p for p in got["coulomb_viscous_friction"][0].params}
     assert cvf["hyp_cvf.F"].start == 2.5 and cvf["hyp_cvf.F"].prior == 0.0   # seeded
     assert cvf["hyp_cvf.b"].start == 0.0
@@ -280,10 +283,19 @@ def test_an_uninformative_extra_parameter_does_not_take_the_name():
     rk = Ranking(rows, [[0, 1, 2]], 0, 0, None, [], (), 1.0)
     got = prefer_simplest(rk, family_index(None))
     assert got.named.candidate.hypothesis == "coulomb_friction" and got.after == 1
-    # 2.5 units: the viscous term earns its place
+    # 2.5 units ahead but b without an interval that excludes 0 and no better
+    # held-out error (issue 24): the simpler member still takes the name
     rows2 = (rows[0], dataclasses.replace(rows[1], aicc=12.5), rows[2])
     assert prefer_simplest(Ranking(rows2, [[0, 1, 2]], 0, 0, None, [], (), 1.0),
-                           family_index(None)).after == 0
+                           family_index(None)).after == 1
+    # b determined (0.01 [0.009, 0.011]) and the held-out error 20 % better:
+    # the viscous term earns its place
+    e = np.random.default_rng(1).standard_normal(300)
+    sure = dataclasses.replace(rows[0], fit=dataclasses.replace(
+        rows[0].fit, ci95={"hyp_cvf.b": (0.009, 0.011), "hyp_cvf.F": (1.9, 2.1)}))
+    rk3 = Ranking((sure,) + rows2[1:], [[0, 1, 2]], 0, 0, None, [], (), 1.0,
+                  (e, 1.2 * e, 1.2 * e))
+    assert prefer_simplest(rk3, family_index(None)).after == 0
     # the constant load is another class of cause: never swapped in
     assert prefer_simplest(Ranking(rows[2:] + rows[:2], [[0]], 0, 0, None, [], (), 1.0),
                            family_index(None)).after == 0

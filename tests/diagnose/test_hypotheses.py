@@ -65,6 +65,10 @@ CASES = [
     ("flexible_link", HERTZ, "mass:contact", "contact_period", +1),
     ("position_dependent_force", "push", "push", "t_arrive", -1),
     ("contact_damping_law", HERTZ, "contact", "restitution", -1),
+    ("stick_slip_friction", HERTZ, "mass", "rebound_velocity", -1),
+    ("viscous_damping", HERTZ, "mass", "rebound_velocity", -1),
+    ("stick_slip_friction", "push", "cart", "t_arrive", +1),
+    ("viscous_damping", "push", "cart", "t_arrive", +1),
 ]
 # flexible_link at T = 0 keeps a stiff link of period T0 = T_load/5: it
 # follows the nominal model to (T0/T_load)^2-ish, not to the solver tolerance
@@ -106,7 +110,8 @@ def test_library_ids_and_texts():
                                 "hardening_spring", "clearance", "flexible_link",
                                 "position_dependent_force", "contact_damping_law",
                                 # family members (fitted where their head is competitive)
-                                "coulomb_viscous_friction", "stribeck_friction", "power_drag",
+                                "coulomb_viscous_friction", "stribeck_friction",
+                                "stick_slip_friction", "viscous_damping", "power_drag",
                                 "bilinear_spring", "dead_band_spring", "restitution_power_law",
                                 "contact_law_hunt_crossley", "contact_law_lankarani_nikravesh",
                                 "contact_law_flores"]
@@ -132,6 +137,8 @@ def test_breaker_candidates():
         "contact_damping_law": ["contact"],
         "coulomb_viscous_friction": ["armature.mass", "hook.body", "main_shaft.body"],
         "stribeck_friction": ["armature.mass", "hook.body", "main_shaft.body"],
+        "stick_slip_friction": ["armature.mass", "hook.body", "main_shaft.body"],
+        "viscous_damping": ["armature.mass", "hook.body", "main_shaft.body"],
         "power_drag": ["armature.mass", "hook.body", "main_shaft.body"],
         "bilinear_spring": ["armature.reset", "hook.reset", "main_shaft.open_spring",
                             "main_shaft.wipe_spring"],

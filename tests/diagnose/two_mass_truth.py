@@ -7,6 +7,7 @@ effects the diagnosis must find::
     f12 = k2 (x2 - x1) + d2 (x2' - x1') + k3 (x2 - x1)^3
 
 * ``m2_coulomb``: f2 = F tanh(x2'/1e-4) (dry friction of m2 on its guide);
+* ``m2_viscous``: f2 += b x2' (a viscous loss in m2's guide, linear in its speed);
 * ``m1_drag``: f1 += c x1'|x1'| (quadratic drag on m1);
 * ``k2_cubic``: k3 (a hardening coupling spring);
 * ``m1_threshold``: f1 += F_t sign(x1') min(max(|x1'| - 0.1, 0)/0.1, 1), a
@@ -37,7 +38,7 @@ def simulate(x20, effect=None, value=0.0):
         f1 = e.get("m1_drag", 0.0) * v1 * abs(v1)
         if "m1_threshold" in e:   # a force that sets in above 0.1 m/s: no library law
             f1 += e["m1_threshold"] * np.sign(v1) * min(max(abs(v1) - 0.1, 0.0) / 0.1, 1.0)
-        f2 = e.get("m2_coulomb", 0.0) * np.tanh(v2 / 1e-4)
+        f2 = e.get("m2_coulomb", 0.0) * np.tanh(v2 / 1e-4) + e.get("m2_viscous", 0.0) * v2
         return [v1, (-K1 * x1 - D1 * v1 + f12 - f1) / M1, v2, (-f12 - f2) / M2]
     sol = solve_ivp(rhs, (0, T_END), [0.0, 0.0, x20, 0.0], t_eval=t, method="LSODA",
                     rtol=1e-11, atol=1e-14, max_step=2e-4)

@@ -53,9 +53,10 @@ class Domain:
 
     def component(self, role: str, **kw):
         """An instance of the domain's component for ``role`` (source,
-        relative_source, body, spring_damper, displacement_source)."""
+        relative_source, body, spring_damper, displacement_source,
+        stick_slip)."""
         name = dict(self.classes)[role]
-        module = ("acausal.diagnose.library.elements" if role == "displacement_source"
+        module = ("acausal.diagnose.library.elements" if role in ELEMENT_ROLES
                   else self.module)
         return getattr(importlib.import_module(module), name)(**kw)
 
@@ -64,17 +65,21 @@ class Domain:
         return self.component("source", **{self.through: value})
 
 
+ELEMENT_ROLES = ("displacement_source", "stick_slip")   # in .elements, not the library
+
 TRANSLATIONAL = Domain(
     "translational", "s", "v", "f", "s_rel", "s_rel0", "f0", "F", "m", "m/s", "N", "kg", "m",
     "+s", "guide", 1e-3, "acausal.mechanics.translational",
     (("source", "Force"), ("relative_source", "RelativeForce"), ("body", "Mass"),
-     ("spring_damper", "SpringDamper"), ("displacement_source", "DisplacementForce")))
+     ("spring_damper", "SpringDamper"), ("displacement_source", "DisplacementForce"),
+     ("stick_slip", "StickSlipForce")))
 
 ROTATIONAL = Domain(
     "rotational", "phi", "w", "tau", "phi_rel", "phi_rel0", "tau0", "tau", "rad", "rad/s",
     "N*m", "kg*m^2", "J", "+phi", "bearing", 0.01, "acausal.mechanics.rotational",
     (("source", "Torque"), ("relative_source", "RelativeTorque"), ("body", "Inertia"),
-     ("spring_damper", "SpringDamper"), ("displacement_source", "DisplacementTorque")))
+     ("spring_damper", "SpringDamper"), ("displacement_source", "DisplacementTorque"),
+     ("stick_slip", "StickSlipTorque")))
 
 DOMAINS = {d.name: d for d in (TRANSLATIONAL, ROTATIONAL)}
 

@@ -7,10 +7,18 @@ have (sign convention: :mod:`acausal.connectors`).
 * :class:`VelocityRestitution`, :class:`PowerRestitution`: mixins that make
   a contact's coefficient of restitution fall with the impact velocity
   (linearly, or as a power law).
+* :class:`StickSlipForce` / :class:`StickSlipTorque`: dry friction with
+  stiction between one flange and the frame, a leaf of the library's
+  friction mode machine (:mod:`acausal.mechanics.frictionmodes`, MSL's
+  ``PartialFriction``): it sticks and slips by events, as MSL's
+  ``SupportFriction`` / ``BearingFriction`` with a constant sliding level do,
+  but needs no second flange and no support (the frame takes the reaction).
 """
 from sympy import Max, Min, Piecewise
 
-from ...lang import Component, Discrete, Eq, Event, Flange, Parameter, RotFlange, Variable
+from ...lang import (Component, Discrete, Eq, Event, Flange, Parameter, RotFlange, Variable,
+                     der)
+from ...mechanics.frictionmodes import PartialFriction, PartialRotFriction
 
 E_MIN = 0.01   # smallest restitution VelocityRestitution lets the law reach
 
@@ -73,6 +81,87 @@ class DisplacementTorque(Component):
 
     def events(self):
         return [_capture(self, self.flange.phi)]
+
+
+class StickSlipForce(PartialFriction):
+    """Dry (Coulomb) friction with stiction between ``flange`` and the frame
+    (a guide), by the shared mode machine (events, MSL's law)::
+
+        sliding:  f = F*sign(v)                  (v != 0, or starting)
+        stuck:    der(v) = 0, while -peak*F <= f <= peak*F
+        f0 = F,  f0_max = peak*F
+
+    ``f`` is the force the flange applies on the element (the element acts
+    on the flange's body with ``-f``: against the sliding velocity). With
+    ``F = 0`` the element transmits nothing (a body at rest breaks away at
+    any force), so the extended model is the nominal one.
+
+    Parameters: ``F`` [N] sliding (kinetic) friction level (>= 0); ``peak``
+    [1] break-away level / sliding level (>= 1); ``v_small`` [m/s] (the
+    machine's). States: ``v`` [m/s], ``a`` [m/s2], ``f`` [N]; the machine's
+    (``mode``, ``startForward``, ``startBackward``, ``sa``, ``locked``,
+    ``f0``, ``f0_max``, ``lossPower``). Connectors: ``flange``.
+    """
+
+    flange = Flange("flange of the sliding body (the frame takes the reaction)")
+    F = Parameter(0.0, "N", "sliding (kinetic) friction force", min=0.0)
+    peak = Parameter(1.0, "1", "break-away force / sliding friction force", min=1.0)
+    v = Variable(0.0, "m/s", "velocity of the flange relative to the frame")
+    a = Variable(0.0, "m/s2", "acceleration of the flange relative to the frame")
+    f = Variable(0.0, "N", "friction force (applied on the element by the flange)")
+
+    def equations(self):
+        return [Eq(self.v, der(self.flange.s)), Eq(self.a, der(self.v)),
+                Eq(self.flange.f, self.f),
+                Eq(self.f0, self.F), Eq(self.f0_max, self.peak * self.F)]
+
+    def friction_motion(self):
+        return self.v, self.a
+
+    def friction_force(self):
+        return self.f
+
+    def sliding_force(self, direction):
+        return direction * self.F
+
+
+class StickSlipTorque(PartialRotFriction):
+    """Dry (Coulomb) friction with stiction between ``flange`` and the frame
+    (a bearing), by the shared mode machine (events, MSL's law)::
+
+        sliding:  tau = T*sign(w)
+        stuck:    der(w) = 0, while -peak*T <= tau <= peak*T
+        tau0 = T,  tau0_max = peak*T
+
+    ``tau`` is the torque the flange applies on the element (it acts on the
+    flange's body with ``-tau``). ``T = 0``: the nominal model.
+
+    Parameters: ``T`` [N*m] sliding (kinetic) friction torque (>= 0);
+    ``peak`` [1] break-away / sliding level (>= 1); ``w_small`` [rad/s] (the
+    machine's). States: ``w`` [rad/s], ``a`` [rad/s2], ``tau`` [N*m]; the
+    machine's. Connectors: ``flange``.
+    """
+
+    flange = RotFlange("flange of the turning body (the frame takes the reaction)")
+    T = Parameter(0.0, "N*m", "sliding (kinetic) friction torque", min=0.0)
+    peak = Parameter(1.0, "1", "break-away torque / sliding friction torque", min=1.0)
+    w = Variable(0.0, "rad/s", "angular velocity of the flange relative to the frame")
+    a = Variable(0.0, "rad/s2", "angular acceleration of the flange relative to the frame")
+    tau = Variable(0.0, "N*m", "friction torque (applied on the element by the flange)")
+
+    def equations(self):
+        return [Eq(self.w, der(self.flange.phi)), Eq(self.a, der(self.w)),
+                Eq(self.flange.tau, self.tau),
+                Eq(self.tau0, self.T), Eq(self.tau0_max, self.peak * self.T)]
+
+    def friction_motion(self):
+        return self.w, self.a
+
+    def friction_force(self):
+        return self.tau
+
+    def sliding_force(self, direction):
+        return direction * self.T
 
 
 class RestitutionLaw:

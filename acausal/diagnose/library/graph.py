@@ -376,6 +376,11 @@ class ModelGraph:
         of the run). Units follow the domain (N or N*m, m or rad)."""
         path = site_or_path.path if isinstance(site_or_path, Site) else site_or_path
         body = self.components[path]
+        if domain_of(body) not in ("translational", "rotational"):
+            raise ModelError(
+                f"{path}: a {domain_of(body)} {type(body).__name__} is not a site of a 1-D "
+                "hypothesis (its loads act through its joints); joint sites: "
+                + (", ".join(s.path for s in self.joints) or "none"))
         rot = domain_of(body) == "rotational"
         xn, vn = ("phi", "w") if rot else ("s", "v")
         m = self.param(body, self.mass_param(body)) if has_role(body, "body") else 0.0

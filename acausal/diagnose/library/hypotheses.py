@@ -42,7 +42,10 @@ contact_damping_law       contact         e(v_i) = e - a v_i (clipped to [0.01, 
 Families (``FAMILIES``: cause class -> members, the head first; the other
 members are fitted where the head is competitive, :mod:`.families`):
 friction (``coulomb_viscous_friction``: + b v; ``stribeck_friction``:
-(F + dF exp(-(v/v_s)^2)) tanh(v/v_eps)), drag (``power_drag``: c v
+(F + dF exp(-(v/v_s)^2)) tanh(v/v_eps); ``stick_slip_friction``: F sign(v)
+sliding and held at rest within peak*F, by the friction mode machine's
+events, so a body that stops against its spring stays there;
+``viscous_damping``: b v), drag (``power_drag``: c v
 (v^2 + v_eps^2)^((n-1)/2) / v_ref^(n-2)), spring_nonlinearity
 (``bilinear_spring``: k2 (u - clip(u, -d, d)); ``dead_band_spring``: the
 spring's force c (u - clip(u, -b, b))), contact_damping
@@ -111,6 +114,10 @@ class Hypothesis:
     #                     cause at a site moving the other way has the same sign
     #                     (acausal.diagnose.stages.kinematics.convert); False: a constant load
     relative_cost = 1.0  # a simulation's cost against the nominal model's (task ordering)
+    refines = None      # the head whose law this member equals outside a regime the data
+    #                     must show (stick_slip_friction: Coulomb friction, except that it
+    #                     holds a stopped body): within the parsimony margin the head is
+    #                     named (acausal.diagnose.stages.families.prefer_simplest)
 
     # -- interface ------------------------------------------------------------------
     def candidates(self, graph):
@@ -450,6 +457,8 @@ class FlexibleLink(Hypothesis):
         out = []
         for j in graph.joints:
             body = j.component
+            if not has_role(body, "body"):
+                continue        # a planar joint: no mass of its own to split
             seen = []
             for o in graph.at_node(body.flange):
                 if o is body:
@@ -673,6 +682,95 @@ class StribeckFriction(CoulombFriction):
         model.connect(hyp.friction.flange, body.flange)
 
 
+class StickSlipFriction(CoulombFriction):
+    """Dry friction that sticks and slips by events: the library's friction
+    mode machine (:mod:`acausal.mechanics.frictionmodes`, MSL's
+    ``PartialFriction``) in :class:`.elements.StickSlipForce` /
+    ``StickSlipTorque`` between the site's flange and the frame. The smooth
+    members (``tanh(v/v_eps)``) pass through zero speed with a force that
+    vanishes there, so they cannot hold a body at rest against a spring;
+    this one holds it while the force needed stays within the break-away
+    level ``peak*F`` and slides at ``F`` otherwise."""
+
+    id = "stick_slip_friction"
+    title = "Dry friction with stiction (stick-slip) at a joint"
+    prefix = "hyp_ssf"
+    refines = "coulomb_friction"   # the same law while it slides
+    fixed = {"peak": 1.0}
+    # events at every stop and reversal (each a re-initialisation): on the stick
+    # rig (tests/diagnose/stick_rig.py, compiled, loaded host) 22.8 ms a run at
+    # F = 0 (14 events) and 14.8 ms at F = 0.9 N (it sticks), nominal 6.6 ms
+    relative_cost = 3.0
+    law = ("sliding: f = -F*sign(v) on the body against the frame; stuck (v = 0): the body "
+           "is held while the force needed stays within peak*F (peak = 1: break-away level "
+           "= sliding level F); stick and slip by events, MSL's friction mode machine")
+    explanation = ("Dry friction in the guide (bearing) that stops the body and holds it "
+                   "where the remaining forces cannot overcome it: the motion ends early, "
+                   "away from the spring's rest position, and stays there.")
+    distinguishing_experiment = ("Release the body from several positions: a body held by "
+                                 "stiction stops within +-F/c of the spring's rest "
+                                 "position and stays there, a viscous or smooth "
+                                 "kinetic loss lets it creep back to rest; a slow "
+                                 "quasi-static push measures the break-away level.")
+
+    def defaults(self, graph, location):
+        return {}
+
+    def _extend(self, model, graph, hyp, location, vals):
+        body = model.find(location)
+        d = domain_of(body)
+        F = self._par(hyp, vals, d.force_name, d.force_unit,
+                      f"sliding (kinetic) friction level at {location}", min=0.0)
+        peak = self._par(hyp, vals, "peak", "1", "break-away level / sliding level",
+                         min=1.0)
+        hyp.friction = d.component("stick_slip", **{"T" if d.rotational else "F": F},
+                                   peak=peak)
+        model.connect(hyp.friction.flange, body.flange)
+
+
+class ViscousDamping(Hypothesis):
+    """Plain viscous friction, linear in the rate. In the friction family
+    (not drag): it is the loss of a lubricated bearing or guide that MSL's
+    friction elements carry as their ``F_prop`` / ``d`` term, it is nested in
+    ``coulomb_viscous_friction`` (F = 0), so the family's parsimony
+    (:func:`acausal.diagnose.stages.families.prefer_simplest`) names it
+    when the Coulomb part of that member is not supported, and a pair of
+    it with Coulomb friction at one site is that member (two members of one
+    family at one site are never a pair)."""
+
+    id = "viscous_damping"
+    title = "Viscous friction (damping) at a joint"
+    prefix = "hyp_vd"
+    site_kinds = ("joint",)
+    law = "f = -b*v on the body against the frame (linear in the rate)"
+    explanation = ("A loss in proportion to the speed (a lubricating film, oil in a "
+                   "bearing, eddy currents, a leak in a dashpot): an oscillation decays "
+                   "exponentially and a driven motion loses force in proportion to its "
+                   "speed.")
+    distinguishing_experiment = ("Run at two or more drive speeds or amplitudes: the lost "
+                                 "force scales with v (viscous), v^2 (quadratic drag) or "
+                                 "not at all (Coulomb friction); a free decay's amplitude "
+                                 "falls geometrically (viscous) rather than linearly "
+                                 "(Coulomb).")
+
+    def candidates(self, graph):
+        return [s.path for s in graph.joints]
+
+    def params(self, graph, location):
+        t = graph.typical(location)
+        d = domain_of(graph.components[location])
+        return [self._spec("b", 0.0, 0.5 * t["force"] / t["speed"], d.unit("{F}*s/{L}"),
+                           f"viscous friction coefficient at the {d.guide} of {location}")]
+
+    def _extend(self, model, graph, hyp, location, vals):
+        body = model.find(location)
+        d = domain_of(body)
+        b = self._par(hyp, vals, "b", d.unit("{F}*s/{L}"), f"viscous friction at {location}",
+                      min=0.0)
+        hyp.viscous = d.source(-b * getattr(body, d.rate))
+        model.connect(hyp.viscous.flange, body.flange)
+
+
 class PowerDrag(QuadraticDamping):
     id = "power_drag"
     title = "Drag growing with a power n of the speed"
@@ -877,7 +975,8 @@ def _same_damping(law, target, e):
 HYPOTHESES = {h.id: h for h in (CoulombFriction(), QuadraticDamping(), ConstantLoad(),
                                  HardeningSpring(), ExtraClearance(), FlexibleLink(),
                                  PositionDependentForce(), ContactDampingLaw(),
-                                 CoulombViscousFriction(), StribeckFriction(), PowerDrag(),
+                                 CoulombViscousFriction(), StribeckFriction(),
+                                 StickSlipFriction(), ViscousDamping(), PowerDrag(),
                                  BilinearSpring(), DeadBandSpring(), RestitutionPowerLaw())
               + tuple(ContactLaw(law) for law in CONTACT_LAWS)}
 
@@ -885,7 +984,8 @@ HYPOTHESES = {h.id: h for h in (CoulombFriction(), QuadraticDamping(), ConstantL
 # family's head) is fitted at every site and the others only where the head
 # is competitive (acausal/diagnose/families.py); the data choose the member.
 FAMILIES = {
-    "friction": ("coulomb_friction", "coulomb_viscous_friction", "stribeck_friction"),
+    "friction": ("coulomb_friction", "coulomb_viscous_friction", "stribeck_friction",
+                 "stick_slip_friction", "viscous_damping"),
     "drag": ("quadratic_damping", "power_drag"),
     "spring_nonlinearity": ("hardening_spring", "bilinear_spring", "dead_band_spring"),
     "contact_damping": ("contact_damping_law", "restitution_power_law")

@@ -51,6 +51,9 @@ class FamilyIndex:
 
     of: dict
     members: dict
+    refines: frozenset = frozenset()   # members that only refine their head in a regime
+    #                                    the data must show (Hypothesis.refines): named
+    #                                    over the head only beyond the parsimony margin
 
     def family(self, hid):
         """The cause class of a hypothesis (its own id when it has no family)."""
@@ -65,6 +68,9 @@ class FamilyIndex:
 
 
 def family_index(library) -> FamilyIndex:
-    fams = getattr(load_library(library), "FAMILIES", None) or {}
+    lib = load_library(library)
+    fams = getattr(lib, "FAMILIES", None) or {}
+    refines = frozenset(hid for hid, h in lib.HYPOTHESES.items()
+                        if getattr(h, "refines", None))
     return FamilyIndex({m: (f, i) for f, ms in fams.items() for i, m in enumerate(ms)},
-                       {f: tuple(ms) for f, ms in fams.items()})
+                       {f: tuple(ms) for f, ms in fams.items()}, refines)

@@ -298,9 +298,28 @@ def _section_cost(d):
             f"Hypothesis library: `{d.problem.library}`.\n")
 
 
+def _candidates_sentence(v) -> str:
+    """The best candidates of each kind with their held-out errors."""
+    cs = v.get("candidates") or []
+    if not cs:
+        return ""
+    return " Best candidates (held-out RMS, floors): " + "; ".join(
+        f"{c['kind']} {c['cause']} at `{c['location']}` {fmt(c['heldout_rmse'], 4)}"
+        for c in cs) + "."
+
+
+def _threshold_sentence(v) -> str:
+    t = v.get("heldout_threshold")
+    if not t:
+        return ""
+    return (f" Held-out threshold {fmt(t['rms'], 4)} floors: the most a held-out RMS error "
+            f"reaches on noise alone at {t['level']:.0%} ({t['n']} values, {t['k']} fitted "
+            f"parameters, {t['experiments']} experiments; {t['sentence']}).")
+
+
 def verdict(d, s) -> str:
-    g = s["gain"]
-    if not s["discrepancy"]:
+    g, v = s["gain"], s["verdict"]
+    if v["kind"] == "no_discrepancy":
         return ("**No significant discrepancy.** The calibrated model explains the data "
                 "within the instrument model at the stated significance level; no cause is "
                 "named and no extended model is written. (This does not prove the model "
@@ -308,25 +327,40 @@ def verdict(d, s) -> str:
                 "would pass.)")
     held = (f"held-out error {fmt(g['before']['heldout'], 3)} -> "
             f"{fmt(g['after']['heldout'], 3)} floor units")
-    if s["unexplained"]["value"]:
-        return (f"**Discrepancy not explained by the library.** A generic term at the node of "
-                f"`{s['unexplained']['node']}` removes most of the misfit (held-out "
-                f"{fmt(s['unexplained']['heldout_rmse'], 3)} floor units; section 4b shows its "
-                f"shape). No library cause is named: {'; '.join(d.ranking.weak)}.")
-    if s["cause"] is None:
-        best, weak = d.ranking.best, d.ranking.weak
-        reasons = "; ".join(weak) if weak else "no candidate could be fitted"
-        txt = f"**Discrepancy, but the evidence is weak: no cause is named.** {reasons}."
+    if v["kind"] == "not_explained":
+        un = s["unexplained"]
+        where = (f" A generic term at the node of `{un['node']}` removes most of the misfit "
+                 f"(held-out {fmt(un['heldout_rmse'], 3)} floor units; section 4b shows its "
+                 f"shape)." if un["node"] else
+                 " No located generic term beats the library's best candidate (section 4b).")
+        laws = "".join(f" **A mixture of laws?** {x['text']}." for x in v["laws"])
+        return (f"**Discrepancy not explained by the library.** "
+                + "; ".join(r["text"] for r in v["reasons"]) + "." + where + laws
+                + _candidates_sentence(v) + _threshold_sentence(v)
+                + _class_sentence(s["cause_class"]))
+    if v["kind"] == "weak" or s["cause"] is None:
+        best = d.ranking.best
+        kinds = sorted({r["code"] for r in v["reasons"]})
+        reasons = "; ".join(r["text"] for r in v["reasons"]) or "no candidate could be fitted"
+        txt = (f"**Discrepancy, but the evidence is weak: no cause is named** (the data "
+               f"cannot decide: {', '.join(kinds)}). {reasons}.")
         if best is not None:
-            txt += f" The best candidate would be {best.candidate.label} ({held})."
-        return txt + _tied_sentence(d) + _class_sentence(s["cause_class"])
+            txt += (f" The best candidate, {best.candidate.label}, explains the held-out "
+                    f"data ({held}).")
+        return (txt + _threshold_sentence(v) + _tied_sentence(d)
+                + _class_sentence(s["cause_class"]))
     txt = (f"**Discrepancy; cause: {s['cause']} at `{s['location']}`.** {held[0].upper()}"
            f"{held[1:]} (train {fmt(g['before']['train'], 3)} -> "
-           f"{fmt(g['after']['train'], 3)}).")
+           f"{fmt(g['after']['train'], 3)}), within the held-out threshold.")
+    if v["undetermined"]:
+        txt += " Undetermined (flagged, consistent with the law without it): " + "; ".join(
+            f"`{c['name']}` = {fmt(c['value'])} [{fmt(c['ci95'][0])}, {fmt(c['ci95'][1])}]"
+            f" (neutral {fmt(c['neutral'])})" for c in v["undetermined"]) + "."
     if s["equivalent_causes"]:
         txt += " The data cannot tell it from: " + ", ".join(
             f"{e['cause']} at `{e['location']}`" for e in s["equivalent_causes"]) + "."
-    return txt + _tied_sentence(d) + _class_sentence(s["cause_class"])
+    return (txt + _threshold_sentence(v) + _tied_sentence(d)
+            + _class_sentence(s["cause_class"]))
 
 
 def _tied_sentence(d) -> str:
@@ -380,7 +414,10 @@ def evidence(d) -> list:
 def _best_lines(d):
     dec, rk, best = d.decision, d.ranking, d.ranking.best
     lib = load_library(d.problem.library)
-    head = "Named cause" if rk.named is not None else "Best candidate (not named: evidence weak)"
+    head = ("Named cause" if rk.named is not None else
+             "Best candidate (not named: it does not explain the held-out data)"
+             if d.verdict.kind == "not_explained" else
+             "Best candidate (not named: evidence weak)")
     L = [f"**{head}: {best.candidate.label}**\n"]
     for h, loc, _ in best.candidate.members():
         hyp = lib.HYPOTHESES[h]
@@ -418,7 +455,16 @@ def _class_lines(d):
         L.append("- the experiments that would tell them apart:")
         for hid in dict.fromkeys(h for r in [best] + others for h, _, _ in r.candidate.members()):
             L.append(f"  - {hid}: {lib.HYPOTHESES[hid].distinguishing_experiment}")
-    if rk.weak:
-        L.append("- **evidence is weak**:")
-        L += [f"  - {w}" for w in rk.weak]
+    v = d.verdict
+    if v.kind == "weak" and v.reasons:
+        L.append("- **evidence is weak** (the data cannot decide):")
+        L += [f"  - {r.text} [`{r.code}`]" for r in v.reasons]
+    elif v.kind == "not_explained":
+        L.append("- **not explained by the library** (never \"weak\" in this case):")
+        L += [f"  - {r.text} [`{r.code}`]" for r in v.reasons]
+        L += [f"  - a mixture of laws? {x.text}" for x in v.laws if x.text not in
+              " ".join(r.text for r in v.reasons)]
+    if v.threshold is not None:
+        L.append(f"- held-out threshold: {fmt(v.threshold.rms, 4)} floors "
+                 f"({v.threshold.sentence()})")
     return L

@@ -17,6 +17,7 @@ from ..stages.kinematics import Kinematics
 from ..stages.locate import Location
 from ..stages.nextexp import NextStep
 from ..stages.stats import OVERDISPERSION
+from ..stages import verdict as vd
 from ..stages.views import Views
 
 
@@ -48,6 +49,19 @@ class Diagnosis:
     families: FamilyIndex | None = None
     kinematics: Kinematics | None = None
     tied: tuple = ()
+
+    @property
+    def verdict(self) -> vd.Verdict:
+        """The diagnosis's verdict (:data:`.stages.verdict.KINDS`): the
+        ranking's, turned into "not explained by the library" when the
+        located generic term beats every library candidate
+        (:mod:`.stages.locate`) while none is named."""
+        v = self.ranking.verdict or vd.Verdict(self.ranking.kind)
+        loc = self.location
+        if v.kind == "weak" and loc is not None and loc.unexplained:
+            return vd.Verdict("not_explained", (vd.Reason("generic", loc.reason),) + v.reasons,
+                              v.threshold, v.heldout, v.laws)
+        return v
 
 
 def num(x):
@@ -176,20 +190,77 @@ def summary(d: Diagnosis) -> dict:
             d.next_experiment.to_dict()),
         profile_ci95={} if d.intervals is None else clean(d.intervals.to_dict()),
         cause_class=cause_class(d),
+        failed=failed(d),
+        verdict=verdict(d),
     )
 
 
+def candidates(d: Diagnosis, singles=3) -> list:
+    """The best candidates of each kind with their held-out errors (floors):
+    the ``singles`` best single causes, the best pair, the best located
+    generic term; each ``{kind, cause, location, aicc, heldout_rmse}``."""
+    rk = d.ranking
+    out = [dict(kind="single", cause=r.candidate.hypothesis, location=r.candidate.location,
+                aicc=num(r.aicc), heldout_rmse=num(r.heldout_rmse))
+           for r in [r for r in rk.rows if "+" not in r.candidate.hypothesis][:singles]]
+    pair = next((r for r in rk.rows if "+" in r.candidate.hypothesis), None)
+    if pair is not None:
+        out.append(dict(kind="pair", cause=pair.candidate.hypothesis,
+                        location=pair.candidate.location, aicc=num(pair.aicc),
+                        heldout_rmse=num(pair.heldout_rmse)))
+    if d.location is not None and d.location.terms:
+        t = d.location.terms[0]
+        out.append(dict(kind="generic", cause="generic_force", location=t.node,
+                        aicc=num(t.aicc), heldout_rmse=num(t.heldout_rmse)))
+    return out
+
+
+def verdict(d: Diagnosis) -> dict:
+    """The verdict (:attr:`Diagnosis.verdict`) as JSON: ``kind``
+    (no_discrepancy, named, weak, not_explained), ``reasons`` (``{code,
+    text}``: the weak rules that object, or why the held-out data are not
+    explained), ``heldout_threshold`` (the most a held-out RMS error reaches
+    on noise alone, with its derivation), ``heldout_rmse`` (of the best
+    candidate), ``candidates`` (:func:`candidates`; with a discrepancy),
+    ``laws`` (shape parameters away from the standard laws or at a bound:
+    a mixture of laws?) and ``undetermined`` (the named cause's parameters
+    whose intervals reach their neutral values, flagged)."""
+    v = d.verdict
+    named = d.ranking.named
+    return clean(dict(
+        kind=v.kind, reasons=[dict(code=r.code, text=r.text) for r in v.reasons],
+        heldout_threshold=None if v.threshold is None else v.threshold.to_dict(),
+        heldout_rmse=v.heldout,
+        candidates=candidates(d) if d.decision.discrepancy else [],
+        laws=[x.to_dict() for x in v.laws],
+        undetermined=[] if named is None else [c.to_dict() for c in vd.undetermined(named)]))
+
+
+def failed(d: Diagnosis) -> list:
+    """The candidates that could not be built or fitted, each with its
+    reason (a candidate the library offers but cannot compile at a site is
+    not silently dropped)."""
+    return [dict(cause=r.candidate.hypothesis, location=r.candidate.location,
+                 error=r.error or (r.fit.message if r.fit is not None else ""))
+            for r in d.decision.failed]
+
+
 def unexplained(d: Diagnosis) -> dict:
-    """``value``: the discrepancy is not explained by the library; ``node``:
-    the body whose node the located generic term sits at (None when not
-    located); ``heldout_rmse`` of that term; ``nearest``: the best library
-    candidate."""
-    loc = d.location
+    """``value``: the discrepancy is not explained by the library (the
+    verdict's kind); ``node``: the body whose node the located generic term
+    sits at (None when no term beats the library); ``heldout_rmse`` of that
+    term (of the best library candidate when none does); ``nearest``: the
+    best library candidate."""
+    loc, best = d.location, d.ranking.best
+    value = d.verdict.kind == "not_explained"
     if loc is None or not loc.terms:
-        return dict(value=False, node=None, heldout_rmse=None, nearest=None)
+        return dict(value=value, node=None,
+                    heldout_rmse=num(best.heldout_rmse) if value and best else None,
+                    nearest=best.candidate.label if value and best else None)
     t = loc.terms[0]
-    return dict(value=loc.unexplained, node=loc.node,
-                heldout_rmse=num(t.heldout_rmse) if loc.unexplained else None,
+    return dict(value=value, node=loc.node,
+                heldout_rmse=(num(t.heldout_rmse) if loc.unexplained else
+                              num(best.heldout_rmse) if value and best else None),
                 nearest=loc.nearest)
 
 
@@ -218,9 +289,7 @@ def details(d: Diagnosis) -> dict:
                          r.fit, dict(aicc=num(r.aicc), heldout_rmse=num(r.heldout_rmse),
                                      lr_p=num(r.lr_p), starts=_starts(r.starts)))
                     for r in rk.rows],
-        failed=[dict(cause=r.candidate.hypothesis, location=r.candidate.location,
-                     error=r.error or (r.fit.message if r.fit is not None else ""))
-                for r in dec.failed],
+        failed=failed(d),
         located=[dict(node=t.node, members=list(t.members), S=num(t.S), aicc=num(t.aicc),
                       heldout_rmse=num(t.heldout_rmse), values=t.values,
                       ranges=list(t.ranges))

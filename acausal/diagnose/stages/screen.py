@@ -152,12 +152,13 @@ class Screen:
     unfitted: tuple = ()
 
 
-def screened(ctx, problem, cal, dec, cands) -> Screen:
+def screened(ctx, problem, cal, dec, cands, max_fits=MAX_FITS) -> Screen:
     """The candidates of ``cands`` whose predicted AICc comes within reach
     of the best row's, most promising first, each with the predicted step as
     a second start: its own parameters' (in the candidate) and the free
-    parameters' (module doc). Those beyond ``MAX_FITS`` are returned as
-    unfitted."""
+    parameters' (module doc). Those beyond ``max_fits`` are returned as
+    unfitted (None: every one within reach is a pick; the family stage
+    fits them all, :func:`.families.fit_members`)."""
     if not cands or not dec.rows:
         return Screen()
     f0 = cal.fit
@@ -175,5 +176,6 @@ def screened(ctx, problem, cal, dec, cands) -> Screen:
         if a < reach:
             scored.append((a, _stepped(c, d[f0.k:]), _free_step(problem, f0, d[:f0.k])))
     scored.sort(key=lambda t: t[0])
-    return Screen(tuple((c, at) for _, c, at in scored[:MAX_FITS]),
-                  tuple(Unfitted(c.label, a) for a, c, _ in scored[MAX_FITS:]))
+    cut = len(scored) if max_fits is None else max_fits
+    return Screen(tuple((c, at) for _, c, at in scored[:cut]),
+                  tuple(Unfitted(c.label, a) for a, c, _ in scored[cut:]))

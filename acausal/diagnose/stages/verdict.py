@@ -1,0 +1,296 @@
+"""The naming rule and the verdict (issue 24).
+
+A diagnosis ends in one of four verdicts (:data:`KINDS`):
+
+* ``no_discrepancy``: the calibrated model explains the data (the
+  discrepancy test, :mod:`.stats`);
+* ``named``: a cause (or a pair) is named. It must explain the held-out
+  data: its leave-one-experiment-out RMS error (in instrument floors) is
+  within :func:`.stats.heldout_threshold`, the largest held-out error that
+  noise alone reaches on data the model explains (one-sided level
+  ``ALPHA``); and no rule of the "weak" kind objects;
+* ``not_explained``: the best candidate leaves the held-out data beyond
+  that threshold: nothing in the library explains them. The verdict lists
+  the best candidates (single, pair, located generic term) with their
+  held-out errors, and a family member whose shape parameter stands in for
+  a mixture of laws (a drag exponent far from the standard laws' 1 and 2)
+  is said to be one. This is never called "weak";
+* ``weak``: the best candidate explains the held-out data, but the data
+  cannot decide: the rivals are tied, the effect is not strong, its
+  parameters are not determined, a rival is untested, ... Each reason comes
+  with its :class:`Reason` code and its numbers.
+
+Parameters are judged one by one (:func:`param_checks`): each amplitude
+parameter against its own neutral value (where the extension changes
+nothing); shape parameters (a drag exponent, a Stribeck speed, a knee
+deflection: the extension is neutral through its amplitude whatever their
+value) have no neutral value and are judged against the physical range
+and the standard laws instead (:func:`law_notes`).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from . import stats as st
+
+KINDS = ("no_discrepancy", "named", "weak", "not_explained")
+
+# Standard values of a family member's shape parameter (the laws it joins):
+# power drag's exponent is viscous at n = 1 and quadratic at n = 2. A
+# hypothesis may declare its own as ``standard_shapes = {short name: values}``;
+# this table is the fallback for the library's members that do not (yet).
+STANDARD_SHAPES = {"power_drag": {"n": (1.0, 2.0)}}
+
+
+@dataclass(frozen=True)
+class Reason:
+    """Why a cause is not named: ``code`` (one of :data:`WEAK_CODES` for a
+    weak verdict, ``heldout`` for "not explained") and the sentence with its
+    numbers."""
+
+    code: str
+    text: str
+
+
+# what each weak reason means (the report and the JSON say which applies)
+WEAK_CODES = {
+    "few_data": "too few data per fitted parameter",
+    "not_strong": "the effect is not strong (AICc gain over no extension)",
+    "rival_tied": "a rival outside the best candidate's class is tied",
+    "no_heldout_gain": "the held-out error does not fall enough",
+    "poorly_determined": "no parameter of the cause is determined",
+    "leaves_misfit": "the best fit leaves misfit on the training data",
+    "coarse": "the data are coarse against the instrument's resolution",
+    "untested_rival": "a rival could not be tested",
+    "unfitted_rival": "a plausible rival was not fitted",
+    "pair_not_earned": "a pair does not earn its second cause",
+    "at_bound": "a parameter ran to the bound of its range",
+    "law_out_of_range": "a shape parameter left its physical range",
+    "nothing_fitted": "no candidate could be fitted",
+}
+
+
+@dataclass(frozen=True)
+class ParamCheck:
+    """One parameter of a cause: its value and 95 % interval, its neutral
+    value (None for a shape parameter), ``rel`` the interval's half-width
+    over the distance from the neutral value, ``determined`` rel <
+    :data:`.stats.CI_REL` (a shape parameter: a finite interval)."""
+
+    name: str
+    value: float
+    ci95: tuple
+    neutral: float | None
+    rel: float
+    determined: bool
+
+    @property
+    def shape(self):
+        return self.neutral is None
+
+    def to_dict(self):
+        lo, hi = self.ci95
+        return dict(name=self.name, value=_num(self.value), ci95=[_num(lo), _num(hi)],
+                    neutral=None if self.neutral is None else _num(self.neutral),
+                    relative_halfwidth=_num(self.rel), determined=bool(self.determined))
+
+    def sentence(self):
+        lo, hi = self.ci95
+        return (f"{self.name} = {self.value:.4g} [{lo:.4g}, {hi:.4g}] is undetermined: its "
+                f"95 % half-width is {self.rel:.0%} of its distance from its neutral value "
+                f"{self.neutral:.4g} (needs below {st.CI_REL:.0%})")
+
+
+@dataclass(frozen=True)
+class LawNote:
+    """A family member's shape parameter that left its physical range (ran
+    to a bound) or lies away from every standard law (``standard``, whose
+    95 % interval excludes them all): the member may stand in for a mixture
+    of laws."""
+
+    cause: str
+    location: str
+    parameter: str
+    value: float
+    ci95: tuple
+    standard: tuple
+    at_bound: bool
+    text: str
+
+    def to_dict(self):
+        return dict(cause=self.cause, location=self.location, parameter=self.parameter,
+                    value=_num(self.value), ci95=[_num(x) for x in self.ci95],
+                    standard=list(self.standard), at_bound=self.at_bound, text=self.text)
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """The verdict of the ranking (:data:`KINDS`), the reasons behind it,
+    the held-out threshold it was judged with, the held-out error of the
+    row judged (the best), and the law notes of that row."""
+
+    kind: str
+    reasons: tuple = ()                       # Reason
+    threshold: st.HeldoutThreshold | None = None
+    heldout: float | None = None
+    laws: tuple = ()                          # LawNote
+
+    @property
+    def weak(self) -> list:
+        """The weak-evidence sentences (empty unless ``kind`` is weak)."""
+        return [r.text for r in self.reasons] if self.kind == "weak" else []
+
+
+def _num(x):
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+# -- parameters ---------------------------------------------------------------------------
+def shape_names(candidate) -> set:
+    """Names of the candidate's shape parameters: within one member (one
+    hypothesis of a pair), a parameter whose neutral start is not zero
+    beside another parameter (the extension is neutral through that one).
+    A single parameter is always an amplitude (a law switch's restitution
+    shift: neutral where the new law matches the model's damping)."""
+    params = {p.name: p for p in candidate.params}
+    out = set()
+    for _, _, names in candidate.members():
+        if len(names) < 2:
+            continue
+        out |= {n for n in names if n in params and params[n].prior != 0.0}
+    return out
+
+
+def param_checks(row) -> list:
+    """:class:`ParamCheck` of each of the row's own parameters."""
+    shapes = shape_names(row.candidate)
+    out = []
+    for p in row.candidate.params:
+        v = row.fit.values.get(p.name)
+        if v is None:
+            continue
+        lo, hi = row.fit.ci95.get(p.name, (float("nan"), float("nan")))
+        finite = math.isfinite(lo) and math.isfinite(hi)
+        if p.name in shapes:
+            out.append(ParamCheck(p.name, v, (lo, hi), None, float("nan"), finite))
+            continue
+        rel = float((hi - lo) / 2 / abs(v - p.prior)) if finite and v != p.prior else math.inf
+        out.append(ParamCheck(p.name, v, (lo, hi), p.prior, rel, rel < st.CI_REL))
+    return out
+
+
+def undetermined(row) -> list:
+    """The amplitude parameters of ``row`` left undetermined (their 95 %
+    interval reaches within twice its half-width of the neutral value)."""
+    return [c for c in param_checks(row) if not c.shape and not c.determined]
+
+
+def determination_reasons(row) -> list:
+    """A cause whose member has no determined amplitude parameter is
+    poorly determined (each parameter judged against its own neutral
+    value: a Coulomb + viscous friction with b known to 0.06 % and F ~ 0 is
+    determined, through b; its F is flagged, not the cause)."""
+    checks = {c.name: c for c in param_checks(row)}
+    out = []
+    for h, loc, names in row.candidate.members():
+        amp = [checks[n] for n in names if n in checks and not checks[n].shape]
+        if amp and not any(c.determined for c in amp):
+            worst = "; ".join(f"{c.name} {c.rel:.0%}" for c in amp)
+            out.append(Reason("poorly_determined", (
+                f"{h} at {loc} is poorly determined: no parameter's 95 % half-width is below "
+                f"{st.CI_REL:.0%} of its distance from its neutral value ({worst})")))
+    return out
+
+
+def _standard(hid, short, lib=None):
+    from ..library.loader import load_library
+    try:
+        hyp = load_library(lib).HYPOTHESES.get(hid)
+    except Exception:  # noqa: BLE001 - a stub library without the table: no standard laws
+        hyp = None
+    declared = getattr(hyp, "standard_shapes", None) if hyp is not None else None
+    table = declared if declared is not None else STANDARD_SHAPES.get(hid, {})
+    return tuple(table.get(short, ()))
+
+
+def law_notes(row, lib=None) -> list:
+    """:class:`LawNote` of each shape parameter of ``row`` that ran to a
+    bound of its range (the law left its physical range) or whose 95 %
+    interval excludes every standard value declared for it (a power drag
+    exponent of 2.61 +- 0.01: neither viscous nor quadratic)."""
+    if row is None:
+        return []
+    shapes = shape_names(row.candidate)
+    params = {p.name: p for p in row.candidate.params}
+    out = []
+    for h, loc, names in row.candidate.members():
+        for n in names:
+            if n not in shapes:
+                continue
+            p, v = params[n], row.fit.values.get(n)
+            if v is None:
+                continue
+            lo, hi = row.fit.ci95.get(n, (float("nan"), float("nan")))
+            span = p.high - p.low
+            at = (math.isfinite(span) and span > 0
+                  and min(abs(v - p.low), abs(v - p.high)) <= AT_BOUND * span)
+            std = _standard(h, n.partition(".")[2], lib)
+            away = bool(std) and math.isfinite(lo) and math.isfinite(hi) and not any(
+                lo <= s <= hi for s in std)
+            if not (at or away):
+                continue
+            laws = " and ".join(f"{s:g}" for s in std)
+            text = (f"{h} at {loc}: its shape parameter {n} = {v:.4g} ran to the bound of "
+                    f"its physical range [{p.low:.4g}, {p.high:.4g}]" if at else
+                    f"{h} at {loc}: its shape parameter {n} = {v:.4g} [{lo:.4g}, {hi:.4g}] "
+                    f"lies away from the standard laws ({n.partition('.')[2]} = {laws})")
+            out.append(LawNote(h, loc, n, v, (lo, hi), std, bool(at),
+                               text + ": a mixture of laws?"))
+    return out
+
+
+AT_BOUND = 1e-6      # of a parameter's range: a fitted value this close to a bound is at it
+
+
+# -- the verdict ----------------------------------------------------------------------------
+def threshold_of(n, row, experiments) -> st.HeldoutThreshold:
+    """The held-out threshold for ``row`` (its k fitted parameters) on ``n``
+    values in ``experiments`` experiments."""
+    return st.heldout_threshold(n, row.k if row is not None else 0, experiments)
+
+
+def explains(row, threshold) -> bool:
+    """Does ``row`` explain the held-out data (its held-out RMS within the
+    threshold)?"""
+    h = row.heldout_rmse
+    return bool(math.isfinite(h) and h <= threshold.rms)
+
+
+def unexplained_reason(row, threshold, notes=()) -> Reason:
+    text = (f"the best candidate, {row.candidate.label}, leaves a held-out error of "
+            f"{row.heldout_rmse:.4g} floors, above {threshold.rms:.4g}, the most that noise "
+            f"alone reaches ({threshold.sentence()})")
+    if notes:
+        text += "; " + "; ".join(x.text for x in notes)
+    return Reason("heldout", text)
+
+
+def judge(discrepancy, rows, threshold, weak_reasons) -> Verdict:
+    """The verdict (module doc) of the best row ``rows[0]`` given its weak
+    reasons (:class:`Reason`, the can't-decide rules)."""
+    if not discrepancy:
+        return Verdict("no_discrepancy", threshold=threshold)
+    if not rows:
+        return Verdict("weak", (Reason("nothing_fitted", "no candidate could be fitted"),),
+                       threshold)
+    best = rows[0]
+    notes = tuple(law_notes(best))
+    if not explains(best, threshold):
+        return Verdict("not_explained", (unexplained_reason(best, threshold, notes),),
+                       threshold, best.heldout_rmse, notes)
+    out = list(weak_reasons)
+    out += [Reason("law_out_of_range", x.text) for x in notes if x.at_bound]
+    return Verdict("weak" if out else "named", tuple(out), threshold, best.heldout_rmse,
+                   notes)
