@@ -57,7 +57,8 @@ def velocity_shape_error(term, law, v_max):
     import numpy as np
 
     from acausal.diagnose.library import generic
-    GENERIC, N_V, shape = generic.GENERIC, generic.N_V, generic.shape
+    GENERIC, shape = generic.GENERIC, generic.shape
+    N_V = generic.resolution(term["values"], GENERIC.prefix)[1]   # the chosen resolution
     sh = shape(term["values"], GENERIC.prefix, term["ranges"], n=401)
     v, fv = sh["v"], sh["f_v"]
     m = np.abs(v) <= v_max

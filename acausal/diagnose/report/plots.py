@@ -27,19 +27,32 @@ def write_plots(out_dir, d) -> dict:
 
 
 def _located(plt, d):
-    """The generic term's shape against position and velocity (best 3 nodes)."""
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.4))
-    for i, t in enumerate(d.location.terms[:3]):
-        lw = 2.0 if i == 0 else 0.8
-        axes[0].plot(t.shape["x"], t.shape["f_x"], lw=lw, label=t.node)
-        axes[1].plot(t.shape["v"], t.shape["f_v"], lw=lw, label=t.node)
+    """The generic term's shape against position and against velocity (best
+    3 nodes; the best node with its +-2 standard deviation band, from the
+    fit's covariance, and the term beside the named cause when fitted)."""
+    fig, axes = plt.subplots(1, 2, figsize=(9.5, 3.6))
+    loc = d.location
+    shown = list(loc.terms[:3]) + ([loc.beside] if loc.beside is not None else [])
+    for i, t in enumerate(shown):
+        best = i == 0
+        label = (f"{t.node} beside {t.beside}" if t.beside else t.node) + \
+            f" ({t.resolution[0]}x{t.resolution[1]} knots, held-out {t.heldout_rmse:.3g})"
+        ls = "--" if t.beside else "-"
+        for ax, z, f, sd in ((axes[0], "x", "f_x", "f_x_sd"), (axes[1], "v", "f_v", "f_v_sd")):
+            line = ax.plot(t.shape[z], t.shape[f], lw=2.0 if best else 0.8, ls=ls,
+                           label=label)[0]
+            if (best or t.beside) and sd in t.shape:
+                ax.fill_between(t.shape[z], t.shape[f] - 2 * t.shape[sd],
+                                t.shape[f] + 2 * t.shape[sd], color=line.get_color(),
+                                alpha=0.25, lw=0)
     axes[0].set_xlabel("position of the node's body [m, or rad for a rotating body]")
     axes[1].set_xlabel("velocity of the node's body [m/s, or rad/s]")
     for ax in axes:
         ax.axhline(0, color="k", lw=0.5)
         ax.set_ylabel("generic force [N, or N*m]")
-        ax.legend(fontsize=7)
-    axes[0].set_title("located generic term (thick: the best node)", fontsize=9)
+        ax.legend(fontsize=6)
+    axes[0].set_title("located generic term (thick: the best node; band: +-2 sd the data "
+                      "support)", fontsize=8)
     return fig
 
 

@@ -1,14 +1,35 @@
 """Stage: where the library falls short. When a discrepancy is found and
 no library cause explains it (no cause named, or the named one still
 leaves misfit beyond the instrument), the generic term of :mod:`.generic`
-is fitted at every node of a body; the node whose term removes most of the
-misfit (by AICc, with its held-out error) locates the discrepancy.
+is fitted at every node of a body; the node whose term has the lowest
+held-out (leave-one-experiment-out) error locates the discrepancy, across
+every site, tied or not.
+
+The term's resolution is chosen from the data (:func:`choose`): the term's
+and the free parameters' data Jacobians are taken once per node at the
+calibrated point, on the finest splines (``X_LADDER[-1]`` x
+``V_LADDER[-1]`` knots); every coarser spline is exactly a finer one
+(:func:`.generic.refine_matrix`), so each resolution in ``X_LADDER`` x
+``V_LADDER`` and each smoothing weight in ``SMOOTH_GRID`` (position and
+velocity parts apart) is scored by its linearised leave-one-experiment-out
+error (the PRESS residuals of the penalised Gauss-Newton step: no
+simulation), and the coarsest, then smoothest, whose error is within
+``CV_TIE`` of the best is fitted in full (output error, from that step) at the nodes whose
+linearised error is within ``REFINE_WITHIN`` of the best (at most
+``REFINE_MAX``); the other nodes keep their linearised scores.
+
+When a single cause is named, the term is also fitted beside it at the
+located node (the cause's parameters refitted with it: :func:`beside`):
+a second, out-of-library force remains when that beats the named cause by
+``MARGIN`` AICc units and by held-out error.
 
 The verdict "not explained by the library" needs: the best generic term
 beats the best library candidate by more than ``MARGIN`` AICc units and by
 held-out error, and it reaches closer to the instrument floor.
+:class:`Location` carries the best term's held-out error and whether it
+reaches the floor (``FLOOR_REACH``).
 
-Degenerate directions are pinned before the fit (:func:`pin_rows`): the
+Degenerate directions are pinned before the fit (:func:`pins_of`): the
 spline reproduces constants and straight lines exactly, so its constant
 and linear parts can do what a free parameter acting at the node does (a
 spring's stiffness, a damper's coefficient), and its position and
@@ -21,19 +42,26 @@ is fitted orthogonal to the free parameters' Jacobian columns and they
 keep what they can explain. The position and velocity parts' shared
 constant is pinned by construction: the velocity part carries no force at
 rest (:func:`at_rest_row`).
+
+The band of the located shape (:func:`weights_cov`) is the penalised
+fit's Bayesian covariance, sigma^2 (J'J + Jp'Jp)^-1 with sigma^2 the
+residual variance per effective degree of freedom (Wahba 1983), pin rows
+included: the directions the free parameters take are not the term's.
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from . import stats as st
 from .fitting import effective_k, heldout_rms, scaled_columns
+from ..library import generic as gen
 from ..library.generic import GENERIC, N_V, N_X, SMOOTH, hats, penalty, shape
 from ..problem import Candidate, Param
 from .chain import fit_tasks
-from .tasks import dataset_of, fit_candidate, model_of, penalty_of
+from .tasks import FitTask, dataset_of, fit_candidate, model_of, penalty_of
 
 MARGIN = 10.0    # AICc units by which the generic term must beat the library
 PIN_TOL = 0.05   # a free parameter whose effect on the data the term reproduces to 5 %
@@ -43,6 +71,25 @@ NULL_TOL = 1e-6  # directions of the weights with no effect on the data (singula
                  # constant is pinned by construction (at_rest_row)
 PIN_WEIGHT = 1e3  # pin rows' size relative to the term's largest singular value
 STEP = 1e-4      # finite-difference step (of each weight's / free parameter's scale)
+SMOOTH_GRID = tuple(10.0 ** np.arange(-5, 6))  # smoothing weights per data value tried
+                 # for each part (generic.SMOOTH is 1): from a term free to follow 8
+                 # cycles over the stroke to one close to straight lines. The penalty is
+                 # on weights over their scale (a third of the node's typical force), so
+                 # a force far below that scale needs a large weight to be smoothed: on
+                 # the two-mass detent (0.04 N against a scale of newtons) both parts
+                 # chose 10, the top of a grid that ended there
+CV_TIE = 2e-3    # resolutions and weights whose linearised held-out RMS is within one
+                 # standard error of the best (1/sqrt(2n) of it, for n values of unit
+                 # variance; at least this fraction) are ties: the coarsest of them (fewest knots: the
+                 # cheapest to fit, one simulation per weight and step), and of those the
+                 # one with the fewest effective degrees of freedom, is fitted
+REFINE_WITHIN = 1.25  # nodes fitted in full: linearised held-out RMS within this factor
+REFINE_MAX = 3        # ... of the best node's, at most this many
+FLOOR_REACH = 1.1     # the best term "reaches the floor" when its held-out RMS is at most
+                 # this many floors (the nulls' held-out spread is 0.99-1.01 on the rig
+                 # and stop rig, docs/diagnosis.md; a penalised term of tens of effective
+                 # parameters adds a few per cent). The verdict may judge against its own
+                 # threshold from Location.heldout
 
 
 @dataclass
@@ -55,13 +102,19 @@ class Term:
     aicc: float
     heldout_rmse: float
     ranges: tuple                 # (x_lo, x_hi, v_lo, v_hi) of the knots
-    shape: dict                   # generic.shape of the fitted weights
+    shape: dict                   # generic.shape of the fitted weights (with its band)
     values: dict
+    resolution: tuple = (N_X, N_V)   # (position knots, velocity knots)
+    smooth: tuple = (SMOOTH, SMOOTH)  # smoothing weights per data value (x part, v part)
+    fitted: str = "output error"  # or "linearised" (a node not fitted in full)
+    beside: str | None = None     # the named cause it was fitted beside, if any
+    k: float = 0.0                # effective number of parameters (with the free ones)
 
 
 @dataclass
 class Location:
-    """The located discrepancy: terms best first, and the verdict."""
+    """The located discrepancy: terms best first (by held-out error), and
+    the verdict's numbers."""
 
     terms: tuple = ()
     unexplained: bool = False
@@ -72,6 +125,14 @@ class Location:
     skipped: str = ""             # why the stage did not run, if it did not
     wall_s: float = 0.0
     details: dict = field(default_factory=dict)
+    heldout: float | None = None  # the best term's held-out RMS [floors]
+    reaches_floor: bool = False   # ... at most FLOOR_REACH
+    floor_threshold: float = FLOOR_REACH
+    best_node: str | None = None  # the best term's node (also when not "unexplained")
+    tied_nodes: tuple = ()        # other nodes whose term the held-out data cannot tell apart
+    beside: Term | None = None    # the term fitted beside the named cause
+    second_force: bool = False    # ... beats the named cause alone: a second force remains
+    n_sim: int = 0                # simulations the stage ran
 
 
 def needed(dec, rk) -> bool:
@@ -80,9 +141,15 @@ def needed(dec, rk) -> bool:
     return dec.discrepancy and (rk.named is None or dec.c_hat > st.OVERDISPERSION)
 
 
-def generic_candidates(problem, n=1):
-    """(Candidate, knot ranges, members) of the generic term at every body
-    node; ``n`` data values set the penalty's weight (generic.SMOOTH per value)."""
+def _params(graph, loc, n_x, n_v):
+    return tuple(Param(s.name, s.initial, s.low, s.high, s.scale, s.initial)
+                 for s in gen.GenericForce(n_x, n_v).params(graph, loc))
+
+
+def generic_candidates(problem, n=1, n_x=N_X, n_v=N_V):
+    """(Candidate, knot ranges, members) of the generic term of ``n_x`` x
+    ``n_v`` knots at every body node; ``n`` data values set the penalty's
+    weight (generic.SMOOTH per value)."""
     from ..library.graph import ModelGraph
     from ..library.nominal import nominal_result
     from ...modelfile import load_model_file
@@ -90,9 +157,8 @@ def generic_candidates(problem, n=1):
                        result=nominal_result(problem.model_path))
     out = []
     for loc in GENERIC.candidates(graph):
-        params = tuple(Param(s.name, s.initial, s.low, s.high, s.scale, s.initial)
-                       for s in GENERIC.params(graph, loc))
-        out.append((Candidate(GENERIC.id, loc, params, penalty(N_X, N_V, SMOOTH * n)),
+        out.append((Candidate(GENERIC.id, loc, _params(graph, loc, n_x, n_v),
+                              penalty(n_x, n_v, SMOOTH * n)),
                     tuple(GENERIC.ranges(graph, loc)),
                     tuple(sorted({p.owner.path for p in
                                   graph.nodes[graph.node(graph.components[loc].flange)]}))))
@@ -121,27 +187,58 @@ def degenerate_directions(Jg, Jf):
     return orth(np.array(dirs).T).T, float(s[0])
 
 
+@dataclass
+class Columns:
+    """The data Jacobians of one node at the calibrated point: residuals
+    ``r0``, the term's columns ``Jg`` and the free parameters' ``Jf`` (per
+    unit of scale), the experiment of each row; ``error`` when the term
+    cannot be simulated there."""
+
+    r0: np.ndarray
+    Jg: np.ndarray
+    Jf: np.ndarray
+    groups: tuple
+    n_sim: int = 0
+    error: str | None = None
+
+
+def columns(task) -> Columns:
+    """:class:`Columns` of ``task``'s candidate (worker side): forward
+    differences, one simulation of every experiment per column. Never
+    raises: a term that cannot be built or simulated gives ``error``."""
+    from .fitting import residuals_of
+    p, cand = task.problem, task.candidate
+    base = {**{q.name: q.start for q in task.free}, **{q.name: q.start for q in cand.params}}
+    try:
+        ds, pair, b = dataset_of(p), model_of(p, cand), p.settings.integrator
+        w0 = residuals_of(pair, ds, base, b)
+        # no step backwards at an upper bound here (the term's weights start
+        # at 0, far inside theirs); the residuals at the base are shared
+        r0, Jg = scaled_columns(pair, ds, base, cand.params, STEP, b, w0.vector, inside=False)
+        Jf = scaled_columns(pair, ds, base, task.free, STEP, b, r0, inside=False)[1]
+    except Exception as exc:  # noqa: BLE001 - reported with the node
+        z = np.zeros(0)
+        return Columns(z, np.zeros((0, 0)), np.zeros((0, 0)), (), 0,
+                       f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}")
+    n_exp = len(ds.experiments)
+    return Columns(r0, Jg, Jf, tuple(w0.groups),
+                   n_exp * (1 + len(cand.params) + len(task.free)))
+
+
 def pin_rows(task):
     """Penalty rows pinning the generic term's degenerate directions (module
     doc) at the calibrated free parameters and zero weights: the term's
     and the free parameters' data Jacobians by forward differences, one
     simulation of every experiment per column. Returns (rows, the term's
     largest singular value); no rows when the term cannot be simulated."""
-    p, cand = task.problem, task.candidate
-    base = {**{q.name: q.start for q in task.free}, **{q.name: q.start for q in cand.params}}
-    try:
-        ds, pair, b = dataset_of(p), model_of(p, cand), p.settings.integrator
-        # no step backwards at an upper bound here (the term's weights start
-        # at 0, far inside theirs); the residuals at the base are shared
-        r0, Jg = scaled_columns(pair, ds, base, cand.params, STEP, b, inside=False)
-        Jf = scaled_columns(pair, ds, base, task.free, STEP, b, r0, inside=False)[1]
-    except Exception:  # noqa: BLE001 - the fit reports the failure; nothing to pin
-        return np.zeros((0, len(cand.params))), 0.0
-    Q, s0 = degenerate_directions(Jg, Jf)
+    c = columns(task)
+    if c.error is not None:
+        return np.zeros((0, len(task.candidate.params))), 0.0
+    Q, s0 = degenerate_directions(c.Jg, c.Jf)
     return PIN_WEIGHT * s0 * Q, s0
 
 
-def at_rest_row(ranges):
+def at_rest_row(ranges, n_x=N_X, n_v=N_V):
     """The row that pins the velocity part's force at rest, f_v(0) = 0 (on
     the weights over their scale, which is one for all of them): the
     position and velocity parts share a constant, which this gives to the
@@ -151,32 +248,286 @@ def at_rest_row(ranges):
     v_lo, v_hi = ranges[2], ranges[3]
     if not v_lo <= 0.0 <= v_hi:
         return None
-    return np.concatenate([np.zeros(N_X), hats(0.0, v_lo, v_hi, N_V)[0]])
+    return np.concatenate([np.zeros(n_x), hats(0.0, v_lo, v_hi, n_v)[0]])
 
 
-def _pinned(ctx, problem, cal, gens):
-    """The generic candidates with their degenerate directions pinned."""
-    import dataclasses
-    tasks = fit_tasks(problem, cal, [g[0] for g in gens])
+def pins_of(Jg, Jf, ranges, n_x, n_v):
+    """Every pin row of a term with data Jacobian ``Jg`` (degenerate
+    directions, then the velocity part's force at rest), scaled as the fit
+    uses them; also the term's largest singular value."""
+    Q, s0 = degenerate_directions(Jg, Jf)
+    rows = PIN_WEIGHT * s0 * Q
+    rest = at_rest_row(ranges, n_x, n_v)
+    if rest is not None and s0 > 0:
+        rows = np.vstack([rows, PIN_WEIGHT * s0 * rest / np.linalg.norm(rest)])
+    return rows, s0
+
+
+# -- the resolution, chosen by linearised leave-one-experiment-out ---------------------
+@dataclass
+class Choice:
+    """The resolution and smoothing chosen at one node, with its linearised
+    scores: held-out and training RMS [floors], effective parameters, the
+    Gauss-Newton step (free parameters, then the term's weights, per unit
+    of scale), the pin rows; ``table``: (n_x, n_v, lam_x, lam_v, held-out
+    RMS, edf) of every setting tried."""
+
+    n_x: int
+    n_v: int
+    lam_x: float
+    lam_v: float
+    heldout: float
+    train: float
+    edf: float
+    step: np.ndarray
+    pins: np.ndarray
+    table: tuple = ()
+
+
+def _transform(n_x, n_v, nf_x, nf_v):
+    T = np.zeros((nf_x + nf_v, n_x + n_v))
+    T[:nf_x, :n_x] = gen.refine_matrix(n_x, nf_x)
+    T[nf_x:, n_x:] = gen.refine_matrix(n_v, nf_v)
+    return T
+
+
+def _grams(X, r, groups):
+    """Per experiment: (X_g'X_g, X_g'r_g, r_g'r_g)."""
+    g = np.asarray(groups)
     out = []
-    for g, (rows, s0) in zip(gens, ctx.run(pin_rows, tasks, "pinning", checkpoint=False)):
-        rest = at_rest_row(g[1])
-        if rest is not None and s0 > 0:
-            rows = np.vstack([rows, PIN_WEIGHT * s0 * rest / np.linalg.norm(rest)])
-        P = np.vstack([np.asarray(g[0].penalty, float), rows])
-        out.append((dataclasses.replace(g[0], penalty=P),) + tuple(g[1:]))
+    for name in dict.fromkeys(groups):
+        m = g == name
+        out.append((X[m].T @ X[m], X[m].T @ r[m], float(r[m] @ r[m])))
     return out
 
 
-def _term(r, n, c_hat, ranges, members):
+def _factor(M):
+    """Cholesky factor of a symmetric positive semi-definite M, with a ridge
+    of 1e-12 of its mean diagonal (the directions no data reach)."""
+    from scipy.linalg import cho_factor
+    ridge = 1e-12 * max(float(np.trace(M)) / max(M.shape[0], 1), 1e-300)
+    return cho_factor(M + ridge * np.eye(M.shape[0]), check_finite=False)
+
+
+def _press(grams, PtP):
+    """(held-out SS, training SS, edf, step) of the penalised linear least
+    squares min |r + X d|^2 + |P d|^2 with the experiments' Gram blocks."""
+    from scipy.linalg import cho_solve
+    A = sum(G for G, _, _ in grams)
+    b = sum(v for _, v, _ in grams)
+    c = sum(s for _, _, s in grams)
+    F = _factor(A + PtP)
+    d = -cho_solve(F, b, check_finite=False)
+    train = c + 2 * b @ d + d @ A @ d
+    held = 0.0
+    for G, v, s in grams:
+        dg = -cho_solve(_factor(A - G + PtP), b - v, check_finite=False)
+        held += s + 2 * v @ dg + dg @ G @ dg
+    # effective degrees of freedom: tr[(A + P'P)^-1 A]
+    edf = float(np.trace(cho_solve(F, A, check_finite=False)))
+    return float(held), float(train), edf, d
+
+
+@dataclass
+class _Setup:
+    """One resolution's linear problem at a node: the experiments' Gram
+    blocks over (free parameters, unpinned weights z), the second-difference
+    Gram matrices of the two parts on z, w = N z, the pin rows."""
+
+    grams: list
+    PxtPx: np.ndarray
+    PvtPv: np.ndarray
+    N: np.ndarray
+    pins: np.ndarray
+    k_f: int
+
+
+def _setup(cols, ranges, n_x, n_v, nf_x, nf_v) -> _Setup:
+    from scipy.linalg import null_space
+    Jr = cols.Jg @ _transform(n_x, n_v, nf_x, nf_v)
+    pins, _ = pins_of(Jr, cols.Jf, ranges, n_x, n_v)
+    # the pinned directions are left out of the linear problem (w = N z)
+    # rather than stiffly penalised, to keep the normal equations sound
+    N = (null_space(pins / np.linalg.norm(pins, axis=1, keepdims=True)) if pins.shape[0]
+         else np.eye(n_x + n_v))
+    X = np.hstack([cols.Jf, Jr @ N])
+    Dx = np.zeros((n_x - 2, n_x + n_v))
+    Dx[:, :n_x] = gen.second_differences(n_x)
+    Dv = np.zeros((n_v - 2, n_x + n_v))
+    Dv[:, n_x:] = gen.second_differences(n_v)
+    Px, Pv = Dx @ N, Dv @ N
+    return _Setup(_grams(X, cols.r0, cols.groups), Px.T @ Px, Pv.T @ Pv, N, pins,
+                  cols.Jf.shape[1])
+
+
+def _score(su: _Setup, n, lam_x, lam_v):
+    """(held-out RMS, edf, training RMS, step over free + weights) of one
+    smoothing setting."""
+    m = su.k_f + su.N.shape[1]
+    PtP = np.zeros((m, m))
+    PtP[su.k_f:, su.k_f:] = n * (lam_x * su.PxtPx + lam_v * su.PvtPv)
+    held, train, edf, d = _press(su.grams, PtP)
+    return (float(np.sqrt(max(held, 0.0) / n)), edf, float(np.sqrt(max(train, 0.0) / n)),
+            np.concatenate([d[:su.k_f], su.N @ d[su.k_f:]]))
+
+
+def _search(su, n, n_x, n_v, grid):
+    """Rows (n_x, n_v, lam_x, lam_v, held-out RMS, edf) of the smoothing
+    weights tried at one resolution: each part's weight over ``grid`` in
+    turn (velocity, position, velocity again), the other held at its best
+    so far (the two parts see different data directions, so one sweep each
+    finds the grid's best pair without its full product)."""
+    seen = {}
+
+    def score(lx, lv):
+        if (lx, lv) not in seen:
+            held, edf, _, _ = _score(su, n, lx, lv)
+            seen[lx, lv] = (n_x, n_v, lx, lv, held, edf)
+        return seen[lx, lv]
+    lx = lv = SMOOTH if SMOOTH in grid else grid[len(grid) // 2]
+    for part in ("v", "x", "v"):
+        rows = [score(g, lv) if part == "x" else score(lx, g) for g in grid]
+        best = min(rows, key=lambda r: r[4])
+        lx, lv = best[2], best[3]
+    return list(seen.values())
+
+
+def choose(cols: Columns, ranges, n, ladder_x=gen.X_LADDER, ladder_v=gen.V_LADDER,
+           grid=SMOOTH_GRID) -> Choice:
+    """The resolution and smoothing of the term at one node (module doc),
+    from its :class:`Columns` on the finest splines of the ladders; ``n``
+    data values (the smoothing weights are per value). Every setting is
+    scored by its linearised leave-one-experiment-out RMS; of those within
+    ``CV_TIE`` of the best the coarsest (fewest knots), then the smoothest
+    (fewest effective degrees of freedom), wins."""
+    from ...infra.blas import single_threaded
+    with single_threaded(cols.Jg.shape[1]):
+        return _choose(cols, ranges, n, ladder_x, ladder_v, grid)
+
+
+def _choose(cols, ranges, n, ladder_x, ladder_v, grid):
+    nf_x, nf_v = ladder_x[-1], ladder_v[-1]
+    table, setups = [], {}
+    for n_x in ladder_x:
+        for n_v in ladder_v:
+            su = setups[n_x, n_v] = _setup(cols, ranges, n_x, n_v, nf_x, nf_v)
+            table += _search(su, n, n_x, n_v, grid)
+    best = min(r[4] for r in table)
+    tie = max(CV_TIE, 1.0 / np.sqrt(2.0 * n))      # one standard error of an RMS
+    pick = min((r for r in table if r[4] <= best * (1 + tie)),
+               key=lambda r: (r[0] + r[1], r[5], -r[2], -r[3]))
+    n_x, n_v, lam_x, lam_v = pick[:4]
+    su = setups[n_x, n_v]
+    held, edf, train, step = _score(su, n, lam_x, lam_v)
+    return Choice(n_x, n_v, lam_x, lam_v, held, train, edf, step, su.pins, tuple(table))
+
+
+# -- the fits --------------------------------------------------------------------------
+@dataclass
+class _Node:
+    """One node's candidate on the finest splines, and what it became."""
+
+    cand: Candidate
+    ranges: tuple
+    members: tuple
+    cols: Columns | None = None
+    choice: Choice | None = None
+
+
+def _graph(problem):
+    from ..library.graph import ModelGraph
+    from ..library.nominal import nominal_result
+    from ...modelfile import load_model_file
+    return ModelGraph(load_model_file(problem.model_path).model,
+                      result=nominal_result(problem.model_path))
+
+
+def chosen_candidate(node: _Node, graph, n, beside=None):
+    """The node's candidate at its chosen resolution, smoothing and pins,
+    its weights starting at the Gauss-Newton step; ``beside`` = a ranking
+    row of a single named cause: that cause's parameters first (starting
+    at its fit), hypothesis ``h+generic_force`` at ``site+node``."""
+    ch = node.choice
+    base = _params(graph, node.cand.location, ch.n_x, ch.n_v)
+    k_f = node.cols.Jf.shape[1]
+    w = ch.step[k_f:]
+    params = tuple(dataclasses.replace(q, start=float(np.clip(w[i] * q.scale, q.low, q.high)))
+                   for i, q in enumerate(base))
+    P = np.vstack([penalty(ch.n_x, ch.n_v, ch.lam_x * n, ch.lam_v * n), ch.pins])
+    if beside is None:
+        return Candidate(GENERIC.id, node.cand.location, params, P)
+    own = tuple(dataclasses.replace(q, start=float(beside.fit.values[q.name]))
+                for q in beside.candidate.params)
+    return Candidate(f"{beside.candidate.hypothesis}+{GENERIC.id}",
+                     f"{beside.candidate.location}+{node.cand.location}", own + params, P)
+
+
+def _free_step(task: FitTask, node: _Node) -> FitTask:
+    """The task with the free parameters' Gauss-Newton step as a seeded start."""
+    k_f = node.cols.Jf.shape[1]
+    d = node.choice.step[:k_f]
+    seed = tuple(float(np.clip(q.start + d[i] * (abs(q.scale) or 1.0), q.low, q.high))
+                 for i, q in enumerate(task.free))
+    return dataclasses.replace(task, seed_free=seed)
+
+
+def weights_cov(f, pen, S, n, edf):
+    """Covariance of the term's weights (the last P.shape[1] parameters) of
+    a penalised fit: sigma^2 (A'A)^+ over the data and penalty rows, sigma^2
+    = S / (n - edf) (module doc)."""
+    P, sc = pen
+    q = P.shape[1]
+    Jp = np.zeros((P.shape[0], f.k))
+    Jp[:, -q:] = P / sc                        # parameter units, as f.jacobian
+    A = np.vstack([f.jacobian, Jp])
+    _, s, Vt = np.linalg.svd(A, full_matrices=False)
+    keep = s > s[0] * max(A.shape) * np.finfo(float).eps if s.size else s > 0
+    C = (Vt[keep].T / s[keep] ** 2) @ Vt[keep]
+    return C[-q:, -q:] * S / max(n - edf, 1.0)
+
+
+def _term(r, n, c_hat, node: _Node, beside=None):
     """The fitted term; its AICc counts the parameters the fit spends
     (:func:`.fitting.effective_k`): pinned directions and the smoothing
     penalty's ties are not free parameters."""
-    f = r.fit
-    k = effective_k(f, penalty_of(r.candidate))
-    return Term(r.candidate.location, members, f.cost, st.aicc(f.cost, n, k, c_hat),
-                heldout_rms(r.loo), ranges, shape(f.values, GENERIC.prefix, ranges),
-                dict(f.values))
+    f, ch = r.fit, node.choice
+    pen = penalty_of(r.candidate)
+    k = effective_k(f, pen)
+    vals = {q: v for q, v in f.values.items() if q.startswith(GENERIC.prefix + ".")}
+    try:
+        cov = weights_cov(f, pen, f.cost, n, k)
+    except (np.linalg.LinAlgError, ValueError):
+        cov = None
+    return Term(node.cand.location, node.members, f.cost, st.aicc(f.cost, n, k, c_hat),
+                heldout_rms(r.loo), node.ranges, shape(vals, GENERIC.prefix, node.ranges,
+                                                       cov=cov),
+                dict(f.values), (ch.n_x, ch.n_v), (ch.lam_x, ch.lam_v), "output error",
+                beside, k)
+
+
+def _linear_term(node: _Node, n, c_hat):
+    """A node not fitted in full, scored by its linearised choice."""
+    ch = node.choice
+    k_f = node.cols.Jf.shape[1]
+    w = ch.step[k_f:]
+    names = [f"{GENERIC.prefix}.a{i}" for i in range(ch.n_x)] + \
+        [f"{GENERIC.prefix}.b{j}" for j in range(ch.n_v)]
+    scale = node.cand.params[0].scale
+    vals = {q: float(v * scale) for q, v in zip(names, w)}
+    S = ch.train ** 2 * n
+    return Term(node.cand.location, node.members, S, st.aicc(S, n, k_f + ch.edf, c_hat),
+                ch.heldout, node.ranges, shape(vals, GENERIC.prefix, node.ranges), vals,
+                (ch.n_x, ch.n_v), (ch.lam_x, ch.lam_v), "linearised", None, k_f + ch.edf)
+
+
+def _refined(nodes):
+    """The nodes fitted in full: within REFINE_WITHIN of the best linearised
+    held-out error, at most REFINE_MAX."""
+    ok = sorted((nd for nd in nodes if nd.choice is not None), key=lambda nd: nd.choice.heldout)
+    if not ok:
+        return []
+    lim = ok[0].choice.heldout * REFINE_WITHIN
+    return [nd for nd in ok if nd.choice.heldout <= lim][:REFINE_MAX]
 
 
 def locate(ctx, problem, cal, dec, rk) -> Location:
@@ -185,21 +536,81 @@ def locate(ctx, problem, cal, dec, rk) -> Location:
     if not needed(dec, rk):
         return Location(skipped="not needed: no discrepancy, or a cause explains it")
     t0 = time.perf_counter()
-    gens = generic_candidates(problem, cal.fit.n)
+    n = cal.fit.n
+    fine = (gen.X_LADDER[-1], gen.V_LADDER[-1])
+    gens = generic_candidates(problem, n, *fine)
     if not gens:
         return Location(skipped="the model has no body node")
-    gens = _pinned(ctx, problem, cal, gens)
-    # the term is linear in its weights: refined from zero weights (with the
-    # calibrated free parameters) only; Latin-hypercube splines are random
-    # wiggles that cost a refinement each and start nowhere useful
-    tasks = fit_tasks(problem.one_start(), cal, [g[0] for g in gens])
+    nodes = [_Node(*g) for g in gens]
+    # the data Jacobians on the finest splines, once per node (workers)
+    col_tasks = fit_tasks(problem, cal, [nd.cand for nd in nodes])
+    failed = {}
+    n_sim = 0
+    for nd, c in zip(nodes, ctx.run(columns, col_tasks, "locating: columns",
+                                    checkpoint=False)):
+        n_sim += c.n_sim
+        if c.error is not None:
+            failed[nd.cand.location] = c.error
+            continue
+        nd.cols = c
+        nd.choice = choose(c, nd.ranges, n)
+    fitted = _refined(nodes)
+    if not fitted:
+        return Location(skipped="no generic term could be built: " + "; ".join(
+            f"{k}: {v}" for k, v in failed.items()), details=dict(failed=failed))
+    graph = _graph(problem)
+    # the term is linear in its weights: refined from the linearised step
+    # (with the free parameters' step) only, on the whole record
+    cands = [chosen_candidate(nd, graph, n) for nd in fitted]
+    tasks = [_free_step(t, nd) for t, nd in zip(fit_tasks(problem.from_fit(), cal, cands),
+                                                fitted)]
     results = ctx.run(fit_candidate, tasks, "locating")
-    n = cal.fit.n
-    terms = sorted((_term(r, n, dec.c_hat, g[1], g[2]) for r, g in zip(results, gens) if r.ok),
-                   key=lambda t: t.aicc)
+    terms = []
+    for r, nd in zip(results, fitted):
+        n_sim += r.fit.n_sim if r.fit is not None else 0
+        if r.ok:
+            terms.append(_term(r, n, dec.c_hat, nd))
+        else:
+            failed[nd.cand.location] = r.error or (r.fit.message if r.fit else "failed")
+    done = {t.node for t in terms}
+    terms += [_linear_term(nd, n, dec.c_hat) for nd in nodes
+              if nd.choice is not None and nd.cand.location not in done]
+    terms.sort(key=lambda t: (t.fitted != "output error", t.heldout_rmse, t.aicc))
     out = _verdict(terms, dec, rk, n)
+    out.n_sim = n_sim
+    out.details = dict(failed=failed, choices={
+        nd.cand.location: dict(n_x=nd.choice.n_x, n_v=nd.choice.n_v, smooth_x=nd.choice.lam_x,
+                                smooth_v=nd.choice.lam_v, heldout_linear=nd.choice.heldout,
+                                edf=nd.choice.edf)
+        for nd in nodes if nd.choice is not None})
+    named = rk.named
+    if terms and named is not None and "+" not in named.candidate.hypothesis:
+        best = next(nd for nd in nodes if nd.cand.location == terms[0].node)
+        bt = _beside(ctx, problem, cal, dec, named, best, graph)
+        if bt is not None:
+            n_sim += bt[1]
+            out.n_sim = n_sim
+            out.beside, t = bt[0], bt[0]
+            out.second_force = bool(named.aicc - t.aicc > MARGIN
+                                    and t.heldout_rmse < named.heldout_rmse)
+            out.reason += (f"; beside the named {named.candidate.label}, the term at "
+                           f"{t.node} {'leaves' if out.second_force else 'does not leave'} "
+                           f"a second force (AICc {named.aicc - t.aicc:+.1f} units, held-out "
+                           f"{named.heldout_rmse:.3g} -> {t.heldout_rmse:.3g})")
     out.wall_s = time.perf_counter() - t0
     return out
+
+
+def _beside(ctx, problem, cal, dec, named, node, graph):
+    """(Term, simulations) of the term at ``node`` fitted beside the named
+    single cause (its parameters refitted with it), or None when it fails."""
+    n = cal.fit.n
+    cand = chosen_candidate(node, graph, n, beside=named)
+    task = _free_step(fit_tasks(problem.from_fit(), cal, [cand])[0], node)
+    r = ctx.run(fit_candidate, [task], "locating beside the named cause")[0]
+    if not r.ok:
+        return None
+    return _term(r, n, dec.c_hat, node, beside=named.candidate.label), r.fit.n_sim
 
 
 def _verdict(terms, dec, rk, n) -> Location:
@@ -222,5 +633,9 @@ def _verdict(terms, dec, rk, n) -> Location:
     reason = (f"the generic term at {best_t.node} is {lib_aicc - best_t.aicc:.1f} AICc units "
               f"better than the best library candidate" if beats else
               "the generic terms do not beat the library's best candidate")
+    tied = tuple(t.node for t in terms[1:] if t.fitted == best_t.fitted
+                 and t.heldout_rmse <= best_t.heldout_rmse * (1 + CV_TIE))
     return Location(tuple(terms), unexplained, best_t.node if unexplained else None, reason,
-                    nearest, why)
+                    nearest, why, heldout=float(best_t.heldout_rmse),
+                    reaches_floor=bool(best_t.heldout_rmse <= FLOOR_REACH),
+                    best_node=best_t.node, tied_nodes=tied)

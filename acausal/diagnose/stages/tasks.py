@@ -37,8 +37,8 @@ from ...modelfile import compile_file
 from ...studies.residuals import subset
 from .fitting import Budget, Fit, Objective, failed_fit, finish, linear_loo, penalty_cost, \
     refine_or_keep, residuals_of, score_starts
-from ..library.generic import GENERIC
-from ..library.generic import build as build_generic
+from ..library.generic import carries_generic, members as generic_members, \
+    model_for as generic_model
 from ..library.loader import load_library
 from ..problem import LOO_TOL, Candidate, Problem
 
@@ -124,9 +124,11 @@ def dataset_of(problem: Problem):
 def model_of(problem: Problem, candidate: Candidate):
     if candidate.hypothesis is None:
         return compile_file(problem.model_path)
-    if candidate.hypothesis == GENERIC.id:
-        return worker_cache(("diagnose-generic", _stamp(problem.model_path), candidate.location),
-                            lambda: build_generic(problem.model_path, candidate.location))
+    if carries_generic(candidate):           # the generic term, alone or beside a cause
+        return worker_cache(("diagnose-generic", _stamp(problem.model_path), problem.library,
+                             generic_members(candidate)), lambda: generic_model(
+                                 problem.model_path, candidate,
+                                 load_library(problem.library).HYPOTHESES))
     if "+" in candidate.hypothesis:          # a pair: "h1+h2" at "l1+l2"
         pair = tuple(zip(candidate.hypothesis.split("+"), candidate.location.split("+")))
         return worker_cache(("diagnose-pair", _stamp(problem.model_path), problem.library,
@@ -330,11 +332,13 @@ def calibrate_nominal(task: FitTask) -> CandidateFit:
 
 
 def penalty_of(cand):
-    """(rows P, scales) of a candidate's penalty on its own parameters (the
-    generic term's smoothing and pins), or None."""
+    """(rows P, scales) of a candidate's penalty on its last P.shape[1]
+    parameters (the generic term's smoothing and pins; a term fitted beside
+    a cause has the cause's parameters first), or None."""
     if cand.penalty is None:
         return None
-    return np.asarray(cand.penalty, float), np.array([abs(p.scale) or 1.0 for p in cand.params])
+    P = np.asarray(cand.penalty, float)
+    return P, np.array([abs(p.scale) or 1.0 for p in cand.params[len(cand.params) - P.shape[1]:]])
 
 
 AGREE_X = 1e-2      # two refinements meet: every parameter within this many scales,
