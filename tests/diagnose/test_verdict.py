@@ -11,6 +11,7 @@
 * every screened plausible rival fitted (a short fit beyond the budget);
 * the pair search goes on when the best single misses the held-out data.
 """
+import dataclasses
 from types import SimpleNamespace as NS
 
 import numpy as np
@@ -179,6 +180,38 @@ def test_rank_names_weakens_or_says_not_explained():
     small = _rank(rows, a0=105.0)
     assert small.kind == "weak" and [r.code for r in small.verdict.reasons] == ["not_strong"]
     assert small.weak == [small.verdict.reasons[0].text] and "5.0" in small.weak[0]
+
+
+def test_a_row_that_explains_the_heldout_data_is_judged_before_one_that_does_not():
+    """The cam follower's Coulomb friction (independent truth, 30 floors):
+    a pair 0.65 AICc units ahead in training left 2.27 floors held out, the
+    single Coulomb at the follower 1.08; the verdict judges the single
+    (named), not the pair ("not explained"). A row more than STRONG units
+    behind is not brought forward."""
+    cf = _row("coulomb_friction", "follower", [("hyp_cf.F", 0.0, 0, 1)], {"hyp_cf.F": 0.5},
+              {"hyp_cf.F": (0.49, 0.51)}, heldout=1.004, aicc=100.65)
+    pair = _row("coulomb_friction+hardening_spring", "follower+spring",
+                [("hyp_cf.F", 0.0, 0, 1), ("hyp_hs.k3", 0.0, -1, 1)],
+                {"hyp_cf.F": 0.5, "hyp_hs.k3": 0.1},
+                {"hyp_cf.F": (0.49, 0.51), "hyp_hs.k3": (0.05, 0.15)}, heldout=2.27,
+                aicc=100.0)
+    got = _rank([pair, cf])
+    assert got.kind == "named" and got.named.candidate.hypothesis == "coulomb_friction"
+    far = dataclasses.replace(cf, aicc=100.0 + st.STRONG + 1.0)
+    assert _rank([pair, far]).kind == "not_explained"
+
+
+def test_a_nominal_near_the_floor_that_the_cause_brings_within_it_is_a_heldout_gain():
+    """The cam follower's viscous loss at 30 floors: the free bearing damping
+    absorbed most of it (held-out 1.069 without extension, above what noise
+    reaches, T = 1.05 here), the viscous damping at the follower brought it
+    to 1.0075: a gain, though not by the factor 0.9."""
+    ev = dict(n=N, k=3, d_null=50.0, d_runner=None, ci_rel=None, c_hat=1.0, coarse=None)
+    codes = lambda **kw: [c for c, _ in st.weak_reasons(st.Evidence(**ev, **kw))]
+    assert codes(heldout_nominal=1.069, heldout_best=1.0075, heldout_threshold=1.05) == []
+    assert codes(heldout_nominal=1.069, heldout_best=1.0075) == ["no_heldout_gain"]
+    assert codes(heldout_nominal=1.04, heldout_best=1.0075,
+                 heldout_threshold=1.05) == ["no_heldout_gain"]
 
 
 def test_the_pair_search_goes_on_when_the_best_single_misses_the_heldout_data():

@@ -273,6 +273,7 @@ class Evidence:
     ci_rel: float | None
     c_hat: float
     coarse: float | None
+    heldout_threshold: float | None = None   # the most noise alone reaches (floors)
 
 
 def weak_evidence(ev: Evidence) -> list:
@@ -301,10 +302,16 @@ def weak_reasons(ev: Evidence) -> list:
     if d_runner is not None and d_runner < RUNNER_UP:
         out.append(("rival_tied", f"the runner-up outside its class is only {d_runner:.1f} "
                     f"AICc units behind (needs {RUNNER_UP:g})"))
-    if not (heldout_best < HELDOUT_GAIN * heldout_nominal):
+    # the held-out error falls enough: by the factor, or from above what noise
+    # alone reaches to within it (a nominal already near the floor, its free
+    # parameters absorbing part of the cause, cannot fall by the factor)
+    crossed = (ev.heldout_threshold is not None and heldout_nominal > ev.heldout_threshold
+               and heldout_best <= ev.heldout_threshold)
+    if not (heldout_best < HELDOUT_GAIN * heldout_nominal or crossed):
         out.append(("no_heldout_gain", f"held-out error does not fall enough: "
                     f"{heldout_best:.3g} against {heldout_nominal:.3g} without extension "
-                    f"(needs below {HELDOUT_GAIN:g}x)"))
+                    f"(needs below {HELDOUT_GAIN:g}x, or from above the noise's "
+                    f"threshold to within it)"))
     if ci_rel is not None and not (ci_rel < CI_REL):
         out.append(("poorly_determined", f"the cause's parameter is poorly determined: 95 % "
                     f"half-width {ci_rel:.0%} of its distance from the neutral value (needs "
