@@ -35,6 +35,7 @@ FIT_BACKEND = "compiled"
 # higher in S (within the converged-start tolerance); not verified on the
 # blind tier yet, so not the default.
 FIT_JACOBIAN = "differences"
+SHORT_EVALS = 4   # a screened rival beyond the fit budget: 4 (k + 1) evaluations, whole record
 
 
 @dataclass(frozen=True)
@@ -187,3 +188,12 @@ class Problem:
         could only lead away."""
         return dataclasses.replace(self, settings=dataclasses.replace(
             self.settings, lhs=0, refine=1, windows=(1.0,)))
+
+    def briefly(self) -> "Problem":
+        """:meth:`from_fit` with the refinement capped at
+        :data:`SHORT_EVALS` (k + 1) evaluations: the short fit a screened
+        rival beyond the fit budget gets from the screen's point (issue 24:
+        every plausible rival is fitted before the verdict)."""
+        p = self.from_fit()
+        return dataclasses.replace(p, settings=dataclasses.replace(
+            p.settings, evals_per_param=SHORT_EVALS))

@@ -306,9 +306,8 @@ def search_pairs(ctx: Context, problem: Problem, cal: NominalFit, dec: Decision)
                        for r in fits if r.ok})
     if left:   # within reach beyond MAX_FITS: a short fit from the step's point each
         # (issue 24: no plausible rival is left unfitted for a budget)
-        short = dataclasses.replace(problem.from_fit(), settings=dataclasses.replace(
-            problem.from_fit().settings, evals_per_param=pscreen.SHORT_EVALS))
-        fits += ctx.run(fit_candidate, [_predicted_task(short, cal, p, budget) for p in left],
+        fits += ctx.run(fit_candidate, [_predicted_task(problem.briefly(), cal, p, budget)
+                                        for p in left],
                         "fitting the other pairs within reach, briefly")
         fitted.update({_pair_key(r.candidate): st.aicc(r.fit.cost, n, r.fit.k, dec.c_hat)
                        for r in fits if r.ok})
@@ -747,12 +746,12 @@ def _explaining_first(rows, n, experiments):
     such row (a name must explain the held-out data: cam follower, Coulomb
     friction at the follower, held-out 1.08, 0.65 units behind a pair that
     reached 5976.2 in training and 2.27 held out)."""
-    if not rows or vd.explains(rows[0], vd.threshold_of(n, rows[0], experiments)):
+    if not rows or _explains(rows[0], n, experiments):
         return rows
     for j, r in enumerate(rows[1:], 1):
         if r.aicc - rows[0].aicc > st.STRONG:
             break
-        if vd.explains(r, vd.threshold_of(n, r, experiments)):
+        if _explains(r, n, experiments):
             return (r,) + rows[:j] + rows[j + 1:]
     return rows
 
@@ -764,10 +763,15 @@ def _runner(rows, classes, n, experiments):
     heads = [c[0] for c in classes[1:]]
     if not heads:
         return None
-    if rows and vd.explains(rows[0], vd.threshold_of(n, rows[0], experiments)):
-        heads = [i for i in heads if vd.explains(rows[i], vd.threshold_of(n, rows[i],
-                                                                           experiments))]
+    if rows and _explains(rows[0], n, experiments):
+        heads = [i for i in heads if _explains(rows[i], n, experiments)]
     return heads[0] if heads else None
+
+
+def _explains(row, n, experiments) -> bool:
+    """Does ``row`` explain the held-out data, against the threshold for its
+    own k (:func:`.verdict.threshold_of`, :func:`.verdict.explains`)?"""
+    return vd.explains(row, vd.threshold_of(n, row, experiments))
 
 
 def _heldout_vector(cv, row, ds):

@@ -107,7 +107,6 @@ def fit_members(ctx, problem, cal, dec) -> Members:
 
 
 SCREEN_FIT_S = 120.0  # seconds of simulation (one core) the screened members' full fits may use
-SHORT_EVALS = 4       # a screened member beyond that budget: 4 (k + 1) evaluations, whole record
 
 
 def seconds_per_simulation(dec, cal) -> float:
@@ -136,16 +135,16 @@ def screened_tasks(problem, cal, dec, picks, seconds=SCREEN_FIT_S) -> list:
     start and the step's point while their simulations fit the budget
     (``seconds`` of simulation over :func:`seconds_per_simulation`: with the
     compiled backend's 5-10 ms per breaker simulation that is 12000-24000
-    simulations, a dozen full fits); the rest briefly (``SHORT_EVALS`` (k +
-    1) evaluations on the whole record from the step's point): every
-    plausible rival is fitted before the verdict."""
+    simulations, a dozen full fits); the rest briefly
+    (:meth:`.problem.Problem.briefly`: ``SHORT_EVALS`` (k + 1) evaluations
+    on the whole record from the step's point): every plausible rival is
+    fitted before the verdict."""
     if not picks:
         return []
     per = seconds_per_simulation(dec, cal)
     budget = seconds / per if per > 0 else float("inf")
     experiments = max(len(set(cal.fit.groups)), 1)
-    short = dataclasses.replace(problem.from_fit(), settings=dataclasses.replace(
-        problem.from_fit().settings, evals_per_param=SHORT_EVALS))
+    short = problem.briefly()
     out, used = [], 0.0
     for cand, free in picks:
         cost = full_fit_simulations(problem, cand, experiments)

@@ -44,7 +44,7 @@ promising first. After the first fits, :func:`more_picks` measures reach
 against the best pair actually fitted (usually far below every
 prediction), and the pairs within it not yet fitted get a second round.
 Pairs still within reach beyond :data:`MAX_FITS` are fitted briefly
-(:data:`SHORT_EVALS` (k + 1) evaluations from the step's point); one whose
+(:meth:`.problem.Problem.briefly`, from the step's point); one whose
 fit fails is returned as unfitted: no cause is named over it. The largest under-prediction the
 fitted pairs showed (:func:`observed_share`) is reported, not used: the
 true pair beats its prediction by many times its predicted gain (dry
@@ -63,7 +63,6 @@ from .screen import predicted_step
 MARGIN = 10.0     # AICc units of uncertainty of every prediction, plus ...
 SHARE = 0.5       # ... this share of its predicted gain over its better member alone
 MAX_FITS = 8      # pairs fitted in full from this screen, both rounds together
-SHORT_EVALS = 4   # a pair within reach beyond MAX_FITS: 4 (k + 1) evaluations, whole record
 
 
 @dataclass(frozen=True)
