@@ -147,6 +147,26 @@ def _check_output(path, option, *, plot=False, create=False):
     if not os.access(folder, os.W_OK) or (os.path.exists(path) and
                                           not os.access(path, os.W_OK)):
         raise UsageError(f"{option} {path}: not writable")
+    _probe_write(path, option)
+
+
+def _probe_write(path, option):
+    """Open ``path`` for appending, as the writer will, and leave no trace:
+    ``os.access`` says yes to root where the file system says no (``/sys``,
+    a read-only mount, a full disk's folder), and the run's result was then
+    lost to a traceback after it had been computed."""
+    existed = os.path.exists(path)
+    try:
+        with open(path, "a"):
+            pass
+    except OSError as exc:
+        raise UsageError(f"{option} {path}: cannot be written: "
+                         f"{exc.strerror or exc}") from None
+    if not existed:
+        try:
+            os.remove(path)
+        except OSError:
+            pass
 
 
 @contextlib.contextmanager
@@ -303,6 +323,8 @@ def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, max_rows, max_wa
                 res, error = _run_keeping_partial(cm, params, opts)
             measures, missing = measure_values(mf, res) if error is None else ({}, {})
             if out:
+                if len(res.t) > 100_000:    # (a million rows take seconds to write)
+                    click.echo(f"acausal: writing {len(res.t):,} rows to {out}", err=True)
                 res.to_csv(out)
                 if error is not None:
                     click.echo(f"acausal: partial results up to t = {res.t[-1]:.6g} s written "
@@ -325,12 +347,20 @@ def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, max_rows, max_wa
         _fail(error)
 
 
+MIN_SPAN = 1e-15   # [s] the shortest run the command accepts (a femtosecond)
+
+
 def _check_run_options(opts):
     """The run's stop time after its start (the model file's t0), checked
     before the run (--t-end -1 gave an IndexError, nan a ValueError)."""
     t0, t_end = opts.get("t0", 0.0), opts.get("t_end")
     if t_end is not None and not t_end > t0:
         raise UsageError(f"--t-end {t_end:g}: must be after the start time t0 = {t0:g} s")
+    floor = max(MIN_SPAN, 1e-12 * abs(t0))
+    if t_end is not None and t_end - t0 < floor:
+        raise UsageError(f"--t-end {t_end:g}: the run from t0 = {t0:g} s would last "
+                         f"{t_end - t0:.3g} s, shorter than {floor:.3g} s, the shortest "
+                         "run accepted")
 
 
 @contextlib.contextmanager

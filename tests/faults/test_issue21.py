@@ -285,6 +285,44 @@ def test_a_long_trace_is_thinned_to_what_the_instrument_supports():
     assert len(ds.experiments[0].trace.time) == n        # the input is not changed
 
 
+@pytest.mark.parametrize("args, said", [
+    (["--out", "/proc/acausal_o.csv"], "--out /proc/acausal_o.csv: cannot be written"),
+    (["--plot", "/proc/acausal_o.png"], "--plot /proc/acausal_o.png: cannot be written"),
+    (["--t-end", "1e-200"], "shorter than 1e-15 s, the shortest run accepted")])
+def test_an_unwritable_output_or_a_vanishing_span_is_refused_before_the_run(tmp_path, args,
+                                                                            said):
+    """os.access said yes to root for /sys and /proc, so the result was lost
+    to a PermissionError traceback after the run; a 1e-200 s run reached IDA
+    and failed there as a solver failure (exit 3), not a usage error."""
+    model = tmp_path / "spring.py"
+    model.write_text(LONG_SPRING.format(step="1e-3").replace("t_end=1e6", "t_end=0.1"))
+    r = CliRunner().invoke(main, ["simulate", str(model), *args])
+    assert r.exit_code == 2, r.output
+    lines = [ln for ln in r.output.splitlines() if ln.strip()]
+    assert len(lines) == 1 and said in lines[0] and "simulated" not in r.output, r.output
+    assert not os.path.exists("/proc/acausal_o.csv")
+
+
+def test_a_large_result_is_written_as_exact_csv(tmp_path):
+    """Result.to_csv writes blocks of rows; every value reads back bit for
+    bit (shortest round-trip repr) across block boundaries."""
+    from acausal.runtime import result as rmod
+    model = tmp_path / "spring.py"
+    model.write_text(LONG_SPRING.format(step="1e-4").replace("t_end=1e6", "t_end=0.5"))
+    from acausal.modelfile import run_file
+    res, _ = run_file(str(model))
+    old, rmod.CSV_BLOCK = rmod.CSV_BLOCK, 777
+    try:
+        res.to_csv(tmp_path / "o.csv")
+    finally:
+        rmod.CSV_BLOCK = old
+    back = np.loadtxt(tmp_path / "o.csv", delimiter=",", skiprows=1)
+    assert back.shape == (len(res.t), 1 + len(res.names))
+    assert np.array_equal(back[:, 0], res.t)
+    for j, n in enumerate(res.names):
+        assert np.array_equal(back[:, 1 + j], np.asarray(res[n], dtype=float)), n
+
+
 def test_plausibility_warnings_are_one_line_each(capsys):
     """A condition outside the declared range (all experiments in one line),
     a fitted value at its bound, a measured value of the other sign or 10x
