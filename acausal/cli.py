@@ -780,12 +780,12 @@ def _calibrate(cal, compile_file, file, data, fit, method, experiments, profile)
     _condition_warnings(mf, ds)
     chosen = None
     if experiments is not None:
-        chosen = "all" if experiments.strip() == "all" else [
-            x.strip() for x in experiments.split(",") if x.strip()]
+        chosen = ("all" if experiments.strip() == "all"
+                  else _csv_list(experiments, "--experiments"))
         if chosen == []:
             raise UsageError("--experiments: the list is empty (give names, or 'all')")
     ds, held = cal.split(ds, chosen)
-    items = [x.strip() for x in fit.split(",") if x.strip()]
+    items = _csv_list(fit, "--fit")
     if not items:
         raise UsageError("--fit: no parameter named (give --fit P1,P2)")
     if method == "report":
@@ -988,9 +988,9 @@ def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max
     from .infra.executor import default_workers, open_executor, terminate_on_sigterm
     from .modelfile import compile_file, sweep_task
     from .studies.sweep import Journal, grid, parse_param, plot_sweep, run_sweep
-    measures = _csv_list(",".join(measures))
     try:
         with _quiet_warnings():
+            measures = _csv_list(",".join(measures), "--measure")
             if not measures:
                 raise UsageError("--measure: no measure named (give --measure M1,M2)")
             _check_output(out, "--out", create=True)
@@ -1092,7 +1092,7 @@ def tolerance(file, spec, n, sampling, seed, measures, out, plot_prefix, json_pa
             tol.check_n(n, sampling)
             mf, cm = compile_file(file)
             dists = tol.parse_spec(spec, cm)
-            measures = _csv_list(",".join(measures)) or list(mf.measures)
+            measures = _csv_list(",".join(measures), "--measure") or list(mf.measures)
             if not measures:
                 raise UsageError(f"{file}: the model file defines no measures to study")
             for m in measures:
@@ -1199,8 +1199,17 @@ def _resumable(where):
         sys.exit(130)
 
 
-def _csv_list(text):
-    return None if text is None else [x.strip() for x in text.split(",") if x.strip()]
+def _csv_list(text, option):
+    """A comma-separated option value as a list (None stays None); a name
+    given twice is refused (``--fit contact.K,contact.K`` fitted one
+    parameter, silently)."""
+    if text is None:
+        return None
+    items = [x.strip() for x in text.split(",") if x.strip()]
+    twice = sorted({x for x in items if items.count(x) > 1})
+    if twice:
+        raise UsageError(f"{option} {text!r}: {', '.join(twice)} named twice")
+    return items
 
 
 @main.command()
@@ -1266,8 +1275,8 @@ def diagnose(file, data, json_opt, json_file, report_dir, scheduler, workers, ma
                     Watchdog(limit, max_wall, "the diagnosis"):
                 out = run_diagnosis(file, data, out_dir=report_dir, scheduler=scheduler,
                                     workers=workers, progress=not no_progress,
-                                    hypotheses=_csv_list(hypotheses),
-                                    locations=_csv_list(locations), alpha=alpha,
+                                    hypotheses=_csv_list(hypotheses, "--hypotheses"),
+                                    locations=_csv_list(locations, "--locations"), alpha=alpha,
                                     library=library,
                                     settings=FitSettings(lhs=starts, refine=refine),
                                     on_resume=lambda n, path: click.echo(

@@ -263,6 +263,20 @@ def test_a_resumed_sweep_says_so_and_writes_rows_in_grid_order(tmp_path):
     assert masses == [1.0, 1.25, 1.5, 1.75, 2.0]
 
 
+@pytest.mark.parametrize("extra", [["--measure", "s_end,s_end"],
+                                   ["--measure", "s_end", "--measure", "s_end"]])
+def test_a_name_given_twice_in_a_list_is_refused(tmp_path, extra):
+    """--fit contact.K,contact.K fitted one parameter and said nothing; every
+    list option (--fit, --experiments, --measure, --hypotheses, --locations)
+    now refuses a repeated name, before the run."""
+    model = h.copy_model("osc_sweep_model.py", tmp_path / "model")
+    r = CliRunner().invoke(main, ["sweep", str(model), "--param", "mass.m=1.5,2.0",
+                                  "--scheduler", "serial", "--no-progress", *extra])
+    assert r.exit_code == 2, r.output
+    lines = [ln for ln in r.output.splitlines() if ln.strip()]
+    assert len(lines) == 1 and "s_end named twice" in lines[0], r.output
+
+
 def test_a_long_trace_is_thinned_to_what_the_instrument_supports():
     from acausal.data.records import Dataset, Instrument, Trace
     from acausal.data.records import MeasuredExperiment as Experiment
