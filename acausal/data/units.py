@@ -75,6 +75,10 @@ def converter(unit_text: Optional[str], expected: Optional[str], label: str,
             target = None
     if unit_text is None:
         return lambda values: values
+    if expected is not None and target is None and unit_text.strip() == expected.strip():
+        # the model's own unit, which pint cannot read ('N/m^gamma', copied
+        # from `acausal variables`): the values are in it already
+        return lambda values: values
     unit = read_unit(unit_text, where)
     if target is not None and unit.dimensionality != target.dimensionality:
         raise DataError(f"wrong unit: '{label}' is {kind(unit)}, "

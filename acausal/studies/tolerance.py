@@ -120,12 +120,17 @@ class Dist:
 _NUMBER = re.compile(r"^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
 
 
+def _declared_unit(cm, name):
+    """The unit text declared for parameter (or fixed start value) ``name``."""
+    free = {e.name: e for e in cm.params}
+    return free[name].unit if name in free else cm.flat.variables[name].unit
+
+
 def _model_unit(cm, name):
     """The declared unit of parameter (or fixed start value) ``name``, with a
     symbolic exponent such as ``N/m^gamma`` resolved from the sibling
     parameter's value (``contact.gamma`` = 1.5 -> ``N/m^1.5``)."""
-    free = {e.name: e for e in cm.params}
-    unit = free[name].unit if name in free else cm.flat.variables[name].unit
+    unit = _declared_unit(cm, name)
     if not unit:
         return unit
     from ..data.units import parse_unit
@@ -135,6 +140,7 @@ def _model_unit(cm, name):
     except Exception:   # noqa: BLE001 - pint cannot read it: resolve symbolic exponents
         pass
     scope = name.rsplit(".", 1)[0] + "." if "." in name else ""
+    free = {e.name: e for e in cm.params}
 
     def value(m):
         e = free.get(scope + m.group(0))
@@ -163,6 +169,9 @@ def _to_si(cm, name, unit_text, where):
     """(factor, offset) taking values in ``unit_text`` to the SI unit of
     ``name``; a DataError if the dimension is wrong."""
     from ..data.units import converter
+    declared = _declared_unit(cm, name)
+    if declared and unit_text.strip() == declared.strip():
+        return 1.0, 0.0        # the declared unit itself ('N/m^gamma', as listed)
     expected = _model_unit(cm, name)
     conv = converter(unit_text if unit_text not in ("",) else "1", expected,
                      f"{name} [{unit_text}]", name, where)

@@ -309,3 +309,18 @@ def test_breaker_study_end_to_end(tmp_path):
     for kind in ("hist", "tornado"):
         assert (tmp_path / f"b_thrt_{kind}.png").stat().st_size > 10_000
     assert len(tol_rows(out)) == 64
+
+
+def test_the_declared_unit_with_a_symbolic_exponent_is_accepted(tmp_path):
+    """'N/m^gamma' is contact.K's declared unit, as `acausal variables` lists
+    it; a spec in that unit was refused ('not a unit expression'). It reads
+    as the model's own unit, the same as the resolved 'N/m^1.5'."""
+    cm = compile_file(BREAKER)[1]
+    dists = []
+    for unit in ("N/m^gamma", "N/m^1.5"):
+        spec = tmp_path / "tol.csv"
+        spec.write_text(f"contact.K, uniform, 1e7, 2e7, {unit}\n")
+        dists.append(tol.parse_spec(spec, cm)[0])
+    same = ("name", "kind", "a", "b", "unit")
+    assert [getattr(dists[0], f) for f in same] == [getattr(dists[1], f) for f in same]
+    assert (dists[0].a, dists[0].b) == (1e7, 2e7)
