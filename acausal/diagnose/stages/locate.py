@@ -135,6 +135,34 @@ class Location:
     n_sim: int = 0                # simulations the stage ran
 
 
+def node_ranking(loc: Location) -> list:
+    """Every node's term, best first (lowest held-out error; the nodes
+    fitted in full before those scored by their linearised step only),
+    tied sites or not: ``{node, heldout_rmse, fitted, aicc, resolution,
+    members}``. Empty when no term was fitted."""
+    return [dict(node=t.node, heldout_rmse=_finite(t.heldout_rmse), fitted=t.fitted,
+                 aicc=_finite(t.aicc), resolution=list(t.resolution), members=list(t.members))
+            for t in loc.terms]
+
+
+def no_node_reason(loc: Location | None) -> str:
+    """One line: why no node could be judged (the stage did not run, or no
+    term could be built or fitted, with each node's reason)."""
+    if loc is None:
+        return "the located generic term was not run"
+    if loc.terms:
+        return ""
+    failed = (loc.details or {}).get("failed") or {}
+    text = loc.skipped or "no generic term could be fitted"
+    extra = "; ".join(f"{k}: {v}" for k, v in failed.items() if k not in text)
+    return text + (f" ({extra})" if extra else "")
+
+
+def _finite(x):
+    x = float(x)
+    return x if np.isfinite(x) else None
+
+
 def needed(dec, rk) -> bool:
     """Run the stage when a discrepancy is found and no cause is named or
     the best fit still leaves misfit beyond the instrument."""
@@ -146,23 +174,52 @@ def _params(graph, loc, n_x, n_v):
                  for s in gen.GenericForce(n_x, n_v).params(graph, loc))
 
 
-def generic_candidates(problem, n=1, n_x=N_X, n_v=N_V):
+def generic_candidates(problem, n=1, n_x=N_X, n_v=N_V, runs=()):
     """(Candidate, knot ranges, members) of the generic term of ``n_x`` x
     ``n_v`` knots at every body node; ``n`` data values set the penalty's
-    weight (generic.SMOOTH per value)."""
-    from ..library.graph import ModelGraph
-    from ..library.nominal import nominal_result
-    from ...modelfile import load_model_file
-    graph = ModelGraph(load_model_file(problem.model_path).model,
-                       result=nominal_result(problem.model_path))
+    weight (generic.SMOOTH per value). ``runs``: simulation results of the
+    calibrated model on every experiment; the knots then span the positions
+    and velocities they cover (:func:`data_ranges`), set as the candidate's
+    fixed values, else the model file's nominal run's."""
+    graph = _graph(problem)
     out = []
     for loc in GENERIC.candidates(graph):
+        rng = data_ranges(graph, loc, runs) if runs else None
         out.append((Candidate(GENERIC.id, loc, _params(graph, loc, n_x, n_v),
-                              penalty(n_x, n_v, SMOOTH * n)),
-                    tuple(GENERIC.ranges(graph, loc)),
+                              penalty(n_x, n_v, SMOOTH * n),
+                              gen.range_values(rng) if rng is not None else ()),
+                    tuple(rng if rng is not None else GENERIC.ranges(graph, loc)),
                     tuple(sorted({p.owner.path for p in
                                   graph.nodes[graph.node(graph.components[loc].flange)]}))))
     return out
+
+
+def data_ranges(graph, loc, runs):
+    """The knot ranges at the body ``loc`` over every run in ``runs`` (its
+    position and velocity, :func:`.generic.knot_ranges`): a term whose knots
+    span only the model file's nominal run is zero wherever an experiment
+    goes further (a larger drive torque, a faster start). None when no run
+    records them."""
+    from ..library.domain import domain_of
+    dom = domain_of(graph.components[loc])
+    xs, vs = [], []
+    for res in runs:
+        try:
+            xs.append(np.asarray(res[f"{loc}.{dom.across}"], float))
+            vs.append(np.asarray(res[f"{loc}.{dom.rate}"], float))
+        except KeyError:
+            continue
+    return gen.knot_ranges(xs, vs) if xs else None
+
+
+def calibrated_runs(problem, cal):
+    """The calibrated nominal model simulated on every experiment (main
+    process, one run each; a failed run is left out)."""
+    from ..problem import NOMINAL
+    from .views import simulate_all
+    return [r for r in simulate_all(model_of(problem, NOMINAL), dataset_of(problem),
+                                    cal.fit.values, problem.settings.integrator).values()
+            if r is not None]
 
 
 def degenerate_directions(Jg, Jf):
@@ -455,11 +512,12 @@ def chosen_candidate(node: _Node, graph, n, beside=None):
                    for i, q in enumerate(base))
     P = np.vstack([penalty(ch.n_x, ch.n_v, ch.lam_x * n, ch.lam_v * n), ch.pins])
     if beside is None:
-        return Candidate(GENERIC.id, node.cand.location, params, P)
+        return Candidate(GENERIC.id, node.cand.location, params, P, node.cand.fixed)
     own = tuple(dataclasses.replace(q, start=float(beside.fit.values[q.name]))
                 for q in beside.candidate.params)
     return Candidate(f"{beside.candidate.hypothesis}+{GENERIC.id}",
-                     f"{beside.candidate.location}+{node.cand.location}", own + params, P)
+                     f"{beside.candidate.location}+{node.cand.location}", own + params, P,
+                     node.cand.fixed)
 
 
 def _free_step(task: FitTask, node: _Node) -> FitTask:
@@ -538,7 +596,7 @@ def locate(ctx, problem, cal, dec, rk) -> Location:
     t0 = time.perf_counter()
     n = cal.fit.n
     fine = (gen.X_LADDER[-1], gen.V_LADDER[-1])
-    gens = generic_candidates(problem, n, *fine)
+    gens = generic_candidates(problem, n, *fine, runs=calibrated_runs(problem, cal))
     if not gens:
         return Location(skipped="the model has no body node")
     nodes = [_Node(*g) for g in gens]
