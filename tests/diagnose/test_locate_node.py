@@ -136,3 +136,45 @@ def test_data_ranges_read_each_bodys_coordinates_over_every_experiment(monkeypat
         5.0 * (1 + gen.PAD))
     assert got[3] == pytest.approx(15.0 * (1 + gen.PAD))
     assert L.data_ranges(graph, "motor", [{"other.phi": np.ones(3)}]) is None
+
+
+def _row(hyp, loc, held=2.0, aicc=100.0):
+    from acausal.diagnose.problem import Candidate, Param
+    names = [f"h{i}.F" for i, _ in enumerate(hyp.split("+"))]
+    params = tuple(Param(nm, 0.0, 0.0, 1.0, 0.1, 0.0) for nm in names)
+    return SimpleNamespace(candidate=Candidate(hyp, loc, params), fit=object(),
+                           heldout_rmse=held, aicc=aicc)
+
+
+def test_term_goes_beside_the_named_cause_or_each_member_of_the_best_candidate():
+    """Named single cause: beside it. Nothing named: beside each member of
+    the library's best candidate that was fitted alone (a pair's members in
+    its order, a member not fitted alone left out). A named pair: none."""
+    cf, hs = _row("coulomb_friction", "cam"), _row("hardening_spring", "spring")
+    pair = _row("coulomb_friction+hardening_spring", "cam+spring")
+    other = _row("constant_load", "follower")
+    rk = SimpleNamespace(named=None, best=pair, rows=(pair, other, hs, cf))
+    assert L.beside_rows(rk) == [cf, hs]
+    rk = SimpleNamespace(named=None, best=pair, rows=(pair, other, hs))
+    assert L.beside_rows(rk) == [hs]
+    assert L.beside_rows(SimpleNamespace(named=cf, best=cf, rows=(cf,))) == [cf]
+    assert L.beside_rows(SimpleNamespace(named=pair, best=pair, rows=(pair, cf))) == []
+    assert L.beside_rows(SimpleNamespace(named=None, best=None, rows=())) == []
+
+
+def test_the_term_beside_a_cause_is_reported_with_the_cause_refitted():
+    from acausal.diagnose.report.result import beside_of
+    t = L.Term("follower", ("follower",), 90.0, 80.0, 1.05, RANGES, {},
+               {"hyp_cf.tau": 8.8e-5, "gen.a0": 0.01}, beside="coulomb_friction at cam")
+    loc = _located([_term("follower", 7.4), _term("cam", 9.0)], lib_aicc=120.0, lib_held=1.5)
+    assert beside_of(loc) is None
+    loc.beside, loc.second_force = t, True
+    loc.beside_cause = dict(cause="coulomb_friction", location="cam",
+                            values={"hyp_cf.tau": 8.8e-5}, alone_heldout=3.2, alone_aicc=150.0)
+    un = unexplained(_diagnosis("not_explained", loc))
+    b = un["beside"]
+    assert (b["cause"], b["location"], b["node"]) == ("coulomb_friction", "cam", "follower")
+    assert b["values"] == {"hyp_cf.tau": 8.8e-5} and b["second_force"] is True
+    assert b["heldout_rmse"] == pytest.approx(1.05) and b["alone_heldout_rmse"] == 3.2
+    text = _where_sentence(un)
+    assert "beside coulomb_friction at `cam`" in text and "leaves a second force" in text

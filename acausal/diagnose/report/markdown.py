@@ -378,9 +378,16 @@ def _where_sentence(un) -> str:
     tail = ("" if un["beats_library"] else
             f", but it does not beat the library's best candidate (held-out "
             f"{fmt(un['nearest_heldout_rmse'], 3)})")
+    bs = un.get("beside")
+    beside = "" if not bs else (
+        f" Fitted beside {bs['cause']} at `{bs['location']}`, the term at `{bs['node']}` "
+        f"{'leaves' if bs['second_force'] else 'does not leave'} a second force (held-out "
+        f"{fmt(bs['alone_heldout_rmse'], 3)} for the cause alone -> "
+        f"{fmt(bs['heldout_rmse'], 3)} with the term; "
+        + ", ".join(f"`{k}` = {fmt(v)}" for k, v in bs["values"].items()) + ").")
     return (f"{head} (held-out {fmt(un['heldout_rmse'], 3)} floor units"
             + (f"; other nodes: {others}" if others else "") + tied
-            + f"){tail}; section 4b shows its shape.")
+            + f"){tail}; section 4b shows its shape." + beside)
 
 
 def _tied_sentence(d) -> str:

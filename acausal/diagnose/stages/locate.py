@@ -19,9 +19,12 @@ linearised error is within ``REFINE_WITHIN`` of the best (at most
 ``REFINE_MAX``); the other nodes keep their linearised scores.
 
 When a single cause is named, the term is also fitted beside it at the
-located node (the cause's parameters refitted with it: :func:`beside`):
-a second, out-of-library force remains when that beats the named cause by
-``MARGIN`` AICc units and by held-out error.
+located node (the cause's parameters refitted with it: :func:`_beside`);
+with none named, beside each member of the library's best candidate that
+was fitted alone (:func:`beside_rows`: a friction at one site and a detent
+at another are a pair no library pair reproduces). A second,
+out-of-library force remains when the term beside the cause beats that
+cause alone by ``MARGIN`` AICc units and by held-out error.
 
 The verdict "not explained by the library" needs: the best generic term
 beats the best library candidate by more than ``MARGIN`` AICc units and by
@@ -130,8 +133,11 @@ class Location:
     floor_threshold: float = FLOOR_REACH
     best_node: str | None = None  # the best term's node (also when not "unexplained")
     tied_nodes: tuple = ()        # other nodes whose term the held-out data cannot tell apart
-    beside: Term | None = None    # the term fitted beside the named cause
-    second_force: bool = False    # ... beats the named cause alone: a second force remains
+    beside: Term | None = None    # the term fitted beside a single cause (beside_rows)
+    beside_cause: dict = field(default_factory=dict)   # that cause: cause, location, values
+                                  # (refitted with the term), alone_heldout, alone_aicc
+    second_force: bool = False    # ... beats the cause alone and the term alone: a second
+                                  # force remains beside that cause
     n_sim: int = 0                # simulations the stage ran
 
 
@@ -641,34 +647,61 @@ def locate(ctx, problem, cal, dec, rk) -> Location:
                                 smooth_v=nd.choice.lam_v, heldout_linear=nd.choice.heldout,
                                 edf=nd.choice.edf)
         for nd in nodes if nd.choice is not None})
-    named = rk.named
-    if terms and named is not None and "+" not in named.candidate.hypothesis:
+    beside = beside_rows(rk) if terms else []
+    if beside:
         best = next(nd for nd in nodes if nd.cand.location == terms[0].node)
-        bt = _beside(ctx, problem, cal, dec, named, best, graph)
-        if bt is not None:
-            n_sim += bt[1]
-            out.n_sim = n_sim
-            out.beside, t = bt[0], bt[0]
-            out.second_force = bool(named.aicc - t.aicc > MARGIN
-                                    and t.heldout_rmse < named.heldout_rmse)
-            out.reason += (f"; beside the named {named.candidate.label}, the term at "
+        got = _beside(ctx, problem, cal, dec, beside, best, graph)
+        n_sim += sum(m for _, _, m in got)
+        out.n_sim = n_sim
+        if got:
+            row, t, _ = min(got, key=lambda x: (x[1].heldout_rmse, x[1].aicc))
+            out.beside, out.beside_cause = t, dict(
+                cause=row.candidate.hypothesis, location=row.candidate.location,
+                values={q.name: float(t.values[q.name]) for q in row.candidate.params},
+                alone_heldout=float(row.heldout_rmse), alone_aicc=float(row.aicc))
+            out.second_force = bool(row.aicc - t.aicc > MARGIN
+                                    and t.heldout_rmse < row.heldout_rmse)
+            which = "named" if rk.named is not None else "library's best single"
+            out.reason += (f"; beside the {which} {row.candidate.label}, the term at "
                            f"{t.node} {'leaves' if out.second_force else 'does not leave'} "
-                           f"a second force (AICc {named.aicc - t.aicc:+.1f} units, held-out "
-                           f"{named.heldout_rmse:.3g} -> {t.heldout_rmse:.3g})")
+                           f"a second force (AICc {row.aicc - t.aicc:+.1f} units, held-out "
+                           f"{row.heldout_rmse:.3g} -> {t.heldout_rmse:.3g}; the term alone "
+                           f"{terms[0].heldout_rmse:.3g})")
     out.wall_s = time.perf_counter() - t0
     return out
 
 
-def _beside(ctx, problem, cal, dec, named, node, graph):
-    """(Term, simulations) of the term at ``node`` fitted beside the named
-    single cause (its parameters refitted with it), or None when it fails."""
+def beside_rows(rk) -> list:
+    """The single causes the term is fitted beside: the named one; with none
+    named, each member of the best library candidate (a pair's two, or the
+    single itself) that was fitted alone, to see whether one in-library
+    cause plus one out-of-library force explains what neither does alone
+    (a friction with a detent elsewhere)."""
+    named = rk.named
+    if named is not None:
+        return [named] if "+" not in named.candidate.hypothesis else []
+    best = rk.best
+    if best is None:
+        return []
+    keys = [(h, loc) for h, loc, _ in best.candidate.members()]
+    singles = {r.candidate.key: r for r in rk.rows if "+" not in r.candidate.hypothesis
+               and r.fit is not None}
+    return [singles[k] for k in dict.fromkeys(keys) if k in singles]
+
+
+def _beside(ctx, problem, cal, dec, rows, node, graph):
+    """[(row, Term, simulations)] of the term at ``node`` fitted beside each
+    single cause in ``rows`` (its parameters refitted with it); a fit that
+    fails is left out."""
     n = cal.fit.n
-    cand = chosen_candidate(node, graph, n, beside=named)
-    task = _free_step(fit_tasks(problem.from_fit(), cal, [cand])[0], node)
-    r = ctx.run(fit_candidate, [task], "locating beside the named cause")[0]
-    if not r.ok:
-        return None
-    return _term(r, n, dec.c_hat, node, beside=named.candidate.label), r.fit.n_sim
+    cands = [chosen_candidate(node, graph, n, beside=r) for r in rows]
+    tasks = [_free_step(t, node) for t in fit_tasks(problem.from_fit(), cal, cands)]
+    out = []
+    for row, r in zip(rows, ctx.run(fit_candidate, tasks, "locating beside a cause")):
+        if r.ok:
+            out.append((row, _term(r, n, dec.c_hat, node, beside=row.candidate.label),
+                        r.fit.n_sim))
+    return out
 
 
 def _verdict(terms, dec, rk, n) -> Location:
