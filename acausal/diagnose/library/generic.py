@@ -7,8 +7,9 @@ At the node of a body (a joint site) :class:`GenericForce` adds
 
 on the body against the frame, ``x``/``v`` the body's position and
 velocity, ``H`` piecewise-linear hat functions (a linear spline) on
-``N_X``/``N_V`` equally spaced knots over the range the nominal run covers
-(padded by 10 %). The weights are fitted with the free parameters by output
+``N_X``/``N_V`` equally spaced knots over the range the model file's nominal
+run covers (padded by 10 %; the located stage spans the calibrated runs of
+every experiment instead, :func:`knot_ranges`). The weights are fitted with the free parameters by output
 error, with a second-difference penalty (:func:`penalty`) that keeps the
 term smooth. Fitted at every node, the term that removes most of the
 misfit locates the discrepancy in the mechanism (where Kennedy and
