@@ -81,6 +81,8 @@ class Candidate:
     location: str | None
     params: tuple = ()            # Param of the extension, neutral start
     penalty: object = field(default=None, compare=False)  # smoothing rows (generic terms)
+    fixed: tuple = ()             # (name, value) of the extension's fixed parameters set
+                                  # at build (the generic term's knot ranges)
 
     @property
     def key(self):

@@ -7,8 +7,9 @@ At the node of a body (a joint site) :class:`GenericForce` adds
 
 on the body against the frame, ``x``/``v`` the body's position and
 velocity, ``H`` piecewise-linear hat functions (a linear spline) on
-``N_X``/``N_V`` equally spaced knots over the range the nominal run covers
-(padded by 10 %). The weights are fitted with the free parameters by output
+``N_X``/``N_V`` equally spaced knots over the range the model file's nominal
+run covers (padded by 10 %; the located stage spans the calibrated runs of
+every experiment instead, :func:`knot_ranges`). The weights are fitted with the free parameters by output
 error, with a second-difference penalty (:func:`penalty`) that keeps the
 term smooth. Fitted at every node, the term that removes most of the
 misfit locates the discrepancy in the mechanism (where Kennedy and
@@ -58,6 +59,32 @@ SMOOTH = 1.0     # penalty weight on second differences, per data value: a secon
                  # The default of the plain term; the located stage chooses the weight
                  # of each part by cross-validation (stages/locate.py, SMOOTH_GRID)
 PAD = 0.1        # knot range padding (fraction of the nominal range)
+
+
+RANGE_NAMES = ("x_lo", "x_hi", "v_lo", "v_hi")   # the term's fixed parameters: knot ranges
+
+
+def knot_ranges(x, v):
+    """(x_lo, x_hi, v_lo, v_hi): the knots' ranges over the position series
+    ``x`` and the velocity series ``v`` (arrays, or lists of arrays: one per
+    run), each padded by ``PAD`` of its span (by 1 when it does not move;
+    the span -1 .. 1 when the series is missing or has no finite value)."""
+    out = []
+    for z in (x, v):
+        z = (np.concatenate([np.ravel(np.asarray(a, float)) for a in z])
+             if isinstance(z, (list, tuple)) and z else
+             None if z is None or isinstance(z, (list, tuple)) else np.asarray(z, float))
+        z = None if z is None else z[np.isfinite(z)]
+        lo, hi = (float(np.min(z)), float(np.max(z))) if z is not None and z.size else (-1.0, 1.0)
+        pad = PAD * (hi - lo) if hi > lo else 1.0
+        out += [lo - pad, hi + pad]
+    return tuple(out)
+
+
+def range_values(ranges, prefix="gen"):
+    """((name, value), ...) of the term's knot ranges as fixed parameter
+    values (``Candidate.fixed``): ``gen.x_lo``, ..."""
+    return tuple((f"{prefix}.{k}", float(r)) for k, r in zip(RANGE_NAMES, ranges))
 
 
 def hats(z, lo, hi, n):
@@ -163,14 +190,13 @@ class GenericForce(Hypothesis):
         return [s.path for s in graph.joints]
 
     def ranges(self, graph, location):
+        """The knot ranges at ``location`` from the model file's nominal run
+        (:func:`knot_ranges`); the located stage takes them from the
+        calibrated runs of every experiment instead (the range the data
+        cover), through the candidate's fixed values (:func:`range_values`)."""
         dom = domain_of(graph.components[location])
-        out = []
-        for name in (dom.across, dom.rate):
-            z = graph._series(f"{location}.{name}")
-            lo, hi = (float(np.min(z)), float(np.max(z))) if z is not None else (-1.0, 1.0)
-            pad = PAD * (hi - lo) if hi > lo else 1.0
-            out += [lo - pad, hi + pad]
-        return out
+        return list(knot_ranges(graph._series(f"{location}.{dom.across}"),
+                                graph._series(f"{location}.{dom.rate}")))
 
     def defaults(self, graph, location):
         return dict(zip(("x_lo", "x_hi", "v_lo", "v_hi"), self.ranges(graph, location)))
@@ -260,9 +286,13 @@ def carries_generic(candidate) -> bool:
 
 def model_for(model_path, candidate, hypotheses=None):
     """The (ModelFile, CompiledModel) a generic-term candidate is fitted on
-    (:func:`members`); ``hypotheses``: the library's, for a term beside a
-    cause."""
+    (:func:`members`), its fixed values (``candidate.fixed``: the knot
+    ranges) as the compiled model's defaults; ``hypotheses``: the
+    library's, for a term beside a cause."""
     beside, node, n_x, n_v = members(candidate)
     if beside is None and (n_x, n_v) == (GENERIC.n_x, GENERIC.n_v):
-        return build(model_path, node)
-    return build_at(model_path, node, n_x, n_v, beside, hypotheses)
+        mf, cm = build(model_path, node)
+    else:
+        mf, cm = build_at(model_path, node, n_x, n_v, beside, hypotheses)
+    fixed = dict(getattr(candidate, "fixed", ()) or ())
+    return (mf, cm.with_defaults(fixed)) if fixed else (mf, cm)

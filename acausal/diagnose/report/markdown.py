@@ -187,10 +187,13 @@ def _section_located(d, figs):
              "velocity, `acausal/diagnose/generic.py`) fitted at each body's node with the "
              "free parameters; the node whose term removes most of the misfit locates the "
              "discrepancy in the mechanism.\n")
-    L += ["| node (body) | components on the node | S | AICc | held-out RMS |",
-          "|---|---|---|---|---|"]
-    L += [f"| {t.node} | {', '.join(t.members)} | {fmt(t.S)} | {fmt(t.aicc)} | "
-          f"{fmt(t.heldout_rmse, 3)} |" for t in loc.terms]
+    L += ["Nodes by held-out error (best first; a node whose linearised score was not "
+          "within reach of the best is not fitted in full):\n",
+          "| node (body) | components on the node | knots (x, v) | fitted | S | AICc | "
+          "held-out RMS |", "|---|---|---|---|---|---|---|"]
+    L += [f"| {t.node} | {', '.join(t.members)} | {t.resolution[0]}, {t.resolution[1]} | "
+          f"{t.fitted} | {fmt(t.S)} | {fmt(t.aicc)} | {fmt(t.heldout_rmse, 3)} |"
+          for t in loc.terms]
     verdict_line = (f"**Not explained by the library**: {loc.reason}." if loc.unexplained
                     else f"The library is not ruled out: {loc.reason}.")
     L += ["", verdict_line]
@@ -328,11 +331,7 @@ def verdict(d, s) -> str:
     held = (f"held-out error {fmt(g['before']['heldout'], 3)} -> "
             f"{fmt(g['after']['heldout'], 3)} floor units")
     if v["kind"] == "not_explained":
-        un = s["unexplained"]
-        where = (f" A generic term at the node of `{un['node']}` removes most of the misfit "
-                 f"(held-out {fmt(un['heldout_rmse'], 3)} floor units; section 4b shows its "
-                 f"shape)." if un["node"] else
-                 " No located generic term beats the library's best candidate (section 4b).")
+        where = _where_sentence(s["unexplained"])
         laws = "".join(f" **A mixture of laws?** {x['text']}." for x in v["laws"])
         return (f"**Discrepancy not explained by the library.** "
                 + "; ".join(r["text"] for r in v["reasons"]) + "." + where + laws
@@ -361,6 +360,34 @@ def verdict(d, s) -> str:
             f"{e['cause']} at `{e['location']}`" for e in s["equivalent_causes"]) + "."
     return (txt + _threshold_sentence(v) + _tied_sentence(d)
             + _class_sentence(s["cause_class"]))
+
+
+def _where_sentence(un) -> str:
+    """Where the located generic term puts what the library leaves: its
+    best node with its held-out error against the other nodes', or why no
+    node could be judged."""
+    if not un["node"]:
+        return f" No node could be judged: {un['why'] or 'no located generic term'}."
+    others = ", ".join(f"`{x['node']}` {fmt(x['heldout_rmse'], 3)}"
+                       for x in un["nodes"][1:4])
+    tied = (f"; the held-out data cannot tell it from "
+            + ", ".join(f"`{n}`" for n in un["tied_nodes"]) if un["tied_nodes"] else "")
+    head = (f" A generic term at the node of `{un['node']}` removes most of the misfit"
+            if un["beats_library"] else
+            f" The located generic term fits best at the node of `{un['node']}`")
+    tail = ("" if un["beats_library"] else
+            f", but it does not beat the library's best candidate (held-out "
+            f"{fmt(un['nearest_heldout_rmse'], 3)})")
+    bs = un.get("beside")
+    beside = "" if not bs else (
+        f" Fitted beside {bs['cause']} at `{bs['location']}`, the term at `{bs['node']}` "
+        f"{'leaves' if bs['second_force'] else 'does not leave'} a second force (held-out "
+        f"{fmt(bs['alone_heldout_rmse'], 3)} for the cause alone -> "
+        f"{fmt(bs['heldout_rmse'], 3)} with the term; "
+        + ", ".join(f"`{k}` = {fmt(v)}" for k, v in bs["values"].items()) + ").")
+    return (f"{head} (held-out {fmt(un['heldout_rmse'], 3)} floor units"
+            + (f"; other nodes: {others}" if others else "") + tied
+            + f"){tail}; section 4b shows its shape." + beside)
 
 
 def _tied_sentence(d) -> str:

@@ -247,21 +247,52 @@ def failed(d: Diagnosis) -> list:
 
 def unexplained(d: Diagnosis) -> dict:
     """``value``: the discrepancy is not explained by the library (the
-    verdict's kind); ``node``: the body whose node the located generic term
-    sits at (None when no term beats the library); ``heldout_rmse`` of that
-    term (of the best library candidate when none does); ``nearest``: the
-    best library candidate."""
+    verdict's kind); ``node``: with ``value``, the node of the located
+    generic term's best fit (lowest held-out error over every node, tied
+    sites or not: :func:`.stages.locate.node_ranking`), else the node of a
+    term that beats the library (None); ``heldout_rmse``: that term's
+    held-out error (the best library candidate's when no term was fitted);
+    ``beats_library``: the term beats the best library candidate
+    (:mod:`.stages.locate`); ``nodes``: every node's term, best first
+    (``{node, heldout_rmse, fitted, aicc, resolution}``); ``tied_nodes``:
+    those the held-out data cannot tell from the best; ``beside``: the
+    term fitted beside a single cause (:func:`beside_of`); ``why``: with
+    ``value`` and no node, why no node could be judged (one line);
+    ``nearest`` and ``nearest_heldout_rmse``: the best library candidate."""
+    from ..stages.locate import node_ranking, no_node_reason
     loc, best = d.location, d.ranking.best
     value = d.verdict.kind == "not_explained"
-    if loc is None or not loc.terms:
-        return dict(value=value, node=None,
-                    heldout_rmse=num(best.heldout_rmse) if value and best else None,
-                    nearest=best.candidate.label if value and best else None)
-    t = loc.terms[0]
-    return dict(value=value, node=loc.node,
-                heldout_rmse=(num(t.heldout_rmse) if loc.unexplained else
-                              num(best.heldout_rmse) if value and best else None),
-                nearest=loc.nearest)
+    ranking = node_ranking(loc) if loc is not None else []
+    out = dict(value=value, node=None, heldout_rmse=None, beside=None, beats_library=bool(
+        loc is not None and loc.unexplained), nodes=ranking, tied_nodes=[], why=None,
+        nearest=(best.candidate.label if best is not None and (value or ranking) else None),
+        nearest_heldout_rmse=num(best.heldout_rmse) if best is not None else None)
+    if not value:
+        if loc is not None and loc.unexplained and ranking:
+            out.update(node=loc.node, heldout_rmse=ranking[0]["heldout_rmse"])
+        return clean(out)
+    if ranking:
+        out.update(node=ranking[0]["node"], heldout_rmse=ranking[0]["heldout_rmse"],
+                   tied_nodes=list(loc.tied_nodes), beside=beside_of(loc))
+    else:
+        out.update(heldout_rmse=num(best.heldout_rmse) if best is not None else None,
+                   why=no_node_reason(loc))
+    return clean(out)
+
+
+def beside_of(loc) -> dict | None:
+    """The located term fitted beside a single cause (:mod:`.stages.locate`):
+    ``{cause, location, values, node, heldout_rmse, aicc, alone_heldout_rmse,
+    alone_aicc, second_force}`` (``values``: the cause's parameters refitted
+    with the term; ``alone_*``: the cause fitted alone; ``second_force``: the
+    term beside it beats it alone), or None when it was not fitted."""
+    t, c = loc.beside, loc.beside_cause
+    if t is None or not c:
+        return None
+    return dict(cause=c["cause"], location=c["location"], values=dict(c["values"]),
+                node=t.node, heldout_rmse=num(t.heldout_rmse), aicc=num(t.aicc),
+                alone_heldout_rmse=num(c["alone_heldout"]), alone_aicc=num(c["alone_aicc"]),
+                second_force=bool(loc.second_force))
 
 
 def _one(label, f, extra):

@@ -19,9 +19,12 @@ linearised error is within ``REFINE_WITHIN`` of the best (at most
 ``REFINE_MAX``); the other nodes keep their linearised scores.
 
 When a single cause is named, the term is also fitted beside it at the
-located node (the cause's parameters refitted with it: :func:`beside`):
-a second, out-of-library force remains when that beats the named cause by
-``MARGIN`` AICc units and by held-out error.
+located node (the cause's parameters refitted with it: :func:`_beside`);
+with none named, beside each member of the library's best candidate that
+was fitted alone (:func:`beside_rows`: a friction at one site and a detent
+at another are a pair no library pair reproduces). A second,
+out-of-library force remains when the term beside the cause beats that
+cause alone by ``MARGIN`` AICc units and by held-out error.
 
 The verdict "not explained by the library" needs: the best generic term
 beats the best library candidate by more than ``MARGIN`` AICc units and by
@@ -130,9 +133,40 @@ class Location:
     floor_threshold: float = FLOOR_REACH
     best_node: str | None = None  # the best term's node (also when not "unexplained")
     tied_nodes: tuple = ()        # other nodes whose term the held-out data cannot tell apart
-    beside: Term | None = None    # the term fitted beside the named cause
-    second_force: bool = False    # ... beats the named cause alone: a second force remains
+    beside: Term | None = None    # the term fitted beside a single cause (beside_rows)
+    beside_cause: dict = field(default_factory=dict)   # that cause: cause, location, values
+                                  # (refitted with the term), alone_heldout, alone_aicc
+    second_force: bool = False    # ... beats the cause alone and the term alone: a second
+                                  # force remains beside that cause
     n_sim: int = 0                # simulations the stage ran
+
+
+def node_ranking(loc: Location) -> list:
+    """Every node's term, best first (lowest held-out error; the nodes
+    fitted in full before those scored by their linearised step only),
+    tied sites or not: ``{node, heldout_rmse, fitted, aicc, resolution,
+    members}``. Empty when no term was fitted."""
+    return [dict(node=t.node, heldout_rmse=_finite(t.heldout_rmse), fitted=t.fitted,
+                 aicc=_finite(t.aicc), resolution=list(t.resolution), members=list(t.members))
+            for t in loc.terms]
+
+
+def no_node_reason(loc: Location | None) -> str:
+    """One line: why no node could be judged (the stage did not run, or no
+    term could be built or fitted, with each node's reason)."""
+    if loc is None:
+        return "the located generic term was not run"
+    if loc.terms:
+        return ""
+    failed = (loc.details or {}).get("failed") or {}
+    text = loc.skipped or "no generic term could be fitted"
+    extra = "; ".join(f"{k}: {v}" for k, v in failed.items() if k not in text)
+    return text + (f" ({extra})" if extra else "")
+
+
+def _finite(x):
+    x = float(x)
+    return x if np.isfinite(x) else None
 
 
 def needed(dec, rk) -> bool:
@@ -146,23 +180,52 @@ def _params(graph, loc, n_x, n_v):
                  for s in gen.GenericForce(n_x, n_v).params(graph, loc))
 
 
-def generic_candidates(problem, n=1, n_x=N_X, n_v=N_V):
+def generic_candidates(problem, n=1, n_x=N_X, n_v=N_V, runs=()):
     """(Candidate, knot ranges, members) of the generic term of ``n_x`` x
     ``n_v`` knots at every body node; ``n`` data values set the penalty's
-    weight (generic.SMOOTH per value)."""
-    from ..library.graph import ModelGraph
-    from ..library.nominal import nominal_result
-    from ...modelfile import load_model_file
-    graph = ModelGraph(load_model_file(problem.model_path).model,
-                       result=nominal_result(problem.model_path))
+    weight (generic.SMOOTH per value). ``runs``: simulation results of the
+    calibrated model on every experiment; the knots then span the positions
+    and velocities they cover (:func:`data_ranges`), set as the candidate's
+    fixed values, else the model file's nominal run's."""
+    graph = _graph(problem)
     out = []
     for loc in GENERIC.candidates(graph):
+        rng = data_ranges(graph, loc, runs) if runs else None
         out.append((Candidate(GENERIC.id, loc, _params(graph, loc, n_x, n_v),
-                              penalty(n_x, n_v, SMOOTH * n)),
-                    tuple(GENERIC.ranges(graph, loc)),
+                              penalty(n_x, n_v, SMOOTH * n),
+                              gen.range_values(rng) if rng is not None else ()),
+                    tuple(rng if rng is not None else GENERIC.ranges(graph, loc)),
                     tuple(sorted({p.owner.path for p in
                                   graph.nodes[graph.node(graph.components[loc].flange)]}))))
     return out
+
+
+def data_ranges(graph, loc, runs):
+    """The knot ranges at the body ``loc`` over every run in ``runs`` (its
+    position and velocity, :func:`.generic.knot_ranges`): a term whose knots
+    span only the model file's nominal run is zero wherever an experiment
+    goes further (a larger drive torque, a faster start). None when no run
+    records them."""
+    from ..library.domain import domain_of
+    dom = domain_of(graph.components[loc])
+    xs, vs = [], []
+    for res in runs:
+        try:
+            xs.append(np.asarray(res[f"{loc}.{dom.across}"], float))
+            vs.append(np.asarray(res[f"{loc}.{dom.rate}"], float))
+        except KeyError:
+            continue
+    return gen.knot_ranges(xs, vs) if xs else None
+
+
+def calibrated_runs(problem, cal):
+    """The calibrated nominal model simulated on every experiment (main
+    process, one run each; a failed run is left out)."""
+    from ..problem import NOMINAL
+    from .views import simulate_all
+    return [r for r in simulate_all(model_of(problem, NOMINAL), dataset_of(problem),
+                                    cal.fit.values, problem.settings.integrator).values()
+            if r is not None]
 
 
 def degenerate_directions(Jg, Jf):
@@ -455,11 +518,12 @@ def chosen_candidate(node: _Node, graph, n, beside=None):
                    for i, q in enumerate(base))
     P = np.vstack([penalty(ch.n_x, ch.n_v, ch.lam_x * n, ch.lam_v * n), ch.pins])
     if beside is None:
-        return Candidate(GENERIC.id, node.cand.location, params, P)
+        return Candidate(GENERIC.id, node.cand.location, params, P, node.cand.fixed)
     own = tuple(dataclasses.replace(q, start=float(beside.fit.values[q.name]))
                 for q in beside.candidate.params)
     return Candidate(f"{beside.candidate.hypothesis}+{GENERIC.id}",
-                     f"{beside.candidate.location}+{node.cand.location}", own + params, P)
+                     f"{beside.candidate.location}+{node.cand.location}", own + params, P,
+                     node.cand.fixed)
 
 
 def _free_step(task: FitTask, node: _Node) -> FitTask:
@@ -538,7 +602,7 @@ def locate(ctx, problem, cal, dec, rk) -> Location:
     t0 = time.perf_counter()
     n = cal.fit.n
     fine = (gen.X_LADDER[-1], gen.V_LADDER[-1])
-    gens = generic_candidates(problem, n, *fine)
+    gens = generic_candidates(problem, n, *fine, runs=calibrated_runs(problem, cal))
     if not gens:
         return Location(skipped="the model has no body node")
     nodes = [_Node(*g) for g in gens]
@@ -583,34 +647,61 @@ def locate(ctx, problem, cal, dec, rk) -> Location:
                                 smooth_v=nd.choice.lam_v, heldout_linear=nd.choice.heldout,
                                 edf=nd.choice.edf)
         for nd in nodes if nd.choice is not None})
-    named = rk.named
-    if terms and named is not None and "+" not in named.candidate.hypothesis:
+    beside = beside_rows(rk) if terms else []
+    if beside:
         best = next(nd for nd in nodes if nd.cand.location == terms[0].node)
-        bt = _beside(ctx, problem, cal, dec, named, best, graph)
-        if bt is not None:
-            n_sim += bt[1]
-            out.n_sim = n_sim
-            out.beside, t = bt[0], bt[0]
-            out.second_force = bool(named.aicc - t.aicc > MARGIN
-                                    and t.heldout_rmse < named.heldout_rmse)
-            out.reason += (f"; beside the named {named.candidate.label}, the term at "
+        got = _beside(ctx, problem, cal, dec, beside, best, graph)
+        n_sim += sum(m for _, _, m in got)
+        out.n_sim = n_sim
+        if got:
+            row, t, _ = min(got, key=lambda x: (x[1].heldout_rmse, x[1].aicc))
+            out.beside, out.beside_cause = t, dict(
+                cause=row.candidate.hypothesis, location=row.candidate.location,
+                values={q.name: float(t.values[q.name]) for q in row.candidate.params},
+                alone_heldout=float(row.heldout_rmse), alone_aicc=float(row.aicc))
+            out.second_force = bool(row.aicc - t.aicc > MARGIN
+                                    and t.heldout_rmse < row.heldout_rmse)
+            which = "named" if rk.named is not None else "library's best single"
+            out.reason += (f"; beside the {which} {row.candidate.label}, the term at "
                            f"{t.node} {'leaves' if out.second_force else 'does not leave'} "
-                           f"a second force (AICc {named.aicc - t.aicc:+.1f} units, held-out "
-                           f"{named.heldout_rmse:.3g} -> {t.heldout_rmse:.3g})")
+                           f"a second force (AICc {row.aicc - t.aicc:+.1f} units, held-out "
+                           f"{row.heldout_rmse:.3g} -> {t.heldout_rmse:.3g}; the term alone "
+                           f"{terms[0].heldout_rmse:.3g})")
     out.wall_s = time.perf_counter() - t0
     return out
 
 
-def _beside(ctx, problem, cal, dec, named, node, graph):
-    """(Term, simulations) of the term at ``node`` fitted beside the named
-    single cause (its parameters refitted with it), or None when it fails."""
+def beside_rows(rk) -> list:
+    """The single causes the term is fitted beside: the named one; with none
+    named, each member of the best library candidate (a pair's two, or the
+    single itself) that was fitted alone, to see whether one in-library
+    cause plus one out-of-library force explains what neither does alone
+    (a friction with a detent elsewhere)."""
+    named = rk.named
+    if named is not None:
+        return [named] if "+" not in named.candidate.hypothesis else []
+    best = rk.best
+    if best is None:
+        return []
+    keys = [(h, loc) for h, loc, _ in best.candidate.members()]
+    singles = {r.candidate.key: r for r in rk.rows if "+" not in r.candidate.hypothesis
+               and r.fit is not None}
+    return [singles[k] for k in dict.fromkeys(keys) if k in singles]
+
+
+def _beside(ctx, problem, cal, dec, rows, node, graph):
+    """[(row, Term, simulations)] of the term at ``node`` fitted beside each
+    single cause in ``rows`` (its parameters refitted with it); a fit that
+    fails is left out."""
     n = cal.fit.n
-    cand = chosen_candidate(node, graph, n, beside=named)
-    task = _free_step(fit_tasks(problem.from_fit(), cal, [cand])[0], node)
-    r = ctx.run(fit_candidate, [task], "locating beside the named cause")[0]
-    if not r.ok:
-        return None
-    return _term(r, n, dec.c_hat, node, beside=named.candidate.label), r.fit.n_sim
+    cands = [chosen_candidate(node, graph, n, beside=r) for r in rows]
+    tasks = [_free_step(t, node) for t in fit_tasks(problem.from_fit(), cal, cands)]
+    out = []
+    for row, r in zip(rows, ctx.run(fit_candidate, tasks, "locating beside a cause")):
+        if r.ok:
+            out.append((row, _term(r, n, dec.c_hat, node, beside=row.candidate.label),
+                        r.fit.n_sim))
+    return out
 
 
 def _verdict(terms, dec, rk, n) -> Location:

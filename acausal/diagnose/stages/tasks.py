@@ -126,9 +126,9 @@ def model_of(problem: Problem, candidate: Candidate):
         return compile_file(problem.model_path)
     if carries_generic(candidate):           # the generic term, alone or beside a cause
         return worker_cache(("diagnose-generic", _stamp(problem.model_path), problem.library,
-                             generic_members(candidate)), lambda: generic_model(
-                                 problem.model_path, candidate,
-                                 load_library(problem.library).HYPOTHESES))
+                             generic_members(candidate), candidate.fixed),
+                            lambda: generic_model(problem.model_path, candidate,
+                                                  load_library(problem.library).HYPOTHESES))
     if "+" in candidate.hypothesis:          # a pair: "h1+h2" at "l1+l2"
         pair = tuple(zip(candidate.hypothesis.split("+"), candidate.location.split("+")))
         return worker_cache(("diagnose-pair", _stamp(problem.model_path), problem.library,

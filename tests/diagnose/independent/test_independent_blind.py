@@ -34,4 +34,8 @@ def test_independent_case(name):
           f"errors {row['errors']}; held-out {row['heldout_before']:.3f} -> "
           f"{row['heldout_after']:.3f}; {row['wall_s']:.0f} s, {row['n_sim']} simulations")
     assert not row["wrong"], f"named a cause the truth lacks: {row['wrong']}"
+    un = row["unexplained"]
+    if un["value"]:    # "not explained" always points somewhere, or says why not
+        assert un["node"] or un["why"], f"not explained, no node and no reason: {un}"
+        assert not un["node"] or un["node"] == un["nodes"][0]["node"]
     assert row["ok"], f"{row['why']}: got {row['verdict']}, errors {row['errors']} %"
