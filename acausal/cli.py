@@ -687,6 +687,10 @@ def linearize(file, at, inputs, outputs, sets, out, as_json):
         params = _parse_sets(sets)
         mf, cm = compile_file(file)
         point = _parse_at(at)
+        if isinstance(point, float) and not (math.isfinite(point)
+                                             and point >= mf.experiment.t0):
+            raise UsageError(f"--at {at}: a time must be finite and at or after the model "
+                             f"file's t0 = {mf.experiment.t0:g} s")
         lin = lin_(cm, at=point, inputs=inputs, outputs=outputs, params=params,
                    t=mf.experiment.t0 if not isinstance(point, float) else None,
                    run=RunSettings(rtol=mf.experiment.rtol, atol=mf.experiment.atol))
@@ -775,19 +779,15 @@ def calibrate(file, data, fit, method, experiments, profile, as_json, json_file,
 def _calibrate(cal, compile_file, file, data, fit, method, experiments, profile):
     """The calibration's work: (result, dataset fitted, ModelFile, CompiledModel)."""
     from .data.thinning import thin_traces
-    mf, cm = compile_file(file)
-    ds = thin_traces(cal.model_dataset(file, data), say=True)
-    _condition_warnings(mf, ds)
+    items = _csv_list(fit, "--fit")          # (the lists first: before any compiling)
     chosen = None
     if experiments is not None:
         chosen = ("all" if experiments.strip() == "all"
                   else _csv_list(experiments, "--experiments"))
-        if chosen == []:
-            raise UsageError("--experiments: the list is empty (give names, or 'all')")
+    mf, cm = compile_file(file)
+    ds = thin_traces(cal.model_dataset(file, data), say=True)
+    _condition_warnings(mf, ds)
     ds, held = cal.split(ds, chosen)
-    items = _csv_list(fit, "--fit")
-    if not items:
-        raise UsageError("--fit: no parameter named (give --fit P1,P2)")
     if method == "report":
         pairs = []
         for it in items:
@@ -1092,7 +1092,7 @@ def tolerance(file, spec, n, sampling, seed, measures, out, plot_prefix, json_pa
             tol.check_n(n, sampling)
             mf, cm = compile_file(file)
             dists = tol.parse_spec(spec, cm)
-            measures = _csv_list(",".join(measures), "--measure") or list(mf.measures)
+            measures = _csv_list(",".join(measures), "--measure", empty_ok=True) or list(mf.measures)
             if not measures:
                 raise UsageError(f"{file}: the model file defines no measures to study")
             for m in measures:
@@ -1199,13 +1199,34 @@ def _resumable(where):
         sys.exit(130)
 
 
-def _csv_list(text, option):
-    """A comma-separated option value as a list (None stays None); a name
-    given twice is refused (``--fit contact.K,contact.K`` fitted one
-    parameter, silently)."""
+def unexplained_line(un):
+    """The summary line of a "not explained" verdict: the located term's
+    best node (and whether it beats the library's best candidate), or why
+    no node could be judged ("located at the node of None" before)."""
+    head = "discrepancy not explained by the library"
+    if not un.get("node"):
+        return f"{head}; no node located: {un.get('why') or 'no located generic term'}"
+    held = un.get("heldout_rmse")
+    where = f"; located at the node of {un['node']}" + (
+        f" (held-out {held:.3g} floor units)" if held is not None else "")
+    if not un.get("beats_library", True):
+        near = un.get("nearest_heldout_rmse")
+        where += (", where a generic term does not beat the library's best candidate"
+                  + (f" ({near:.3g})" if near is not None else ""))
+    return head + where
+
+
+def _csv_list(text, option, empty_ok=False):
+    """A comma-separated option value as a list (None stays None), checked
+    before anything is compiled: an empty list (unless ``empty_ok``) and a
+    name given twice are refused (``--fit contact.K,contact.K`` fitted one
+    parameter, silently; ``--hypotheses ,`` was refused only after the
+    model's C code was built)."""
     if text is None:
         return None
     items = [x.strip() for x in text.split(",") if x.strip()]
+    if not items and not empty_ok:
+        raise UsageError(f"{option} {text!r}: the list is empty")
     twice = sorted({x for x in items if items.count(x) > 1})
     if twice:
         raise UsageError(f"{option} {text!r}: {', '.join(twice)} named twice")
@@ -1264,6 +1285,8 @@ def diagnose(file, data, json_opt, json_file, report_dir, scheduler, workers, ma
         json_path = json_opt
     try:
         with _quiet_warnings():
+            hyps = _csv_list(hypotheses, "--hypotheses")
+            locs = _csv_list(locations, "--locations")
             if json_path:
                 _check_output(json_path, "--json-file")
             _check_output(os.path.join(report_dir, "report.md"), "--report", create=True)
@@ -1275,8 +1298,7 @@ def diagnose(file, data, json_opt, json_file, report_dir, scheduler, workers, ma
                     Watchdog(limit, max_wall, "the diagnosis"):
                 out = run_diagnosis(file, data, out_dir=report_dir, scheduler=scheduler,
                                     workers=workers, progress=not no_progress,
-                                    hypotheses=_csv_list(hypotheses, "--hypotheses"),
-                                    locations=_csv_list(locations, "--locations"), alpha=alpha,
+                                    hypotheses=hyps, locations=locs, alpha=alpha,
                                     library=library,
                                     settings=FitSettings(lhs=starts, refine=refine),
                                     on_resume=lambda n, path: click.echo(
@@ -1294,8 +1316,7 @@ def diagnose(file, data, json_opt, json_file, report_dir, scheduler, workers, ma
     if not out["discrepancy"]:
         click.echo("no significant discrepancy between the calibrated model and the data")
     elif out["unexplained"]["value"]:
-        click.echo(f"discrepancy not explained by the library; located at the node of "
-                   f"{out['unexplained']['node']}")
+        click.echo(unexplained_line(out["unexplained"]))
     elif out["cause"] is None:
         click.echo("discrepancy, but the evidence is weak: no cause named"
                    + (f" (best candidate: {out['ranking'][0]['cause']} at "

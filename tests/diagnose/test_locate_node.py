@@ -178,3 +178,17 @@ def test_the_term_beside_a_cause_is_reported_with_the_cause_refitted():
     assert b["heldout_rmse"] == pytest.approx(1.05) and b["alone_heldout_rmse"] == 3.2
     text = _where_sentence(un)
     assert "beside coulomb_friction at `cam`" in text and "leaves a second force" in text
+
+
+def test_the_command_line_names_the_node_or_says_why_not():
+    """`acausal diagnose` printed 'located at the node of None'."""
+    from acausal.cli import unexplained_line
+    line = unexplained_line(dict(value=True, node=None, why="the located generic term was "
+                                 "not run"))
+    assert "None" not in line and line.endswith("no node located: the located generic term "
+                                                "was not run")
+    line = unexplained_line(dict(value=True, node="follower", heldout_rmse=7.37,
+                                 beats_library=False, nearest_heldout_rmse=1.496))
+    assert "node of follower (held-out 7.37" in line and "does not beat" in line
+    assert "does not beat" not in unexplained_line(dict(value=True, node="motor",
+                                                        heldout_rmse=2.1, beats_library=True))
