@@ -99,32 +99,22 @@ def test_model_form_error_is_kept():
         assert whitened_heldout(f, loo) <= heldout_rms(loo) + 1e-12
 
 
-def test_explains_judges_the_whitened_error_once_ranked():
-    th = st.heldout_threshold(6000, 4, 3)
-    row = SimpleNamespace(heldout_rmse=4.4, heldout_white=1.0004)
-    assert vd.judged_heldout(row) == 1.0004 and vd.explains(row, th)
-    unranked = SimpleNamespace(heldout_rmse=4.4, heldout_white=float("nan"))
-    assert vd.judged_heldout(unranked) == 4.4 and not vd.explains(unranked, th)
-    assert not vd.explains(SimpleNamespace(heldout_rmse=1.0, heldout_white=3.0), th)
+def test_the_verdict_judges_the_plain_heldout_error_and_reports_the_whitened():
+    """A name still needs its plain held-out error within the threshold:
+    on the cam follower's three runs a hardening spring absorbed an
+    out-of-library detent to a whitened 1.008 (plain 1.76), as the right
+    friction + drag pair reached 1.0002 (plain 4.41). The whitened error is
+    said in the "not explained" reason, with what it suggests."""
+    from acausal.diagnose.problem import Candidate, Param
 
-
-def test_a_pair_earns_its_second_cause_by_the_judged_heldout_error():
-    """The cam follower's dry friction + drag (numbers of that run): the
-    plain held-out errors (pair 4.41, friction alone 4.37) are both the
-    fastest run predicted without it; judged beyond the parameters'
-    uncertainty (1.0002 against 1.0105), the pair predicts better and earns
-    its drag. With the pair's judged error the worse one, it does not."""
-    from acausal.diagnose.problem import Candidate, Param, pair_of
-    from acausal.diagnose.stages.chain import _pair_reasons
-
-    ssf = Candidate("stick_slip_friction", "cam", (Param("hyp_ssf.tau", 0, 0, 1, 1, 0),))
-    qd = Candidate("quadratic_damping", "cam", (Param("hyp_qd.c", 0, 0, 1, 1, 0),))
-    pair = SimpleNamespace(candidate=pair_of(ssf, qd), aicc=5993.65, heldout_rmse=4.409,
-                           heldout_white=1.0002)
-    single = SimpleNamespace(candidate=ssf, aicc=6042.9, heldout_rmse=4.375,
-                             heldout_white=1.0105)
-    drag = SimpleNamespace(candidate=qd, aicc=6100.0, heldout_rmse=9.96, heldout_white=1.12)
-    assert _pair_reasons(pair, [pair, single, drag]) == []
-    worse = SimpleNamespace(**{**vars(pair), "heldout_white": 1.02})
-    (why,) = _pair_reasons(worse, [worse, single, drag])
-    assert "stick_slip_friction at cam" in why and "1.0200 against 1.0105" in why
+    th = st.heldout_threshold(6006, 6, 3)
+    cand = Candidate("stick_slip_friction", "cam", (Param("hyp_ssf.tau", 0, 0, 1, 1, 0),))
+    right = SimpleNamespace(candidate=cand, heldout_rmse=4.409, heldout_white=1.0002)
+    assert not vd.explains(right, th)
+    assert vd.explains(SimpleNamespace(heldout_rmse=1.0, heldout_white=float("nan")), th)
+    text = vd.unexplained_reason(right, th).text
+    assert "4.409 floors" in text and "1 beyond its parameters' uncertainty" in text
+    assert "one experiment alone determines" in text
+    wrong_form = SimpleNamespace(candidate=cand, heldout_rmse=40.7, heldout_white=4.70)
+    text = vd.unexplained_reason(wrong_form, th).text
+    assert "4.7 beyond" in text and "alone determines" not in text

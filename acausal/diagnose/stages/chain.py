@@ -656,12 +656,7 @@ def _acted_in(best) -> set:
 
 def _pair_reasons(best, rows):
     """A pair is named only when it beats each of its single members by
-    STRONG AICc units and by held-out error, each judged as the verdict
-    judges it (:func:`.verdict.judged_heldout`: beyond the parameters'
-    uncertainty without each experiment). The plain held-out errors of the
-    cam follower's dry friction + drag, 4.41 for the pair and 4.37 for the
-    friction alone, were both the fastest run predicted without it (the
-    drag undetermined there); whitened, 1.0002 against 1.0105."""
+    STRONG AICc units and by held-out error."""
     if "+" not in best.candidate.hypothesis:
         return []
     out = []
@@ -670,11 +665,10 @@ def _pair_reasons(best, rows):
         if single is None:
             continue
         d = single.aicc - best.aicc
-        hb, hs = vd.judged_heldout(best), vd.judged_heldout(single)
-        if d < st.STRONG or not hb < hs:
+        if d < st.STRONG or not best.heldout_rmse < single.heldout_rmse:
             out.append(f"the pair does not earn its second cause against {h} at {loc} alone "
-                       f"(dAICc {d:.1f}, needs {st.STRONG:g}; held-out {hb:.4f} against "
-                       f"{hs:.4f}, beyond the parameters' uncertainty without each experiment)")
+                       f"(dAICc {d:.1f}, needs {st.STRONG:g}; held-out {best.heldout_rmse:.3g} "
+                       f"against {single.heldout_rmse:.3g})")
     return out
 
 

@@ -510,8 +510,9 @@ def whitened_heldout(f: Fit, loo: dict, penalty=None) -> float:
     no fault of the model's form (cam follower, dry friction + drag, the
     truth's own parameters on that run: 0.99 floors; refitted without it:
     7.4, whitened 0.99). An error the model's form leaves, in directions
-    the other experiments determine, is kept whole. NaN without a
-    Jacobian or residuals."""
+    the other experiments determine, is kept whole. Reported beside the
+    plain one, not judged (:func:`.verdict.explains` says why). NaN
+    without a Jacobian or residuals."""
     if not loo or f is None or f.jacobian is None or f.jacobian.size == 0:
         return float("nan")
     groups = np.asarray(f.groups)
