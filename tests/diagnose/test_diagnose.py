@@ -77,7 +77,10 @@ def test_blind_case_names_the_hidden_cause(blind):
     assert len(out["ranking"]) == 6
     assert out["ranking"][0] == {"cause": "coulomb_friction", "location": "latch",
                                  "aicc": out["ranking"][0]["aicc"],
-                                 "heldout_rmse": out["ranking"][0]["heldout_rmse"]}
+                                 "heldout_rmse": out["ranking"][0]["heldout_rmse"],
+                                 "heldout_whitened": out["ranking"][0]["heldout_whitened"]}
+    # the whitened held-out error (judged by the verdict) never exceeds the plain one
+    assert 0.5 < out["ranking"][0]["heldout_whitened"] <= out["ranking"][0]["heldout_rmse"]
     assert out["extended_model"] and os.path.exists(out["extended_model"])
     assert out["causes"] == [{"cause": "coulomb_friction", "location": "latch",
                               "family": "friction", "member": "coulomb_friction",

@@ -181,7 +181,9 @@ def summary(d: Diagnosis) -> dict:
         equivalent_causes=_equivalent(d),
         parameters={} if named is None else parameters(named),
         ranking=[dict(cause=r.candidate.hypothesis, location=r.candidate.location,
-                      aicc=num(r.aicc), heldout_rmse=num(r.heldout_rmse)) for r in rk.rows],
+                      aicc=num(r.aicc), heldout_rmse=num(r.heldout_rmse),
+                      heldout_whitened=num(getattr(r, "heldout_white", float("nan"))))
+                 for r in rk.rows],
         gain=gain(d),
         extended_model=d.extended_model,
         causes=causes,

@@ -30,11 +30,12 @@ from . import pairsearch as ps
 from . import stats as st
 from . import verdict as vd
 from .context import Context, longest_first, run_tasks  # noqa: F401 (run_tasks re-exported)
-from .fitting import Fit, heldout_rms
+from .fitting import Fit, heldout_rms, whitened_heldout
 from .screen import Unfitted
 from ..library.loader import FamilyIndex, family_index, load_library
 from ..problem import NOMINAL, Candidate, FitSettings, Param, Problem, free_param, pair_of
 from .tasks import CandidateFit, FitTask, LooTask, Starts, calibrate_nominal, fit_candidate, \
+    penalty_of, \
     refit_without
 from .tasks import MAX_TRACE_SAMPLES, MIN_TRACE_SAMPLES, thin_traces  # noqa: F401 (re-exported)
 
@@ -411,6 +412,9 @@ class Row:
     lr_p: float
     heldout_rmse: float
     heldout_exact: bool = False
+    # the held-out error beyond the parameters' uncertainty without each
+    # experiment (:func:`.fitting.whitened_heldout`; NaN until ranked)
+    heldout_white: float = float("nan")
 
     @property
     def k(self):
@@ -705,9 +709,12 @@ def rank(ds, cal: NominalFit, dec: Decision, cv: CrossValidation, unfitted=()) -
     library" otherwise, never "weak") and no weak-evidence rule objects; it
     is never named while a rival candidate is untested, or screened as
     plausible and left unfitted (``unfitted``: :class:`.screen.Unfitted`)."""
-    rows = tuple(dataclasses.replace(r, heldout_rmse=cv.heldout(r.candidate.key, r.loo),
-                                     heldout_exact=r.candidate.key in cv.exact)
-                 for r in dec.rows)
+    rows = tuple(dataclasses.replace(
+        r, heldout_rmse=cv.heldout(r.candidate.key, r.loo),
+        heldout_exact=r.candidate.key in cv.exact,
+        heldout_white=whitened_heldout(r.fit, cv.residuals(r.candidate.key, r.loo),
+                                       penalty_of(r.candidate)))
+        for r in dec.rows)
     held0 = cv.heldout(NOMINAL.key, cal.nominal.loo)
     if dec.discrepancy:
         rows = _explaining_first(rows, cal.fit.n, len(ds.experiments))
