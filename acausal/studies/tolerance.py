@@ -240,8 +240,9 @@ def parse_spec(path: str | os.PathLike, cm) -> list[Dist]:
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
-        raise UsageError(f"{path}: cannot read the tolerance spec ({exc.__class__.__name__}: "
-                         f"{exc})") from None
+        why = (getattr(exc, "strerror", None) or "not UTF-8 text"
+               if not isinstance(exc, FileNotFoundError) else "no such file")
+        raise UsageError(f"{path}: cannot read the tolerance spec: {why}") from None
     dists, bad, seen = [], [], {}
     for line, row in enumerate(csv.reader(text.splitlines()), start=1):
         cells = [c.strip() for c in row]
