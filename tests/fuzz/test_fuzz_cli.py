@@ -46,10 +46,10 @@ measures = {"s_end": lambda res: res.final()["body.s"]}
 
 NUMBERS = ["-1", "0", "nan", "inf", "-inf", "1e6", "1e-300", "1e300", "abc", "", " ", "1,5",
            "0x10", "1_000", "3", "0.5", "1e999", "-0.0", "2.5e", "None"]
-TIMES = ["-1", "0", "nan", "inf", "abc", "1e8", "1e-9", "0.05", "0.3", "1e300", ""]
+TIMES = ["-1", "0", "nan", "inf", "abc", "1e8", "1e-9", "0.05", "0.3", "1e300", "", "1e-200"]
 SIZES = ["4GB", "512MB", "1KB", "0", "-1GB", "abc", "1e9", "2GiB", "100", "1XB", ""]
 FIGS = ["o.png", "o.xyz", "o", "o.pdf", "o.PNG", "nodir/o.png", ".", "o.svg", "o.png/"]
-OUTS = ["o.csv", "nodir/o.csv", ".", "o.txt", "deep/er/o.csv"]
+OUTS = ["o.csv", "nodir/o.csv", ".", "o.txt", "deep/er/o.csv", "/proc/acausal_fuzz.csv"]
 
 
 def simulate_case(rng, model):
@@ -96,6 +96,10 @@ def other_case(rng, model):
          rng.choice(NUMBERS + ["1KB"]), "--report", "rep", "--locations", "nowhere"],
         ["animate", model, "--out", rng.choice(["a.gif", "nodir/a.gif"]), "--t-end",
          rng.choice(TIMES)],
+        ["linearize", model, "--at", rng.choice(TIMES + ["start", "equilibrium",
+                                                         "body.s=abc", "nothing=1", "body.s"])],
+        ["linearize", model, rng.choice(["--inputs", "--outputs"]),
+         rng.choice(["", ",", "nothing", "k.c,k.c", "body.s"])],
     ])
 
 
