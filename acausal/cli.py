@@ -15,6 +15,7 @@ terminal: a command that succeeds ends with one line counting them
 declared ranges get one warning line each.
 """
 import contextlib
+from dataclasses import dataclass
 import json
 import math
 import os
@@ -303,10 +304,11 @@ def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, max_rows, max_wa
     """Simulate a model file. Stopped by a limit, Ctrl-C or SIGTERM, it
     writes what it computed (--out, --plot, --json) and says where it stopped."""
     from .infra.budget import max_memory as memory_limit
+    from .infra.executor import exit_no_sooner
     from .modelfile import compile_file, measure_values
     res = error = None
     try:
-        with _interruptible(), _quiet_warnings():
+        with _interruptible() as phase, _quiet_warnings():
             _check_output(out, "--out")
             _check_output(plot, "--plot", plot=True)
             params = _parse_sets(sets)
@@ -321,10 +323,14 @@ def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, max_rows, max_wa
             opts["max_memory"] = memory_limit(max_memory)
             with _c_stdout_to_stderr() if as_json else contextlib.nullcontext():
                 res, error = _run_keeping_partial(cm, params, opts)
+            phase.writing = True
             measures, missing = measure_values(mf, res) if error is None else ({}, {})
             if out:
                 if len(res.t) > 100_000:    # (a million rows take seconds to write)
                     click.echo(f"acausal: writing {len(res.t):,} rows to {out}", err=True)
+                    # an interruption's grace covers the write (about 4 us a value)
+                    phase.grace = 60.0 + WRITE_S_PER_VALUE * len(res.t) * (1 + len(res.names))
+                    exit_no_sooner(phase.grace)
                 res.to_csv(out)
                 if error is not None:
                     click.echo(f"acausal: partial results up to t = {res.t[-1]:.6g} s written "
@@ -345,9 +351,14 @@ def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, max_rows, max_wa
         _print_run(mf, cm, res, measures, missing)
     if error is not None:
         _fail(error)
+    if phase.interrupted:
+        click.echo(f"acausal: interrupted ({phase.interrupted}) after the run had ended: its "
+                   "results were written first", err=True)
+        sys.exit(130)
 
 
 MIN_SPAN = 1e-15   # [s] the shortest run the command accepts (a femtosecond)
+WRITE_S_PER_VALUE = 20e-6   # [s] a generous time to write one CSV value (measured ~4 us)
 
 
 def _check_run_options(opts):
@@ -363,6 +374,15 @@ def _check_run_options(opts):
                          "run accepted")
 
 
+@dataclass
+class _Phase:
+    """What an interrupted command is doing: ``writing`` its results (a
+    signal then waits for them), ``interrupted`` by the signal named."""
+    writing: bool = False
+    interrupted: str = ""
+    grace: float = 0.0        # [s] the write's own time budget, once sized
+
+
 @contextlib.contextmanager
 def _interruptible():
     """Ctrl-C, SIGTERM and SIGHUP stop a running simulation with its partial
@@ -372,9 +392,17 @@ def _interruptible():
     process ends within the grace period whatever it is doing)."""
     from .runtime import hybrid as sim
     from .infra.executor import exit_soon
+    phase = _Phase()
 
     def handler(signum, frame):
         name = signal.Signals(signum).name
+        if phase.writing and not phase.interrupted:
+            # the run is over: its results are being written; finish them
+            # (the compiled backend's run can end between a signal and its
+            # handler, and the written results were lost to a KeyboardInterrupt)
+            phase.interrupted = name
+            exit_soon(130, grace=max(120.0, phase.grace))
+            return
         if not sim.STOP.reason and sim.request_stop(f"an interruption ({name})"):
             exit_soon(130, grace=120.0)     # time to write the partial result
             return
@@ -382,13 +410,13 @@ def _interruptible():
         raise KeyboardInterrupt(name)
 
     if not _in_main_thread():
-        yield
+        yield phase
         return
     names = [n for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n)]
     old = {n: signal.signal(getattr(signal, n), handler) for n in names}
     sim.STOP.armed = True
     try:
-        yield
+        yield phase
     finally:
         sim.STOP.armed = False
         for n, h in old.items():

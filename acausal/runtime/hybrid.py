@@ -718,9 +718,13 @@ class _Watch:
             return "rows"   # every step is stored (a two-point span)
         return None
 
-    def guard(self, steps_now):
+    def guard(self, steps_now, t=None):
         """The compiled backend's check, each time its output buffer fills:
-        True to end the call (its rows are kept)."""
+        True to end the call (its rows are kept). ``t``: the last row's
+        time, shown on the progress bar (a run of one long segment showed
+        its bar only at its end)."""
+        if t is not None:
+            self._show(t)
         self.stopping = self.stopping or self._hard(steps_now)
         return bool(self.stopping)
 

@@ -442,3 +442,19 @@ def test_calibrate_fits_a_long_trace_thinned(tmp_path):
     fitted = out["values"]["spring.c"] if "values" in out else out["parameters"]["spring.c"]
     fitted = fitted["value"] if isinstance(fitted, dict) else fitted
     assert abs(fitted - c) / c < 1e-3
+
+
+def test_a_sized_write_moves_the_exit_deadline_later():
+    """exit_no_sooner: an interrupted run's rows, sized in advance, are
+    written within a deadline moved later (5.4 M rows took about the whole
+    first grace of 120 s); without a pending deadline it does nothing."""
+    r = run_py("""
+        import time
+        from acausal.infra.executor import exit_soon, exit_no_sooner
+        exit_no_sooner(100.0)          # nothing pending: no deadline set
+        exit_soon(7, grace=0.5)
+        exit_no_sooner(3.0)
+        time.sleep(1.5)
+        print("written", flush=True)
+        """, timeout=600)
+    assert r.returncode == 0 and "written" in r.stdout, r.stderr

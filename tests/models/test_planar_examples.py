@@ -254,20 +254,30 @@ def test_dead_centre_is_warned_of_before_the_solver_fails():
 
 @pytest.mark.slow   # 3 s of simulation to the failure
 def test_a_solver_failure_away_from_a_dead_centre_is_not_called_one():
-    """The vertical-extreme crank-rocker from theta1_0 = 0.5 at rtol 9e-11
-    stops at t = 1.998 s (the coupler's acceleration passes through zero
-    among terms of 600 rad/s^2, below atol's rounding: docs/planar.md), with
-    its following joints bent at sine 0.94: the error names the loop and
-    says the failure is numerical, not a dead centre; a real dead centre
-    (test_dead_centre_names_the_loop) still is one."""
+    """The vertical-extreme crank-rocker from theta1_0 = 0.5 at tolerances
+    near rtol 1e-10 stops part-way (the coupler's acceleration passes
+    through zero among terms of 600 rad/s^2, below atol's rounding:
+    docs/planar.md), with its following joints bent at sine 0.94: the error
+    names the loop and says the failure is numerical, not a dead centre; a
+    real dead centre (test_dead_centre_names_the_loop) still is one.
+    Which tolerances fail is an accident of the step sequence: at rtol 9e-11
+    alone it failed at t = 1.998 s until the per-variable nominal changed
+    the steps (2026-11-27: 9e-11 then ran to 3 s, while 5e-11, 2e-11 and
+    1e-10 failed), so several are tried and every failure is checked."""
     from acausal.errors import SolverError
     from acausal.mechanics.planar.loops import LoopSingularityError
     from acausal.modelfile import compile_file
     _, cm = compile_file(FOURBAR)
-    with pytest.raises(SolverError) as err:
-        cm.simulate(t_end=3.0, rtol=9e-11, atol=1e-12, output_step=1e-3,
-                    params={**OTHER, "theta1_0": 0.5, "w1_0": 5.0, "spring.c": 0.0})
-    msg = str(err.value)
-    assert not isinstance(err.value, LoopSingularityError), msg
-    assert "\n" not in msg and "not near a dead centre" in msg and "linkage.pin_c" in msg
-    assert err.value.t == pytest.approx(err.value.result.t[-1])
+    failures = []
+    for rtol in (9e-11, 5e-11, 2e-11, 1e-10):
+        try:
+            cm.simulate(t_end=3.0, rtol=rtol, atol=1e-12, output_step=1e-3,
+                        params={**OTHER, "theta1_0": 0.5, "w1_0": 5.0, "spring.c": 0.0})
+        except SolverError as exc:
+            failures.append(exc)
+    assert failures, "no tolerance near 1e-10 fails: the case no longer tests the message"
+    for exc in failures:
+        msg = str(exc)
+        assert not isinstance(exc, LoopSingularityError), msg
+        assert "\n" not in msg and "not near a dead centre" in msg and "linkage.pin_c" in msg
+        assert exc.t == pytest.approx(exc.result.t[-1])

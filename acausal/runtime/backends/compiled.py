@@ -302,7 +302,7 @@ class CompiledSolver(SegmentSolver):
             if flag == _FULL:
                 if self.guard is not None:
                     L.acs_counters(self.h, self.counters.ctypes.data)
-                    if self.guard(int(self.counters[0])):
+                    if self.guard(int(self.counters[0]), float(bt[k - 1]) if k else None):
                         flag = 0      # stopped: the rows so far are the segment
                         break
                 continue
