@@ -24,8 +24,13 @@ def test_stop_strong_single_cause(tmp_path):
     out, det, floors = blind.run_case(STOP, stop_truth, tmp_path, "coulomb", 0.05,
                                       name="stop coulomb 0.05")
     assert 50 <= floors <= 500
-    assert blind.named(out) == {("coulomb_friction", "slider")}
-    assert blind.values(out)["hyp_cf.F"] == pytest.approx(0.05, rel=0.10)
+    # Coulomb's law: smoothed (coulomb_friction) or by events (stick_slip_friction,
+    # which refines it and was added after this case; it was named here on
+    # 8c07d19: the same law while the body slides)
+    (named,) = blind.named(out)
+    assert named in {("coulomb_friction", "slider"), ("stick_slip_friction", "slider")}
+    key = {"coulomb_friction": "hyp_cf.F", "stick_slip_friction": "hyp_ssf.F"}[named[0]]
+    assert blind.values(out)[key] == pytest.approx(0.05, rel=0.10)
     assert out["gain"]["after"]["heldout"] <= 1.2
 
 

@@ -167,10 +167,15 @@ def test_blind_next_experiment_then_the_second_run_names_one_cause(tmp_path):
     print(f"\nfirst run: cause {first['cause']}, class {first['equivalent_causes']}, "
           f"rivals {nxt['members']}")
     assert first["discrepancy"] and nxt["computed"] and nxt["decisive"]
-    # the class the data cannot split: a friction law and the constant load
-    assert sorted(m.split(" at ")[0] for m in nxt["members"]) in (
-        ["constant_load", m] for m in ("coulomb_friction", "coulomb_viscous_friction",
-                                       "stribeck_friction"))
+    # the class the data cannot split: the constant load (at one or more tied
+    # sites) and friction laws (on 8c07d19: constant_load twice, coulomb_friction
+    # and coulomb_viscous_friction, since family members beyond the budget get
+    # short fits instead of none)
+    kinds = {m.split(" at ")[0] for m in nxt["members"]}
+    friction = {"coulomb_friction", "coulomb_viscous_friction", "stribeck_friction",
+                "stick_slip_friction"}
+    assert "constant_load" in kinds and kinds - {"constant_load"}
+    assert kinds - {"constant_load"} <= friction, kinds
     c = nxt["conditions"]
     y = stick_slip(c["s0"], c["v0"], TIMES) + FLOOR * rng.standard_normal(TIMES.size)
     exps.append(MeasuredExperiment("next", dict(c), {}, Trace(TIMES, {"mass.s": y})))
