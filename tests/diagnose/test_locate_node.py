@@ -14,23 +14,10 @@ from acausal.diagnose.library import generic as gen
 from acausal.diagnose.report.markdown import _where_sentence
 from acausal.diagnose.report.result import unexplained
 from acausal.diagnose.stages import locate as L
+
+from .locate_fakes import RANGES, Decision as _Dec, Ranking as _Rk, term as _term
 from acausal.diagnose.stages import verdict as vd
 
-RANGES = (-1.2, 1.2, -3.0, 3.0)
-
-
-def _term(node, held, aicc=100.0, fitted="output error"):
-    return L.Term(node, (node,), 100.0, aicc, held, RANGES, {}, {}, fitted=fitted)
-
-
-class _Rk:
-    best = named = None
-    heldout0 = 30.0
-
-
-class _Dec:
-    a0 = 1e4
-    c_hat = 20.0
 
 
 def _diagnosis(kind, loc, best_held=1.6):

@@ -9,7 +9,8 @@ import pytest
 from acausal.diagnose.library import generic as gen
 from acausal.diagnose.stages import locate as L
 
-RANGES = (-1.2, 1.2, -3.0, 3.0)   # knot ranges (x, v) of the synthetic term
+from .locate_fakes import RANGES, Decision as _Dec, Ranking as _Rk, term as _term
+
 
 
 def _columns(law, seed=0, n_per=400, sigma=1.0, offset=0.0):
@@ -104,20 +105,6 @@ def test_band_is_the_fit_covariance():
     fits = [Hg @ np.linalg.lstsq(H, rng.normal(size=300), rcond=None)[0] for _ in range(300)]
     # sigma^2 = S / (n - edf) = 300 / 291 with unit noise
     assert np.std(fits, axis=0) * np.sqrt(300 / 291) == pytest.approx(sd, rel=0.12)
-
-
-def _term(node, held, aicc, fitted="output error"):
-    return L.Term(node, (node,), 100.0, aicc, held, RANGES, {}, {}, fitted=fitted)
-
-
-class _Rk:
-    best = named = None
-    heldout0 = 30.0
-
-
-class _Dec:
-    a0 = 1e4
-    c_hat = 20.0
 
 
 def test_location_is_the_best_held_out_and_says_if_it_reaches_the_floor():
