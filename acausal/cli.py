@@ -1018,9 +1018,7 @@ def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max
     from .studies.sweep import Journal, grid, parse_param, plot_sweep, run_sweep
     try:
         with _quiet_warnings():
-            measures = _csv_list(",".join(measures), "--measure")
-            if not measures:
-                raise UsageError("--measure: no measure named (give --measure M1,M2)")
+            measures = _csv_list(",".join(measures), "--measure")   # (refuses an empty list)
             _check_output(out, "--out", create=True)
             _check_output(plot, "--plot", plot=True, create=True)
             specs = [parse_param(p, max_points) for p in params]

@@ -8,9 +8,8 @@ import numpy as np
 
 from ..errors import UnknownNameError
 
-
-
 CSV_BLOCK = 50_000   # rows formatted at a time by Result.to_csv
+
 
 class Rows(NamedTuple):
     """The stored output rows of a run: times ``t``, unknowns ``y`` and
