@@ -328,23 +328,41 @@ def test_an_unwritable_output_or_a_vanishing_span_is_refused_before_the_run(tmp_
 
 
 def test_a_large_result_is_written_as_exact_csv(tmp_path):
-    """Result.to_csv writes blocks of rows; every value reads back bit for
-    bit (shortest round-trip repr) across block boundaries."""
-    from acausal.runtime import result as rmod
+    """Result.to_csv writes every value so that it reads back bit for bit
+    (shortest round-trip form), including -0.0, nan, infinities, subnormals
+    and the largest double, with the units in the header."""
+    from acausal.runtime.result import Result
     model = tmp_path / "spring.py"
     model.write_text(LONG_SPRING.format(step="1e-4").replace("t_end=1e6", "t_end=0.5"))
     from acausal.modelfile import run_file
     res, _ = run_file(str(model))
-    old, rmod.CSV_BLOCK = rmod.CSV_BLOCK, 777
-    try:
-        res.to_csv(tmp_path / "o.csv")
-    finally:
-        rmod.CSV_BLOCK = old
+    res.to_csv(tmp_path / "o.csv")
     back = np.loadtxt(tmp_path / "o.csv", delimiter=",", skiprows=1)
     assert back.shape == (len(res.t), 1 + len(res.names))
     assert np.array_equal(back[:, 0], res.t)
     for j, n in enumerate(res.names):
         assert np.array_equal(back[:, 1 + j], np.asarray(res[n], dtype=float)), n
+    header = (tmp_path / "o.csv").read_text().splitlines()[0].split(",")
+    assert header[0] == "time [s]" and all(h.endswith("]") for h in header)
+
+    odd = np.array([0.0, -0.0, np.nan, np.inf, -np.inf, 5e-324, 1.7976931348623157e308,
+                    0.1, 1 / 3, 1.2345678901234568e17, 1e-300, 2.5e-7])
+
+    class Odd(Result):   # the same writer on hand-made columns
+        names = ["x"]
+
+        def __init__(self):
+            self.t = np.arange(len(odd), dtype=float)
+
+        def __getitem__(self, name):
+            return odd
+
+        def unit(self, name):
+            return "m"
+
+    Odd().to_csv(tmp_path / "odd.csv")
+    got = np.loadtxt(tmp_path / "odd.csv", delimiter=",", skiprows=1)[:, 1]
+    assert np.array_equal(got, odd, equal_nan=True) and np.signbit(got[1])
 
 
 def test_plausibility_warnings_are_one_line_each(capsys):
