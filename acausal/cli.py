@@ -26,7 +26,7 @@ import warnings
 import click
 import numpy as np
 
-from .errors import AcausalError, Interrupted, SolverError, UsageError
+from .errors import AcausalError, Interrupted, LimitError, SolverError, UsageError
 
 
 def _fail(exc):
@@ -151,6 +151,38 @@ def _check_output(path, option, *, plot=False, create=False):
     _probe_write(path, option)
 
 
+def _check_distinct(outputs, inputs):
+    """Refuse, before anything runs, an output (``(option, path)`` pairs)
+    that is one of the command's inputs (the model file, a spec, a file of
+    the data folder) or the same file as another output: ``calibrate
+    --json-file DATA/experiments.csv`` overwrote the measured data with the
+    fit's JSON, exit 0."""
+    def key(path):
+        return os.path.realpath(os.fspath(path))
+    read = {}
+    for given in (p for p in inputs if p is not None):
+        if os.path.isdir(given):
+            try:
+                names = os.listdir(given)
+            except OSError:
+                names = []
+            read.update((key(os.path.join(given, n)), os.path.join(given, n)) for n in names)
+        else:
+            read[key(given)] = os.fspath(given)
+    taken = {}
+    for option, path in outputs:
+        if path is None:
+            continue
+        k = key(path)
+        if k in read:
+            raise UsageError(f"{option} {path}: is an input of the command ({read[k]}): "
+                             "writing it would destroy it; choose another file")
+        if k in taken:
+            raise UsageError(f"{option} {path}: the same file as {taken[k]}; give each "
+                             "output its own file")
+        taken[k] = f"{option} {path}"
+
+
 def _probe_write(path, option):
     """Open ``path`` for appending, as the writer will, and leave no trace:
     ``os.access`` says yes to root where the file system says no (``/sys``,
@@ -203,10 +235,14 @@ def _far_settings(cm, params):
         except AcausalError:
             continue
         d = e.default
-        if d and value and math.isfinite(value) and (abs(math.log10(abs(value / d))) >= SUSPECT_DECADES or
-                            (value > 0) != (d > 0)):
+        if not (d and value and math.isfinite(value) and math.isfinite(d)):
+            continue
+        # decades as a difference of logs: value / d underflowed to 0 for a
+        # subnormal value (--set c=5e-324: log10(0), a traceback)
+        decades = abs(math.log10(abs(value)) - math.log10(abs(d)))
+        if decades >= SUSPECT_DECADES or (value > 0) != (d > 0):
             _warn(f"--set {name}={value:g} [{e.unit}] is far from its default {d:g} "
-                  f"[{e.unit}] ({abs(math.log10(abs(value / d))):.1f} decades"
+                  f"[{e.unit}] ({decades:.1f} decades"
                   f"{', other sign' if (value > 0) != (d > 0) else ''}): check its value "
                   "and unit")
 
@@ -219,6 +255,8 @@ def _parse_sets(sets):
         if "=" not in item:
             raise UsageError(f"--set {item!r}: expected PATH=VALUE")
         k, v = item.split("=", 1)
+        if k.strip() in out:     # (the last one silently won)
+            raise UsageError(f"--set {item!r}: {k.strip()} is set twice", variable=k.strip())
         try:
             out[k.strip()] = float(v)
         except ValueError:
@@ -303,24 +341,33 @@ def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, max_rows, max_wa
              max_memory, progress, backend):
     """Simulate a model file. Stopped by a limit, Ctrl-C or SIGTERM, it
     writes what it computed (--out, --plot, --json) and says where it stopped."""
+    from .infra.budget import Watchdog, tripped
     from .infra.budget import max_memory as memory_limit
     from .infra.executor import exit_no_sooner
     from .modelfile import compile_file, measure_values
     res = error = None
+    limit = memory_limit(max_memory)
     try:
-        with _interruptible() as phase, _quiet_warnings():
+        # the whole command is watched for memory (a model file's or a measure's own
+        # allocations too: 6 GB passed a 1 GB limit); --max-wall also bounds reading
+        # and compiling the model file (one that never returned ignored it); the run
+        # then has its own --max-wall, as before, and keeps its rows
+        with _interruptible() as phase, _quiet_warnings(), \
+                Watchdog(limit, max_wall, "the simulation") as watch:
             _check_output(out, "--out")
             _check_output(plot, "--plot", plot=True)
+            _check_distinct([("--out", out), ("--plot", plot)], [file])
             params = _parse_sets(sets)
             mf, cm = compile_file(file)
             cm.param_vector(cm.split_overrides(params)[0])   # names, bounds: errors first
             _far_settings(cm, params)
+            watch.max_wall = None   # the run checks its own wall time and keeps its rows
             opts = _simulate_options(mf, dict(t_end=t_end, rtol=rtol, atol=atol,
                                               max_rows=max_rows, max_wall=max_wall,
                                               max_total_steps=max_steps, backend=backend),
                                      progress, dense=bool(out or plot))
             _check_run_options(opts)
-            opts["max_memory"] = memory_limit(max_memory)
+            opts["max_memory"] = limit
             with _c_stdout_to_stderr() if as_json else contextlib.nullcontext():
                 res, error = _run_keeping_partial(cm, params, opts)
             phase.writing = True
@@ -331,17 +378,20 @@ def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, max_rows, max_wa
                     # an interruption's grace covers the write (about 4 us a value)
                     phase.grace = 60.0 + WRITE_S_PER_VALUE * len(res.t) * (1 + len(res.names))
                     exit_no_sooner(phase.grace)
-                res.to_csv(out)
+                _write_rows(res, out)
                 if error is not None:
                     click.echo(f"acausal: partial results up to t = {res.t[-1]:.6g} s written "
                                f"to {out}", err=True)
             if plot:
                 _plot(mf, res, plot, partial=error is not None)
+            _nonfinite_warning(res, every_row=bool(out or plot))
     except (AcausalError, click.BadParameter) as exc:
         if as_json:
             click.echo(json.dumps({"error": _error_dict(exc)}, indent=1))
         _fail(exc)
     except KeyboardInterrupt:
+        if tripped():
+            _fail(LimitError(f"{tripped()}, before the simulation started: nothing computed"))
         click.echo("acausal: interrupted before the simulation started: nothing computed",
                    err=True)
         sys.exit(130)
@@ -355,6 +405,56 @@ def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, max_rows, max_wa
         click.echo(f"acausal: interrupted ({phase.interrupted}) after the run had ended: its "
                    "results were written first", err=True)
         sys.exit(130)
+
+
+def _write_rows(res, out):
+    """``res.to_csv(out)``; a write that fails there (a full disk: /dev/full
+    gave a traceback) is one line saying what was lost."""
+    try:
+        res.to_csv(out)
+    except OSError as exc:
+        raise AcausalError(f"--out {out}: writing the {len(res.t):,} rows failed: "
+                           f"{exc.strerror or exc}; the run up to t = {res.t[-1]:.6g} s "
+                           "is lost with it: free space or write elsewhere") from None
+
+
+def _write_json(path, obj, option, **kw):
+    """``obj`` as JSON in ``path``; a failed write (a full disk) is one line."""
+    try:
+        with open(path, "w", encoding="utf-8") as f:
+            json.dump(obj, f, indent=1, **kw)
+    except OSError as exc:
+        raise AcausalError(f"{option} {path}: writing failed: {exc.strerror or exc}"
+                           ) from None
+
+
+def _nonfinite_warning(res, every_row):
+    """One line when variables of the result are NaN or infinite (log of a
+    negative number, 1/0 in an observed variable: the run went on, exit 0,
+    and nothing said so): the first one, where, and how many. ``every_row``:
+    every row is searched (the CSV or the plot computed them all), else the
+    final values only."""
+    if not len(res.t):
+        return
+    bad = {}
+    if every_row:
+        for name in res.names:
+            try:
+                v = np.asarray(res[name], dtype=float)
+            except (AcausalError, TypeError, ValueError):
+                continue
+            hit = np.flatnonzero(~np.isfinite(v))
+            if hit.size:
+                bad[name] = (float(res.t[hit[0]]), float(v[hit[0]]))
+    else:
+        bad = {n: (float(res.t[-1]), v) for n, v in res.final().items()
+               if not math.isfinite(v) and n in set(res.names)}
+    if bad:
+        name, (t, v) = min(bad.items(), key=lambda kv: kv[1][0])
+        where = f"from t = {t:.6g} s on" if every_row else f"at the end, t = {t:.6g} s"
+        _warn(f"{name} is {v} {where}" + (f" ({len(bad) - 1} other variable(s) "
+              "too)" if len(bad) > 1 else "") + ": the model computes a value outside its "
+              "domain there (a log or square root of a negative number, a division by zero)")
 
 
 MIN_SPAN = 1e-15   # [s] the shortest run the command accepts (a femtosecond)
@@ -395,7 +495,10 @@ def _interruptible():
     phase = _Phase()
 
     def handler(signum, frame):
+        from .infra.budget import tripped
         name = signal.Signals(signum).name
+        if tripped():     # the watchdog: a limit, named
+            name = tripped()
         if phase.writing and not phase.interrupted:
             # the run is over: its results are being written; finish them
             # (the compiled backend's run can end between a signal and its
@@ -403,7 +506,8 @@ def _interruptible():
             phase.interrupted = name
             exit_soon(130, grace=max(120.0, phase.grace))
             return
-        if not sim.STOP.reason and sim.request_stop(f"an interruption ({name})"):
+        if not sim.STOP.reason and sim.request_stop(name if tripped() else
+                                                    f"an interruption ({name})"):
             exit_soon(130, grace=120.0)     # time to write the partial result
             return
         exit_soon(130, grace=5.0)
@@ -519,12 +623,13 @@ def _plot(mf, res, path, partial=False):
     """The model file's plot (or its list of variables), else the states.
     A partial result that the model file's plot function cannot draw gets
     the default plot."""
+    from .modelfile import call_plot
     custom = mf.namespace.get("plot")
     if callable(custom):
         try:
-            custom(res, path)
+            call_plot(mf, res, path)
             return
-        except Exception:  # noqa: BLE001 - only for a partial result, see below
+        except AcausalError:   # one line naming the file's line; a partial result: see above
             if not partial:
                 raise
         custom = None
@@ -554,6 +659,7 @@ def animate(file, out, t_end, sets, fps, frames, max_wall, max_memory):
             if os.path.splitext(out)[1].lower() not in (".gif", ".mp4"):
                 raise UsageError(f"--out {out}: an animation is written as .gif or .mp4")
             _check_output(out, "--out")
+            _check_distinct([("--out", out)], [file])
             mf, cm = compile_file(file)
             opts = mf.experiment.run_options()
             if t_end is not None:
@@ -626,7 +732,8 @@ def variables(file, only_states, pattern):
     names one of them as its column."""
     from .modelfile import compile_file
     try:
-        mf, cm = compile_file(file)
+        with _quiet_warnings():      # a model file's own warnings: one line, counted
+            mf, cm = compile_file(file)
     except AcausalError as exc:
         _fail(exc)
     keep = _name_filter(pattern)
@@ -678,8 +785,9 @@ def check(file, as_json):
     from .compiler.check import check_model
     from .modelfile import compile_file
     try:
-        mf, cm = compile_file(file)
-        report = check_model(None, compiled=cm)
+        with _quiet_warnings():      # a model file's own warnings: one line, counted
+            mf, cm = compile_file(file)
+            report = check_model(None, compiled=cm)
     except AcausalError as exc:
         _fail(exc)
     if as_json:
@@ -712,8 +820,14 @@ def linearize(file, at, inputs, outputs, sets, out, as_json):
     from .analysis import RunSettings, linearize as lin_
     from .modelfile import compile_file
     try:
+        if out:
+            if os.path.splitext(out)[1].lower() not in (".json", ".npz"):
+                raise UsageError(f"--out {out}: a linearisation is written as .json or .npz")
+            _check_output(out, "--out")
+            _check_distinct([("--out", out)], [file])
         params = _parse_sets(sets)
-        mf, cm = compile_file(file)
+        with _quiet_warnings():      # a model file's own warnings: one line, counted
+            mf, cm = compile_file(file)
         point = _parse_at(at)
         if isinstance(point, float) and not (math.isfinite(point)
                                              and point >= mf.experiment.t0):
@@ -791,6 +905,7 @@ def calibrate(file, data, fit, method, experiments, profile, as_json, json_file,
     try:
         if json_file:
             _check_output(json_file, "--json-file")
+            _check_distinct([("--json-file", json_file)], [file, data])
         with _quiet_warnings(), _resumable("nothing (a calibration keeps no partial result)"), \
                 Watchdog(memory_limit(max_memory), max_wall, "the calibration"):
             out, ds, held, mf, cm = _calibrate(cal, compile_file, file, data, fit, method,
@@ -799,8 +914,10 @@ def calibrate(file, data, fit, method, experiments, profile, as_json, json_file,
         _fail(exc)
     _calibration_warnings(mf, cm, ds, held, out)
     if json_file:
-        with open(json_file, "w") as f:
-            json.dump(out.to_dict(), f, indent=1, default=float)
+        try:
+            _write_json(json_file, out.to_dict(), "--json-file", default=float)
+        except AcausalError as exc:
+            _fail(exc)
     _print_calibration(out, ds, mf, file, data, as_json)
 
 
@@ -815,6 +932,7 @@ def _calibrate(cal, compile_file, file, data, fit, method, experiments, profile)
     mf, cm = compile_file(file)
     ds = thin_traces(cal.model_dataset(file, data), say=True)
     _condition_warnings(mf, ds)
+    _trace_span_warnings(mf, ds)
     ds, held = cal.split(ds, chosen)
     if method == "report":
         pairs = []
@@ -907,6 +1025,26 @@ def _condition_warnings(mf, ds):
                      f"{min(vals):.4g} .. {max(vals):.4g} {unit}")
             _warn(f"{which} (in SI) outside the range {low:g}..{high:g} {unit} the model "
                   "declares: check the values and the unit in the data's header")
+
+
+def _trace_span_warnings(mf, ds):
+    """One line per trace with samples outside the model file's run, t0 to
+    t_end: the simulation is compared there with its first or last value
+    (a trace to 50 s against a 0.3 s run was fitted so, without a word)."""
+    t0, t_end = mf.experiment.t0, mf.experiment.t_end
+    for e in list(ds.experiments):
+        tr = e.trace
+        if tr is None or not len(tr.time):
+            continue
+        t = np.asarray(tr.time, dtype=float)
+        before, after = int(np.sum(t < t0)), int(np.sum(t > t_end * (1 + 1e-9) + 1e-15))
+        if before or after:
+            where = tr.file.name if tr.file is not None else f"{e.name}'s trace"
+            parts = ([f"{before} before t0 = {t0:g} s (from {t.min():g} s)"] if before else []) \
+                + ([f"{after} after t_end = {t_end:g} s (to {t.max():g} s)"] if after else [])
+            _warn(f"{where}: {' and '.join(parts)} of its {t.size:,} samples lie outside the "
+                  "model file's run, where they are compared with its first or last value: "
+                  "check the time column's unit, or the experiment's t0 and t_end")
 
 
 AT_BOUND = 1e-4     # of a range: a fitted value this close to a bound is at it
@@ -1021,6 +1159,7 @@ def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max
             measures = _csv_list(",".join(measures), "--measure")   # (refuses an empty list)
             _check_output(out, "--out", create=True)
             _check_output(plot, "--plot", plot=True, create=True)
+            _check_distinct([("--out", out), ("--plot", plot)], [file])
             specs = [parse_param(p, max_points) for p in params]
             n_points = math.prod(len(v) for _, v in specs)
             if n_points > max_points:
@@ -1115,6 +1254,7 @@ def tolerance(file, spec, n, sampling, seed, measures, out, plot_prefix, json_pa
                 _check_output(path, option, create=True)
             if plot_prefix:
                 _check_output(plot_prefix + "_hist.png", "--plot", plot=True, create=True)
+            _check_distinct([("--out", out), ("--json", json_path)], [file, spec])
             tol.check_n(n, sampling)
             mf, cm = compile_file(file)
             dists = tol.parse_spec(spec, cm)
@@ -1153,8 +1293,7 @@ def tolerance(file, spec, n, sampling, seed, measures, out, plot_prefix, json_pa
                 tol.plot_histograms(res, plot_prefix, display)
                 tol.plot_tornado(res, plot_prefix, display)
             if json_path:
-                with open(json_path, "w", encoding="utf-8") as f:
-                    json.dump(tol.summary_json(res), f, indent=1)
+                _write_json(json_path, tol.summary_json(res), "--json")
     except tol.SpecError as exc:                # one line per bad row of the spec
         for line in exc.lines:
             click.echo(f"acausal: error: {_one_line(line)}", err=True)
@@ -1315,6 +1454,7 @@ def diagnose(file, data, json_opt, json_file, report_dir, scheduler, workers, ma
             locs = _csv_list(locations, "--locations")
             if json_path:
                 _check_output(json_path, "--json-file")
+                _check_distinct([("--json-file", json_path)], [file, data])
             _check_output(os.path.join(report_dir, "report.md"), "--report", create=True)
             limit = memory_limit(max_memory)
             n_workers = workers or (default_workers() if scheduler is None else 1)
@@ -1331,8 +1471,7 @@ def diagnose(file, data, json_opt, json_file, report_dir, scheduler, workers, ma
                                         f"acausal: resumed: {n:,} fits already done "
                                         f"(from {path})", err=True))
             if json_path:
-                with open(json_path, "w") as f:
-                    json.dump(out, f, indent=1)
+                _write_json(json_path, out, "--json-file")
     except (AcausalError, click.BadParameter) as exc:
         _fail(exc)
     if as_json:
@@ -1378,8 +1517,11 @@ def fmu(file, out, outputs, inputs, measures, fmu_backend):
     """Export a model file as an FMU (FMI 2.0 Co-Simulation)."""
     from .interop.fmu import export_fmu
     try:
-        path = export_fmu(file, out, outputs=outputs, inputs=inputs, measures=measures,
-                          backend=fmu_backend)
+        _check_output(out, "--out")
+        _check_distinct([("--out", out)], [file])
+        with _quiet_warnings():      # a model file's own warnings: one line, counted
+            path = export_fmu(file, out, outputs=outputs, inputs=inputs, measures=measures,
+                              backend=fmu_backend)
     except AcausalError as exc:
         _fail(exc)
     click.echo(f"wrote {path}")

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 from .runtime.model import compile_model
 from .lang.component import Model
 from .errors import AcausalError, ModelFileError
-from .lang.experiment import Experiment, Measure
+from .lang.experiment import Experiment, Measure, Stop
 
 
 @dataclass
@@ -71,6 +71,10 @@ def _run(path):
         raise _error(path, line or _bad_byte_line(path), f"syntax error: {exc.msg}") from None
     except AcausalError as exc:
         raise _error(path, _line(exc, path), str(exc)) from None
+    except SystemExit as exc:  # sys.exit() in the script: the command went on with nothing
+        raise _error(path, _line(exc, path), f"the model file called sys.exit({exc.code!r}) "
+                     "while it was being read: a model file binds 'model', it does not end "
+                     "the command") from None
     except Exception as exc:  # a bug in the script: say where
         line = _line(exc, path) or _bad_byte_line(path)
         hint = ""
@@ -139,15 +143,17 @@ def load_model_file(path):
 
 
 def _binding_line(path, name):
-    """Line of the first top-level assignment to ``name`` in the file."""
+    """Line of the last top-level assignment to ``name`` in the file: the
+    binding the file ends with (a rebinding was reported at the first one)."""
+    found = None
     try:
         with open(path, encoding="utf-8", errors="replace") as f:
             for k, text in enumerate(f, start=1):
                 if re.match(rf"{name}\s*(:[^=]*)?=(?!=)", text):
-                    return k
+                    found = k
     except OSError:
         pass
-    return None
+    return found
 
 
 def _bad(path, name, message):
@@ -208,6 +214,12 @@ def _check_experiment(exp, path):
                 not all(_positive(v) for v in values):
             bad = f"{name} = {value!r} must be a finite number > 0" + \
                 (" (or 0: the solver's steps)" if name == "output_step" else "")
+    if bad is None and _positive(exp.rtol) and not _number(exp.rtol) < 1:
+        bad = f"rtol = {exp.rtol!r} must be below 1 (a relative tolerance)"
+    stop = getattr(exp, "stop", None)
+    if bad is None and stop is not None and not isinstance(stop, Stop):
+        bad = (f"stop = {stop!r} must be an acausal.Stop, e.g. Stop('hook.phi', '<=', -0.1) "
+               f"(found {type(stop).__name__})")
     if bad is not None:
         raise _bad(path, "experiment", f"experiment {bad}")
 
@@ -292,7 +304,7 @@ def evaluate_measures(mf, result):
     for name, fn in mf.measures.items():
         try:
             out[name] = float(fn(result))
-        except Exception as exc:
+        except (Exception, SystemExit) as exc:   # sys.exit() in a measure: it failed
             raise ModelFileError(f"{mf.path}: measure {name!r} failed: "
                                  f"{type(exc).__name__}: {exc}") from None
     return out
@@ -323,13 +335,30 @@ def measure_values(mf, result):
     for name, fn in mf.measures.items():
         try:
             values[name] = float(fn(result))
-        except Exception as exc:  # noqa: BLE001 - the model file's code: reported, not raised
+        except (Exception, SystemExit) as exc:  # noqa: BLE001 - the model file's code:
+            # reported, not raised (a measure's sys.exit() ended the command, results unsaid)
             values[name] = float("nan")
             missing[name] = f"{type(exc).__name__}: {exc}"
             continue
         if values[name] != values[name]:
             missing[name] = "no value (the measure gave NaN)"
     return values, missing
+
+
+def call_plot(mf, result, path):
+    """Call the model file's ``plot(result, path)``; whatever it raises
+    (sys.exit included) becomes a ModelFileError naming the file's line
+    (a plot function that raised ended the command with a traceback, after
+    the run and its CSV)."""
+    try:
+        mf.namespace["plot"](result, path)
+    except (Exception, SystemExit) as exc:  # noqa: BLE001 - the model file's code
+        raise _error(mf.path, _line(exc, mf.path), f"its plot(result, path) failed: "
+                     f"{type(exc).__name__}: {_short(exc)}") from None
+
+
+def _short(exc):
+    return " ".join(str(exc).split())[:300]
 
 
 def run_file(path, params=None, **overrides):

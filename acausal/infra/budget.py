@@ -151,6 +151,7 @@ class Watchdog:
         self.reason = None
         self.peak = 0.0
         self._stop = threading.Event()
+        self._lock = threading.Lock()      # no trip once the block has ended
         self._t0 = time.monotonic()
 
     def __enter__(self):
@@ -161,7 +162,8 @@ class Watchdog:
         return self
 
     def __exit__(self, *exc):
-        self._stop.set()
+        with self._lock:
+            self._stop.set()
         return False
 
     def _watch(self):
@@ -181,9 +183,20 @@ class Watchdog:
 
     def _trip(self, reason):
         """Stop the command: Ctrl-C in its main thread, and its end armed
-        (whatever it is doing then: executor.exit_soon)."""
+        (whatever it is doing then: executor.exit_soon); nothing once the
+        watched block has ended (the signal would reach whatever runs next)."""
+        with self._lock:
+            if not self._stop.is_set():
+                self._interrupt(reason)
+
+    def _interrupt(self, reason):
         self.reason = _LAST["reason"] = reason
-        _thread.interrupt_main(signal.SIGINT)
+        if callable(signal.getsignal(signal.SIGINT)):
+            # a real signal to the main thread, as Ctrl-C is: it also wakes a blocking
+            # call (a model file that slept ignored interrupt_main until the grace ended)
+            signal.pthread_kill(threading.main_thread().ident, signal.SIGINT)
+        else:
+            _thread.interrupt_main(signal.SIGINT)
         from .executor import exit_soon
         exit_soon(3)
 

@@ -318,12 +318,32 @@ def _terminate_workers(pool: cf.ProcessPoolExecutor) -> None:
         proc.join(timeout=5.0)
 
 
+def _quiet_broken_pool() -> None:
+    """Before 3.12 the pool's manager thread, finding its workers gone,
+    sets an exception on every pending future, cancelled ones included, and
+    dies of InvalidStateError (a thread traceback on the terminal of a large
+    sweep ended by SIGTERM: 'CANCELLED: <Future ...>'). That error, in that
+    thread, is expected here and not printed; every other thread error is."""
+    if getattr(threading.excepthook, "_acausal", False):
+        return
+    previous = threading.excepthook
+
+    def hook(args):
+        if isinstance(args.exc_value, cf.InvalidStateError) and \
+                type(args.thread).__name__ == "_ExecutorManagerThread":
+            return
+        previous(args)
+    hook._acausal = True
+    threading.excepthook = hook
+
+
 @contextlib.contextmanager
 def _process_pool(workers: int | None):
     """A local pool whose workers die with this process (see
     :func:`_die_with_parent`); on an exception (an interruption, SIGTERM
     turned into one by the CLI) the workers are terminated, not waited for."""
     n = default_workers() if workers is None else workers
+    _quiet_broken_pool()     # (before the workers can die: a group's SIGTERM reaches them first)
     pool = cf.ProcessPoolExecutor(max_workers=n, initializer=_die_with_parent,
                                   initargs=(os.getpid(),))
     try:

@@ -62,9 +62,13 @@ STOP = _StopRequest()
 
 def request_stop(reason):
     """Ask the running simulation(s) to stop with their partial result;
-    False when none is running (the caller then interrupts as it would)."""
+    False when none is running (the caller then interrupts as it would, and
+    nothing is left set: a request made between runs stopped the next run of
+    the process at its start, as 'interrupted')."""
+    if STOP.active <= 0:
+        return False
     STOP.reason = reason
-    return STOP.active > 0
+    return True
 
 
 @dataclass(frozen=True)

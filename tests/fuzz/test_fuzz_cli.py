@@ -49,7 +49,8 @@ NUMBERS = ["-1", "0", "nan", "inf", "-inf", "1e6", "1e-300", "1e300", "abc", "",
 TIMES = ["-1", "0", "nan", "inf", "abc", "1e8", "1e-9", "0.05", "0.3", "1e300", "", "1e-200"]
 SIZES = ["4GB", "512MB", "1KB", "0", "-1GB", "abc", "1e9", "2GiB", "100", "1XB", ""]
 FIGS = ["o.png", "o.xyz", "o", "o.pdf", "o.PNG", "nodir/o.png", ".", "o.svg", "o.png/"]
-OUTS = ["o.csv", "nodir/o.csv", ".", "o.txt", "deep/er/o.csv", "/proc/acausal_fuzz.csv"]
+OUTS = ["o.csv", "nodir/o.csv", ".", "o.txt", "deep/er/o.csv", "/proc/acausal_fuzz.csv",
+        "/dev/full", "spring.py"]   # a full disk; the model file itself (the input)
 
 
 def simulate_case(rng, model):
@@ -60,7 +61,7 @@ def simulate_case(rng, model):
                           "--backend", "--bogus"])
         pool = {"--t-end": TIMES, "--max-memory": SIZES, "--plot": FIGS, "--out": OUTS,
                 "--set": ["k.c=1e30", "k.c=-1", "body.m=nan", "nothing=1", "k.c", "k.c=5",
-                          "body.v=0.1", "=3"],
+                          "body.v=0.1", "=3", "k.c=5e-324", "body.m=1e-320"],
                 "--backend": ["sundae", "compiled", "fast"]}.get(opt, NUMBERS)
         args += [opt] if opt == "--bogus" else [opt, rng.choice(pool)]
     return args

@@ -228,7 +228,22 @@ def unit_string(data, rng):
     return data[:m.start()] + b'"' + rng.choice(mu.UNITS).encode() + b'"' + data[m.end():]
 
 
-MODEL_MUTATIONS = [mu.truncate_line, mu.truncate_file, mu.drop_line, mu.duplicate_line,
+# statements a model file may end with that end the command, rebind its
+# experiment badly or raise from the interpreter's own exits (a traceback, or
+# exit 0 with nothing done, before they were checked)
+TAILS = [b"import sys\nsys.exit(0)\n", b"raise SystemExit('bye')\n", b"exit(3)\n",
+         b"experiment.stop = 5\n", b"experiment.rtol = 5.0\n", b"experiment.rtol = 1\n",
+         b"experiment.stop = 'mass.s'\n", b"experiment.t_end = -experiment.t_end\n",
+         b"measures = {'m': 3}\n", b"free_parameters = {'x': (2, 1)}\n",
+         b"conditions = 'F'\n", b"model = model.children\n"]
+
+
+def tail_statement(data, rng):
+    """A statement from TAILS appended to the file."""
+    return data + b"\n" + rng.choice(TAILS)
+
+
+MODEL_MUTATIONS = [tail_statement, tail_statement, mu.truncate_line, mu.truncate_file, mu.drop_line, mu.duplicate_line,
                    mu.nul_byte, mu.latin1, mu.utf16, mu.flip_byte, mu.empty, mu.quote,
                    mu.semicolons, mu.swap_lines, float_literal, float_literal, float_literal,
                    unit_string, mu.bom, mu.crlf, mu.blank_and_comment_lines]
