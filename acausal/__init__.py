@@ -8,7 +8,12 @@ The public face. The layers, bottom up (docs/architecture.md):
 :mod:`.viz`; :mod:`.modelfile`; :mod:`.studies` (calibrate, profile,
 design, sweep); :mod:`.diagnose`; :mod:`.cli`.
 """
-from sympy import Piecewise, cos, exp, sin, sqrt  # noqa: F401  (for model files)
+from .infra import startup as _startup
+
+if _startup.is_command():   # first thing: a signal while the command imports is one line
+    _startup.guard()
+
+from sympy import Piecewise, cos, exp, sin, sqrt  # noqa: E402,F401  (for model files)
 
 from .lang.component import Component, Model
 from .runtime.model import CompiledModel, compile_model

@@ -57,6 +57,8 @@ class _Group(click.Group):
              **extra):
         if not standalone_mode:
             return super().main(args, prog_name, complete_var, standalone_mode, **extra)
+        from .infra import startup
+        startup.started()
         try:
             return super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
         except click.exceptions.Abort:
@@ -652,20 +654,27 @@ def _plot(mf, res, path, partial=False):
 def animate(file, out, t_end, sets, fps, frames, max_wall, max_memory):
     """Simulate a planar model file and animate its mechanism."""
     from .viz.animate import animate as write_animation
+    from .infra.budget import Watchdog, tripped
     from .infra.budget import max_memory as memory_limit
     from .modelfile import compile_file
+    limit, res, existed = memory_limit(max_memory), None, os.path.exists(out)
     try:
-        with _interruptible(), _quiet_warnings():
+        # the whole command is watched for memory (drawing 501 frames took 899 MB
+        # against --max-memory 300MB); --max-wall bounds the reading and compiling
+        # of the model file, and the run has its own, as in simulate
+        with _interruptible(), _quiet_warnings(), \
+                Watchdog(limit, max_wall, "the animation") as watch:
             if os.path.splitext(out)[1].lower() not in (".gif", ".mp4"):
                 raise UsageError(f"--out {out}: an animation is written as .gif or .mp4")
             _check_output(out, "--out")
             _check_distinct([("--out", out)], [file])
             mf, cm = compile_file(file)
+            watch.max_wall = None
             opts = mf.experiment.run_options()
             if t_end is not None:
                 opts["t_end"] = t_end
             _check_run_options(opts)
-            opts.update(max_memory=memory_limit(max_memory),
+            opts.update(max_memory=limit,
                         **({"max_wall": max_wall} if max_wall else {}))
             res, error = _run_keeping_partial(cm, _parse_sets(sets), opts)
             ks = write_animation(res, out, fps=fps, max_frames=frames,
@@ -673,7 +682,12 @@ def animate(file, out, t_end, sets, fps, frames, max_wall, max_memory):
     except (AcausalError, click.BadParameter) as exc:
         _fail(exc)
     except KeyboardInterrupt:
-        click.echo("acausal: interrupted before the simulation started: nothing drawn", err=True)
+        when = "before the simulation started" if res is None else "while drawing"
+        if res is not None and not existed and os.path.exists(out):
+            os.remove(out)         # a half-written animation is no result
+        if tripped():
+            _fail(LimitError(f"{tripped()}, {when}: nothing written to {out}"))
+        click.echo(f"acausal: interrupted {when}: nothing written to {out}", err=True)
         sys.exit(130)
     if error is not None:
         click.echo(f"wrote {out}: {len(ks)} frames, t = {res.t[0]:g} .. {res.t[-1]:g} s "
@@ -826,9 +840,11 @@ def linearize(file, at, inputs, outputs, sets, out, as_json):
             _check_output(out, "--out")
             _check_distinct([("--out", out)], [file])
         params = _parse_sets(sets)
+        inputs = _csv_list(inputs, "--inputs", empty_ok=True)    # (a name twice: refused;
+        outputs = _csv_list(outputs, "--outputs", empty_ok=True)  # an output twice passed)
+        point = _parse_at(at)
         with _quiet_warnings():      # a model file's own warnings: one line, counted
             mf, cm = compile_file(file)
-        point = _parse_at(at)
         if isinstance(point, float) and not (math.isfinite(point)
                                              and point >= mf.experiment.t0):
             raise UsageError(f"--at {at}: a time must be finite and at or after the model "
@@ -864,6 +880,9 @@ def _parse_at(text):
     out = {}
     for item in (x.strip() for x in text.split(",") if x.strip()):
         name, _, value = item.partition("=")
+        if name.strip() in out:      # (the last one silently won)
+            raise UsageError(f"--at {text!r}: {name.strip()} is given twice",
+                             variable=name.strip())
         try:
             out[name.strip()] = float(value)
         except ValueError:
@@ -1216,7 +1235,8 @@ def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max
 @click.option("--sampling", type=click.Choice(["lhs", "sobol"]), default="lhs", show_default=True,
               help="Latin hypercube (variance shares: correlation ratios, regression) or "
                    "Sobol' in Saltelli's design (first-order and total Sobol' indices)")
-@click.option("--seed", type=int, default=0, show_default=True, help="the sampling's seed")
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
+              help="the sampling's seed (a whole number >= 0; -1 gave a numpy traceback)")
 @click.option("--measure", "measures", multiple=True, metavar="M1,M2,...",
               help="measures to study (default: every measure of the model file)")
 @click.option("--out", type=click.Path(dir_okay=False), default="tolerance.csv",

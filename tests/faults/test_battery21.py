@@ -323,3 +323,54 @@ def test_a_stop_requested_between_runs_does_not_stop_the_next_run(tmp_path):
     assert request_stop("between runs") is False
     r = invoke(["simulate", model_file(tmp_path)])
     assert r.exit_code == 0 and "interrupt" not in r.output, r.output
+
+
+@pytest.mark.parametrize("args, said", [
+    (["linearize", "{m}", "--outputs", "body.v,body.v"], "body.v named twice"),
+    (["linearize", "{m}", "--at", "body.s=1,body.s=2"], "body.s is given twice"),
+    (["tolerance", "{m}", "--spec", "{m}", "-n", "8", "--seed", "-1"], "-1 is not in the range")])
+def test_other_values_refused_in_one_line(tmp_path, args, said):
+    """--outputs with a name twice and --at with a state twice: the last
+    silently won; tolerance --seed -1: a numpy ValueError traceback."""
+    m = model_file(tmp_path)
+    err = one_error_line(invoke([a.format(m=m) for a in args]))
+    assert said in err, err
+
+
+@pytest.mark.slow
+def test_animate_is_held_to_its_memory_limit(tmp_path):
+    """Drawing 501 frames of the slider-crank took 899 MB against
+    --max-memory 300MB (the limit covered the run's rows only); the
+    half-written file is removed (17 s: slow tier)."""
+    out = tmp_path / "a.gif"
+    p, _ = run_cli(["animate", ROOT / "models" / "examples" / "slider_crank.py", "--out", out,
+                    "--frames", "1e6", "--max-memory", "250MB"], timeout=600)
+    assert p.returncode == 3, p.stderr
+    lines = [ln for ln in p.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and "more than the limit 250 MB (--max-memory)" in lines[0], p.stderr
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
+def test_a_signal_while_the_command_starts_is_one_line(sig):
+    """Ctrl-C in the command's first second (its imports) printed a
+    KeyboardInterrupt traceback from inside scipy; SIGTERM and SIGHUP ended
+    it silently (exit -15, -1)."""
+    proc = subprocess.Popen([sys.executable, "-m", "acausal.cli", "check",
+                             str(ROOT / "models" / "examples" / "oscillator.py")],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env=dict(os.environ, PYTHONPATH=str(ROOT)))
+    time.sleep(0.4)          # (importing: about a second; later, the command is interrupted)
+    proc.send_signal(sig)
+    _, err = proc.communicate(timeout=120)
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert proc.returncode == 130 and "Traceback" not in err, (proc.returncode, err)
+    assert len(lines) == 1 and lines[0].startswith("acausal: interrupted"), err
+
+
+def test_only_the_command_guards_its_start():
+    from acausal.infra.startup import is_command
+    assert is_command(["/usr/bin/acausal", "simulate"], [])
+    assert is_command(["-m"], ["python", "-m", "acausal.cli", "simulate", "x.py"])
+    assert not is_command(["-m"], ["python", "-m", "pytest", "-q"])
+    assert not is_command(["script.py"], ["python", "script.py"])

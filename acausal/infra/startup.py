@@ -1,0 +1,60 @@
+"""The command's first second: a signal while it is still importing.
+
+``python -m acausal.cli`` and the ``acausal`` script spend about a second
+importing numpy, scipy and sympy before the command's own handlers exist. A
+Ctrl-C then printed a KeyboardInterrupt traceback from inside scipy, and a
+SIGTERM or SIGHUP ended it silently (exit -15). :func:`guard` (called by
+``acausal/__init__`` first thing, only in that process) makes such a signal
+one line and exit 130; once the command starts (:func:`started`) a signal
+interrupts as Ctrl-C does (KeyboardInterrupt: the command's one-line
+'interrupted'), SIGTERM and SIGHUP included, with the process's end armed
+(:func:`acausal.infra.executor.exit_soon`). Commands that save work install
+their own handlers over these while they run. A signal the process was
+started ignoring (``nohup``: SIGHUP) stays ignored.
+"""
+import os
+import signal
+import sys
+
+_STATE = {"starting": False}
+_NAMES = ("SIGINT", "SIGTERM", "SIGHUP")
+
+
+def is_command(argv=None, orig_argv=None) -> bool:
+    """True when this process is the acausal command: the ``acausal``
+    script, or ``python -m acausal.cli`` (``sys.orig_argv``: while the package
+    is imported, ``sys.argv[0]`` is only '-m')."""
+    argv = sys.argv if argv is None else argv
+    orig = getattr(sys, "orig_argv", None) if orig_argv is None else orig_argv
+    if argv and os.path.basename(str(argv[0])) == "acausal":
+        return True
+    orig = list(orig or [])
+    return any(a == "-m" and b in ("acausal.cli", "acausal") for a, b in zip(orig, orig[1:]))
+
+
+def _handler(signum, frame):
+    name = signal.Signals(signum).name
+    if _STATE["starting"]:
+        os.write(2, f"acausal: interrupted ({name}) while starting: nothing done\n".encode())
+        os._exit(130)
+    if signum != signal.SIGINT:
+        from .executor import exit_soon
+        exit_soon(130)      # whatever the unwinding meets, the process ends
+    raise KeyboardInterrupt(name)
+
+
+def guard() -> None:
+    """Install the handlers (where a signal has its default action)."""
+    defaults = {"SIGINT": signal.default_int_handler}
+    _STATE["starting"] = True
+    for name in _NAMES:
+        sig = getattr(signal, name, None)
+        if sig is None:
+            continue
+        if signal.getsignal(sig) in (defaults.get(name, signal.SIG_DFL),):
+            signal.signal(sig, _handler)
+
+
+def started() -> None:
+    """The imports are over: from now on a signal interrupts the command."""
+    _STATE["starting"] = False
