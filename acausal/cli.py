@@ -386,7 +386,7 @@ def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, max_rows, max_wa
                                f"to {out}", err=True)
             if plot:
                 _plot(mf, res, plot, partial=error is not None)
-            _nonfinite_warning(res, every_row=bool(out or plot))
+            _nonfinite_warning(res, every_row=bool(out or plot) and len(res.t) <= NAN_SCAN_ROWS)
     except (AcausalError, click.BadParameter) as exc:
         if as_json:
             click.echo(json.dumps({"error": _error_dict(exc)}, indent=1))
@@ -430,33 +430,28 @@ def _write_json(path, obj, option, **kw):
                            ) from None
 
 
+NAN_SCAN_ROWS = 200_000   # a result up to this long is searched for NaN row by row (~1 s)
+
+
 def _nonfinite_warning(res, every_row):
     """One line when variables of the result are NaN or infinite (log of a
     negative number, 1/0 in an observed variable: the run went on, exit 0,
-    and nothing said so): the first one, where, and how many. ``every_row``:
-    every row is searched (the CSV or the plot computed them all), else the
-    final values only."""
+    and nothing said so): the first one and where. ``every_row``: every row
+    is searched (a result written to CSV or plotted, up to NAN_SCAN_ROWS rows:
+    the observed variables are evaluated again), else the final values only."""
     if not len(res.t):
         return
-    bad = {}
-    if every_row:
-        for name in res.names:
-            try:
-                v = np.asarray(res[name], dtype=float)
-            except (AcausalError, TypeError, ValueError):
-                continue
-            hit = np.flatnonzero(~np.isfinite(v))
-            if hit.size:
-                bad[name] = (float(res.t[hit[0]]), float(v[hit[0]]))
+    if every_row:           # (by blocks: a large result's observed variables are not kept)
+        hit = res.nonfinite()
     else:
-        bad = {n: (float(res.t[-1]), v) for n, v in res.final().items()
-               if not math.isfinite(v) and n in set(res.names)}
-    if bad:
-        name, (t, v) = min(bad.items(), key=lambda kv: kv[1][0])
+        last = res.final()
+        hit = next(((n, float(res.t[-1]), last[n]) for n in res.names
+                    if n in last and not math.isfinite(last[n])), None)
+    if hit is not None:
+        name, t, v = hit
         where = f"from t = {t:.6g} s on" if every_row else f"at the end, t = {t:.6g} s"
-        _warn(f"{name} is {v} {where}" + (f" ({len(bad) - 1} other variable(s) "
-              "too)" if len(bad) > 1 else "") + ": the model computes a value outside its "
-              "domain there (a log or square root of a negative number, a division by zero)")
+        _warn(f"{name} is {v} {where}: the model computes a value outside its domain there "
+              "(a log or square root of a negative number, a division by zero)")
 
 
 MIN_SPAN = 1e-15   # [s] the shortest run the command accepts (a femtosecond)

@@ -46,6 +46,13 @@ def initial_point(cm, p, d, cb, t0, starts=None):
         except InitializationError as exc:
             _raise_if_parameter_breaks(cm, t0, p, d, exc)
             raise
+        except np.linalg.LinAlgError as exc:
+            # a NaN or inf in the Jacobian at the start values (a 1e300 m crank
+            # radius: "SVD did not converge", a traceback)
+            err = InitializationError(f"no consistent initial point found: the initial "
+                                      f"equations are not finite at the start values ({exc})")
+            _raise_if_parameter_breaks(cm, t0, p, d, err)
+            raise err from None
 
 
 class _InitialSystem:
@@ -272,9 +279,10 @@ SUSPECT_DECADES = 6.0
 def _far_from(value, default):
     """True if ``value`` lies SUSPECT_DECADES or more (in magnitude) from a
     nonzero default."""
-    if default == 0 or value == 0:
+    if default == 0 or value == 0 or not (math.isfinite(value) and math.isfinite(default)):
         return False
-    return abs(math.log10(abs(value / default))) >= SUSPECT_DECADES
+    # a difference of logs: value / default underflows to 0 for a subnormal value
+    return abs(math.log10(abs(value)) - math.log10(abs(default))) >= SUSPECT_DECADES
 
 
 def _snap_fixed_states(cm, y, fixed):

@@ -374,3 +374,45 @@ def test_only_the_command_guards_its_start():
     assert is_command(["-m"], ["python", "-m", "acausal.cli", "simulate", "x.py"])
     assert not is_command(["-m"], ["python", "-m", "pytest", "-q"])
     assert not is_command(["script.py"], ["python", "script.py"])
+
+
+def test_a_parameter_that_makes_the_start_not_finite_is_named(tmp_path):
+    """--set crank.rx=1e300 on the slider-crank: the initial Jacobian held
+    inf and NaN, and numpy's 'SVD did not converge' ended the command with a
+    traceback. Now the parameter is named, as for any value that breaks the
+    initial equations."""
+    err = one_error_line(invoke(["simulate", ROOT / "models" / "examples" / "slider_crank.py",
+                                 "--set", "crank.rx=1e300"]))
+    assert "parameter crank.rx = 1e+300 [m] makes the initial equations unsolvable" in err
+    assert "not finite at the start values" in err, err
+
+
+def test_a_subnormal_value_is_far_from_its_default():
+    """value / default underflowed to 0 (5e-324 / 40) before its log10: a
+    ValueError where the initialisation names suspect parameters."""
+    from acausal.runtime.initialize import _far_from
+    assert _far_from(5e-324, 40.0) and _far_from(1e300, 1e-300)
+    assert not _far_from(41.0, 40.0) and not _far_from(0.0, 40.0)
+
+
+def test_a_result_is_written_by_blocks_exactly(tmp_path, monkeypatch):
+    """Writing 8.9 M rows took 5.4 GB at once (the observed matrix and a copy
+    of every column), past the 4 GB limit, and the watchdog then ended the
+    write: the interrupted run's rows were lost. The CSV is written by
+    blocks; across block boundaries it reads back bit for bit."""
+    from acausal.modelfile import run_file
+    from acausal.runtime import result as result_module
+    model = model_file(tmp_path, LOG_OF_NEGATIVE, base=SPRING.replace("t_end=0.1", "t_end=0.2"))
+    res, _ = run_file(str(model))
+    monkeypatch.setattr(result_module, "BLOCK_ROWS", 7)      # 201 rows: 29 blocks
+    res.to_csv(tmp_path / "o.csv")
+    back = np.loadtxt(tmp_path / "o.csv", delimiter=",", skiprows=1)
+    assert back.shape == (len(res.t), 1 + len(res.names))
+    assert np.array_equal(back[:, 0], res.t)
+    for j, n in enumerate(res.names):
+        assert np.array_equal(back[:, 1 + j], np.asarray(res[n], dtype=float),
+                              equal_nan=True), n
+    assert (tmp_path / "o.csv").read_text().count("time [s]") == 1
+    name, t, value = res.nonfinite()
+    assert name == "w" and t == pytest.approx(0.101) and math.isnan(value)
+    assert res.final()["w"] != res.final()["w"] and res.final()["body.s"] == res["body.s"][-1]
