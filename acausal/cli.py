@@ -373,7 +373,6 @@ def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, max_rows, max_wa
             with _c_stdout_to_stderr() if as_json else contextlib.nullcontext():
                 res, error = _run_keeping_partial(cm, params, opts)
             phase.writing = True
-            measures, missing = measure_values(mf, res) if error is None else ({}, {})
             if out:
                 if len(res.t) > 100_000:    # (a million rows take seconds to write)
                     click.echo(f"acausal: writing {len(res.t):,} rows to {out}", err=True)
@@ -386,12 +385,24 @@ def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, max_rows, max_wa
                                f"to {out}", err=True)
             if plot:
                 _plot(mf, res, plot, partial=error is not None)
+            # the measures (the model file's code) once the rows are safe, with a
+            # --max-wall of their own (one that never returned ignored --max-wall)
+            phase.writing = False
+            watch.restart(max_wall)
+            measures, missing = measure_values(mf, res) if error is None else ({}, {})
             _nonfinite_warning(res, every_row=bool(out or plot) and len(res.t) <= NAN_SCAN_ROWS)
     except (AcausalError, click.BadParameter) as exc:
         if as_json:
             click.echo(json.dumps({"error": _error_dict(exc)}, indent=1))
         _fail(exc)
     except KeyboardInterrupt:
+        if res is not None:
+            kept = "its results were written" if out or plot else "no --out was given"
+            if tripped():
+                _fail(LimitError(f"{tripped()}, while the measures were computed: {kept}"))
+            click.echo(f"acausal: interrupted while the measures were computed: {kept}",
+                       err=True)
+            sys.exit(130)
         if tripped():
             _fail(LimitError(f"{tripped()}, before the simulation started: nothing computed"))
         click.echo("acausal: interrupted before the simulation started: nothing computed",

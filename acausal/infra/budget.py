@@ -166,6 +166,11 @@ class Watchdog:
             self._stop.set()
         return False
 
+    def restart(self, max_wall=None):
+        """Watch the wall time afresh from now, against ``max_wall`` (None:
+        memory only), for the next part of the command."""
+        self._t0, self.max_wall = time.monotonic(), max_wall
+
     def _watch(self):
         while not self._stop.wait(WATCH_S):
             rss = tree_rss()

@@ -416,3 +416,17 @@ def test_a_result_is_written_by_blocks_exactly(tmp_path, monkeypatch):
     name, t, value = res.nonfinite()
     assert name == "w" and t == pytest.approx(0.101) and math.isnan(value)
     assert res.final()["w"] != res.final()["w"] and res.final()["body.s"] == res["body.s"][-1]
+
+
+def test_max_wall_bounds_a_measure_that_never_returns(tmp_path):
+    """A measure that slept (the model file's code, run after the run)
+    ignored --max-wall 5: a hang. The rows are written first; the measures
+    then get a --max-wall of their own."""
+    path = model_file(tmp_path, "import time\nmeasures['slow'] = lambda res: time.sleep(600)\n")
+    out = tmp_path / "o.csv"
+    p, wall = run_cli(["simulate", path, "--max-wall", "2", "--out", out], timeout=300)
+    assert p.returncode == 3, p.stderr
+    lines = [ln for ln in p.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and "more than the limit --max-wall 2 s, while the measures were " \
+        "computed: its results were written" in lines[0], p.stderr
+    assert wall < 60 and len(out.read_text().splitlines()) == 102
