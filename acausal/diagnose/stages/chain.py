@@ -30,7 +30,8 @@ from . import pairsearch as ps
 from . import stats as st
 from . import verdict as vd
 from .context import Context, longest_first, run_tasks  # noqa: F401 (run_tasks re-exported)
-from .fitting import Fit, heldout_rms, whitened_heldout
+from .fitting import DirectionalHeldout, Fit, directional_heldout, heldout_rms, \
+    whitened_heldout
 from .screen import Unfitted
 from ..library.loader import FamilyIndex, family_index, load_library
 from ..problem import NOMINAL, Candidate, FitSettings, Param, Problem, free_param, pair_of
@@ -415,6 +416,9 @@ class Row:
     # the held-out error beyond the parameters' uncertainty without each
     # experiment (:func:`.fitting.whitened_heldout`; NaN until ranked)
     heldout_white: float = float("nan")
+    # its part within the parameters' directions, per held-out experiment
+    # (:func:`.fitting.directional_heldout`; empty until ranked)
+    heldout_dir: DirectionalHeldout = field(default_factory=DirectionalHeldout)
 
     @property
     def k(self):
@@ -713,7 +717,9 @@ def rank(ds, cal: NominalFit, dec: Decision, cv: CrossValidation, unfitted=()) -
         r, heldout_rmse=cv.heldout(r.candidate.key, r.loo),
         heldout_exact=r.candidate.key in cv.exact,
         heldout_white=whitened_heldout(r.fit, cv.residuals(r.candidate.key, r.loo),
-                                       penalty_of(r.candidate)))
+                                       penalty_of(r.candidate)),
+        heldout_dir=directional_heldout(r.fit, cv.residuals(r.candidate.key, r.loo),
+                                        penalty_of(r.candidate)))
         for r in dec.rows)
     held0 = cv.heldout(NOMINAL.key, cal.nominal.loo)
     if dec.discrepancy:
