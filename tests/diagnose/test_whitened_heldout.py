@@ -207,3 +207,29 @@ def test_directional_statistic_against_its_definition():
         assert d.stats[h] == pytest.approx(inside, rel=1e-8)
         assert d.dofs[h] == 3
     assert 0.0 <= d.p <= 1.0 and d.worst in loo
+
+
+def test_a_rescued_pair_earns_its_second_cause_against_a_single_that_does_not_explain():
+    """Cam follower, Coulomb friction + quadratic drag at the cam: the pair's
+    plain held-out error (6.92) is above the friction alone's (4.26), but the
+    pair explains the held-out data (whitened 0.999, directional p 0.45) and
+    the friction alone does not (whitened 2.1): the pair earns its drag. A
+    single that explains them too keeps the pair from being named."""
+    from acausal.diagnose.problem import Candidate, Param
+    from acausal.diagnose.stages import chain
+    from acausal.diagnose.stages.fitting import DirectionalHeldout
+
+    ok = DirectionalHeldout({"E01": 6.7, "E02": 5.8, "E03": 3.0}, {"E01": 4, "E02": 4, "E03": 4})
+    f = Param("hyp_cf.F", 0, 0, 1, 1, 0)
+    c = Param("hyp_qd.c", 0, 0, 1, 1, 0)
+
+    def row(hyp, loc, params, aicc, plain, white):
+        return SimpleNamespace(candidate=Candidate(hyp, loc, params), aicc=aicc, k=len(params),
+                               heldout_rmse=plain, heldout_white=white, heldout_dir=ok)
+    pair = row("coulomb_friction+quadratic_damping", "cam+cam", (f, c), 5993.7, 6.923, 0.999)
+    drag = row("quadratic_damping", "cam", (c,), 9000.0, 40.0, 30.0)
+    for white, earned in ((2.1, True), (1.0, False)):
+        single = row("coulomb_friction", "cam", (f,), 6042.9, 4.26, white)
+        reasons = chain._pair_reasons(pair, [pair, single, drag], 6006, 3)
+        assert (reasons == []) is earned, reasons
+    assert "explains them too" in reasons[0]
