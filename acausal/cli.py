@@ -1514,6 +1514,8 @@ def diagnose(file, data, json_opt, json_file, report_dir, scheduler, workers, ma
                       f"{out['ranking'][0]['location']})" if out["ranking"] else ""))
     else:
         click.echo(f"discrepancy; cause: {out['cause']} at {out['location']}")
+        for c in (out.get("verdict") or {}).get("caveats", []):
+            click.echo(f"  named on this ground: {c['text']}")
         for e in out["equivalent_causes"]:
             click.echo(f"  equivalent: {e['cause']} at {e['location']}")
     click.echo(f"error [instrument floor units]: train {g['before']['train']:.3g} -> "

@@ -48,8 +48,13 @@ def test_two_mass_strong_single_cause(tmp_path):
     at m2, F = 0.0199990 (truth 0.02), held-out 80.7 -> 1.001, 49 s."""
     out, det, floors = _run(tmp_path, "m2_coulomb", 0.02)
     assert 50 <= floors <= 500
-    assert blind.named(out) == {("coulomb_friction", "m2")}
-    assert blind.values(out)["hyp_cf.F"] == pytest.approx(0.02, rel=0.10)
+    # Coulomb's law: smoothed (coulomb_friction) or by events
+    # (stick_slip_friction, which refines it and was added after this case;
+    # named here on e3ef4d4: the same law while the body slides)
+    (named,) = blind.named(out)
+    assert named in {("coulomb_friction", "m2"), ("stick_slip_friction", "m2")}
+    key = {"coulomb_friction": "hyp_cf.F", "stick_slip_friction": "hyp_ssf.F"}[named[0]]
+    assert blind.values(out)[key] == pytest.approx(0.02, rel=0.10)
     assert out["gain"]["after"]["heldout"] <= 1.2
 
 
@@ -81,7 +86,9 @@ def test_two_mass_two_causes_at_two_sites(tmp_path):
     assert 50 <= floors <= 500
     got = blind.named(out)
     assert ("quadratic_damping", "m1") in got
-    assert ("coulomb_friction", "m2") in got
+    # the simplest Coulomb law, smoothed or by events (stick_slip_friction,
+    # named here on e3ef4d4: the same law while the body slides)
+    assert got & {("coulomb_friction", "m2"), ("stick_slip_friction", "m2")}
     vals = blind.values(out)
     assert vals["hyp_qd.c"] == pytest.approx(0.5, rel=0.10)
     assert next(v for k, v in vals.items() if k.endswith(".F")) == pytest.approx(0.02, rel=0.10)

@@ -78,9 +78,16 @@ def test_blind_case_names_the_hidden_cause(blind):
     assert out["ranking"][0] == {"cause": "coulomb_friction", "location": "latch",
                                  "aicc": out["ranking"][0]["aicc"],
                                  "heldout_rmse": out["ranking"][0]["heldout_rmse"],
-                                 "heldout_whitened": out["ranking"][0]["heldout_whitened"]}
-    # the whitened held-out error (judged by the verdict) never exceeds the plain one
+                                 "heldout_whitened": out["ranking"][0]["heldout_whitened"],
+                                 "heldout_directional": out["ranking"][0]["heldout_directional"]}
+    # the whitened held-out error never exceeds the plain one; its part within
+    # the parameters' directions: one statistic per experiment, on the cause's
+    # and the free parameters' columns, a p-value for a right law
     assert 0.5 < out["ranking"][0]["heldout_whitened"] <= out["ranking"][0]["heldout_rmse"]
+    dirn = out["ranking"][0]["heldout_directional"]
+    assert len(dirn["folds"]) >= 2
+    assert all(1 <= f["dof"] <= 6 and f["stat"] >= 0 for f in dirn["folds"].values())
+    assert 0.01 <= dirn["p"] <= 1.0 and dirn["worst"] in dirn["folds"]
     assert out["extended_model"] and os.path.exists(out["extended_model"])
     assert out["causes"] == [{"cause": "coulomb_friction", "location": "latch",
                               "family": "friction", "member": "coulomb_friction",

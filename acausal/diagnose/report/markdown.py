@@ -483,6 +483,9 @@ def _class_lines(d):
         for hid in dict.fromkeys(h for r in [best] + others for h, _, _ in r.candidate.members()):
             L.append(f"  - {hid}: {lib.HYPOTHESES[hid].distinguishing_experiment}")
     v = d.verdict
+    if v.kind == "named" and v.caveats:
+        L.append("- **named, on this ground**:")
+        L += [f"  - {r.text} [`{r.code}`]" for r in v.caveats]
     if v.kind == "weak" and v.reasons:
         L.append("- **evidence is weak** (the data cannot decide):")
         L += [f"  - {r.text} [`{r.code}`]" for r in v.reasons]

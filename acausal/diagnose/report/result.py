@@ -84,6 +84,16 @@ def clean(obj):
     return obj
 
 
+def _directional(d) -> dict | None:
+    """A row's directional held-out test (:func:`..stages.fitting.directional_heldout`):
+    its Bonferroni p, the worst experiment and each experiment's statistic
+    and degrees of freedom."""
+    if d is None or not d.stats:
+        return None
+    return dict(p=num(d.p), worst=d.worst,
+                folds={h: dict(stat=num(x), dof=d.dofs[h]) for h, x in d.stats.items()})
+
+
 def gain(d: Diagnosis) -> dict:
     f0, best = d.calibration.fit, d.ranking.best
     before = dict(train=f0.rms(), heldout=d.ranking.heldout0)
@@ -182,7 +192,8 @@ def summary(d: Diagnosis) -> dict:
         parameters={} if named is None else parameters(named),
         ranking=[dict(cause=r.candidate.hypothesis, location=r.candidate.location,
                       aicc=num(r.aicc), heldout_rmse=num(r.heldout_rmse),
-                      heldout_whitened=num(getattr(r, "heldout_white", float("nan"))))
+                      heldout_whitened=num(getattr(r, "heldout_white", float("nan"))),
+                      heldout_directional=_directional(getattr(r, "heldout_dir", None)))
                  for r in rk.rows],
         gain=gain(d),
         extended_model=d.extended_model,
@@ -235,6 +246,7 @@ def verdict(d: Diagnosis) -> dict:
         heldout_rmse=v.heldout,
         candidates=candidates(d) if d.decision.discrepancy else [],
         laws=[x.to_dict() for x in v.laws],
+        caveats=[dict(code=r.code, text=r.text) for r in getattr(v, "caveats", ())],
         undetermined=[] if named is None else [c.to_dict() for c in vd.undetermined(named)]))
 
 

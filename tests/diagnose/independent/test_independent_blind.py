@@ -29,14 +29,11 @@ EFFECT = 30.0
 # pass says so and its mark is removed. Each is an open acceptance item, not
 # an accepted behaviour.
 OPEN = {
-    "cam_friction_drag": "issue 24 open: best row stick_slip + quadratic drag at the cam "
-                         "leaves held-out 4.41 (threshold ~1.1); one run alone determines "
-                         "the drag (pairs25)",
-    "gear_friction_drag": "issue 24 open: the true pair at the load leaves held-out 1.30 "
-                          "(threshold ~1.1): the largest-torque run alone determines it",
-    "cam_stick": "issue 24 open: stick_slip_friction at the cam (right cause and site) "
-                 "leaves held-out 1.62 on a 4812-floor effect; the only run that does not "
-                 "stop alone determines the bearing's loss",
+    "cam_friction_drag": "issue 24 open: named coulomb_friction + quadratic_damping at the cam "
+                         "(both right) on ac8c704, but the drag c is 11.2 % off (friction "
+                         "5.4 %): its stick-slip sibling (4.7 %, 9.3 %) fails the directional "
+                         "held-out test (p 0.0015: its refit without the fastest run falls "
+                         "into the c ~ 0 basin)",
     "gear_friction_cogging": "issue 24 open: failed on 35b2fe0; not re-measured after "
                              "the located term's node fix (locate25)",
 }
