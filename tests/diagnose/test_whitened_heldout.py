@@ -233,3 +233,34 @@ def test_a_rescued_pair_earns_its_second_cause_against_a_single_that_does_not_ex
         reasons = chain._pair_reasons(pair, [pair, single, drag], 6006, 3)
         assert (reasons == []) is earned, reasons
     assert "explains them too" in reasons[0]
+
+
+def test_a_plain_explanation_is_judged_before_a_rescued_one():
+    """A row that explains the held-out data plainly, within STRONG AICc
+    units of a rescued best row, is judged first; with none, the rescued
+    row is judged before rows that explain nothing. A pair yields to its
+    own single member when that explains them too within STRONG units
+    (cam follower, Coulomb friction at the follower: the pair with a
+    hardening spring 0.6 units ahead, plain 2.27, and the friction alone,
+    plain 1.079, both rescued at whitened 0.997)."""
+    from acausal.diagnose.problem import Candidate, Param
+    from acausal.diagnose.stages import chain
+    from acausal.diagnose.stages.fitting import DirectionalHeldout
+
+    ok = DirectionalHeldout({"E01": 1.0, "E02": 2.0, "E03": 3.0}, {"E01": 4, "E02": 4, "E03": 4})
+    f = Param("hyp_cf.F", 0, 0, 1, 1, 0)
+    k3 = Param("hyp_hs.k3", 0, 0, 1, 1, 0)
+
+    def row(hyp, loc, params, aicc, plain, white=0.997):
+        return SimpleNamespace(candidate=Candidate(hyp, loc, params), aicc=aicc, k=len(params),
+                               heldout_rmse=plain, heldout_white=white, heldout_dir=ok)
+    pair = row("coulomb_friction+hardening_spring", "follower+spring", (f, k3), 5976.21, 2.267)
+    single = row("coulomb_friction", "follower", (f,), 5976.85, 1.079)
+    plain = row("coulomb_friction", "cam", (f,), 5980.0, 1.0)
+    far = row("coulomb_friction", "cam", (f,), 5990.0, 1.0)
+    assert chain._explaining_first((pair, single), 6006, 3)[0] is single    # its member
+    assert chain._explaining_first((pair, plain), 6006, 3)[0] is plain      # plainly
+    assert chain._explaining_first((pair, far), 6006, 3)[0] is pair         # beyond STRONG
+    worse = row("stick_slip_friction+hardening_spring", "follower+spring", (f, k3), 5975.0,
+                4.0, white=3.0)
+    assert chain._explaining_first((worse, pair, far), 6006, 3)[0] is pair
