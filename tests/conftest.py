@@ -11,10 +11,20 @@ without ``-s``.
 import os
 import platform
 import shutil
+import signal
 import tempfile
 from importlib import metadata
 
 import pytest
+
+# A test run started in the background (`nohup ... &`, `cmd &` in a script)
+# inherits SIGINT and SIGHUP ignored, and so would every command the tests
+# spawn: the tests that send them a terminal user's signals would measure
+# that instead. Restore the defaults the spawned commands inherit.
+for _name, _default in (("SIGINT", signal.default_int_handler), ("SIGHUP", signal.SIG_DFL)):
+    _sig = getattr(signal, _name, None)
+    if _sig is not None and signal.getsignal(_sig) is signal.SIG_IGN:
+        signal.signal(_sig, _default)
 
 VERSIONED = ("numpy", "scipy", "sympy", "scikit-sundae", "matplotlib", "pint", "click",
              "tqdm", "dask", "distributed", "hypothesis", "casadi", "pytest")

@@ -155,8 +155,15 @@ class Watchdog:
         self._t0 = time.monotonic()
 
     def __enter__(self):
+        self._ignored = False
         if threading.current_thread() is threading.main_thread() and (
                 self.max_memory or self.max_wall):
+            if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+                # started in the background (`nohup cmd &`: the shell ignores SIGINT
+                # for it), where neither a signal nor interrupt_main reaches Python:
+                # the watchdog's stop would end in the hard exit, its rows lost
+                signal.signal(signal.SIGINT, signal.default_int_handler)
+                self._ignored = True
             threading.Thread(target=self._watch, daemon=True, name="acausal-watchdog").start()
         _LAST["reason"] = None
         return self
@@ -164,6 +171,8 @@ class Watchdog:
     def __exit__(self, *exc):
         with self._lock:
             self._stop.set()
+        if self._ignored:
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
         return False
 
     def restart(self, max_wall=None):

@@ -139,6 +139,33 @@ def test_an_interrupted_command_ends_within_its_grace_period():
     assert "did not end within 0.5 s" in r.stderr
 
 
+def test_a_watchdog_stops_a_command_started_with_sigint_ignored():
+    """A long command started in the background (`nohup acausal sweep ... &`)
+    has SIGINT ignored: neither the watchdog's signal nor interrupt_main
+    reached Python, so a budget's stop ended in the hard exit 20 s later
+    (exit 3, the rows lost). The watchdog now restores Python's handler for
+    the block it watches, and the ignored state after it."""
+    r = run_py("""
+        import signal, sys, time
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        from acausal.infra.budget import Watchdog, tripped
+        t0 = time.monotonic()
+        try:
+            with Watchdog(max_wall=1.0, what="the test"):
+                while True:
+                    time.sleep(0.05)
+        except KeyboardInterrupt:
+            print("stopped after", round(time.monotonic() - t0, 1), tripped(), flush=True)
+        print("after:", signal.getsignal(signal.SIGINT) is signal.SIG_IGN, flush=True)
+        sys.exit(0)
+        """, timeout=300)
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    assert lines[0].startswith("stopped after") and "--max-wall 1 s" in lines[0], r.stdout
+    assert float(lines[0].split()[2]) < 15.0      # not the 20 s hard exit
+    assert lines[1] == "after: True"
+
+
 def test_a_memory_watchdog_stops_the_command_with_its_reason():
     r = run_py("""
         import sys
