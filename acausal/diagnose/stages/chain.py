@@ -717,6 +717,17 @@ def _unfitted_reasons(unfitted):
             for u in unfitted][:3]
 
 
+def _scored(r, cv: CrossValidation):
+    """The row with its held-out errors: plain, whitened and directional
+    (the held-out residuals and the penalty taken once)."""
+    res, pen = cv.residuals(r.candidate.key, r.loo), penalty_of(r.candidate)
+    return dataclasses.replace(
+        r, heldout_rmse=cv.heldout(r.candidate.key, r.loo),
+        heldout_exact=r.candidate.key in cv.exact,
+        heldout_white=whitened_heldout(r.fit, res, pen),
+        heldout_dir=directional_heldout(r.fit, res, pen))
+
+
 def rank(ds, cal: NominalFit, dec: Decision, cv: CrossValidation, unfitted=()) -> Ranking:
     """Stage 6: exact held-out errors in, classes, and the verdict
     (:mod:`.verdict`): a cause is named only when its held-out error is
@@ -724,14 +735,7 @@ def rank(ds, cal: NominalFit, dec: Decision, cv: CrossValidation, unfitted=()) -
     library" otherwise, never "weak") and no weak-evidence rule objects; it
     is never named while a rival candidate is untested, or screened as
     plausible and left unfitted (``unfitted``: :class:`.screen.Unfitted`)."""
-    rows = tuple(dataclasses.replace(
-        r, heldout_rmse=cv.heldout(r.candidate.key, r.loo),
-        heldout_exact=r.candidate.key in cv.exact,
-        heldout_white=whitened_heldout(r.fit, cv.residuals(r.candidate.key, r.loo),
-                                       penalty_of(r.candidate)),
-        heldout_dir=directional_heldout(r.fit, cv.residuals(r.candidate.key, r.loo),
-                                        penalty_of(r.candidate)))
-        for r in dec.rows)
+    rows = tuple(_scored(r, cv) for r in dec.rows)
     held0 = cv.heldout(NOMINAL.key, cal.nominal.loo)
     if dec.discrepancy:
         rows = _explaining_first(rows, cal.fit.n, len(ds.experiments))

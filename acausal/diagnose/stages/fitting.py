@@ -488,6 +488,20 @@ def effective_k(f: Fit, penalty=None) -> float:
     return float(np.sum(U[:J.shape[0], keep] ** 2))
 
 
+def _scaled_information(f: Fit, penalty=None):
+    """(groups, J / scale, A^-1) of a fit: its Jacobian's columns scaled to
+    unit norm over the data and penalty rows, and the inverse of their
+    information A = J'J (+ the penalty's rows), shared by the whitened
+    held-out error and its directional part."""
+    J = np.asarray(f.jacobian, float)
+    Jp, _ = _penalty_rows(f, penalty)
+    A_rows = np.vstack([J, Jp])
+    scale = np.linalg.norm(A_rows, axis=0)
+    scale[scale == 0] = 1.0
+    A = (A_rows / scale).T @ (A_rows / scale)
+    return np.asarray(f.groups), J / scale, np.linalg.pinv(A, rcond=1e-12, hermitian=True)
+
+
 def whitened_heldout(f: Fit, loo: dict, penalty=None) -> float:
     """The held-out RMS error (noise-floor units) beyond what the parameters'
     uncertainty without each experiment allows: with ``r_h`` experiment
@@ -510,20 +524,13 @@ def whitened_heldout(f: Fit, loo: dict, penalty=None) -> float:
     no fault of the model's form (cam follower, dry friction + drag, the
     truth's own parameters on that run: 0.99 floors; refitted without it:
     7.4, whitened 0.99). An error the model's form leaves, in directions
-    the other experiments determine, is kept whole. Reported beside the
-    plain one, not judged (:func:`.verdict.explains` says why). NaN
-    without a Jacobian or residuals."""
+    the other experiments determine, is kept whole. Judged with its
+    directional part (:func:`directional_heldout`) only where the plain
+    error fails (:func:`.verdict.rescued` says why). NaN without a
+    Jacobian or residuals."""
     if not loo or f is None or f.jacobian is None or f.jacobian.size == 0:
         return float("nan")
-    groups = np.asarray(f.groups)
-    J = np.asarray(f.jacobian, float)
-    Jp, _ = _penalty_rows(f, penalty)
-    A_rows = np.vstack([J, Jp])
-    scale = np.linalg.norm(A_rows, axis=0)
-    scale[scale == 0] = 1.0
-    Js = J / scale
-    A = (A_rows / scale).T @ (A_rows / scale)
-    A_inv = np.linalg.pinv(A, rcond=1e-12, hermitian=True)
+    groups, Js, A_inv = _scaled_information(f, penalty)
     total, count = 0.0, 0
     for g, r in loo.items():
         r = np.atleast_1d(np.asarray(r, float))
@@ -590,14 +597,7 @@ def directional_heldout(f: Fit, loo: dict, penalty=None) -> DirectionalHeldout:
     does not."""
     if not loo or f is None or f.jacobian is None or f.jacobian.size == 0:
         return DirectionalHeldout()
-    groups = np.asarray(f.groups)
-    J = np.asarray(f.jacobian, float)
-    Jp, _ = _penalty_rows(f, penalty)
-    A_rows = np.vstack([J, Jp])
-    scale = np.linalg.norm(A_rows, axis=0)
-    scale[scale == 0] = 1.0
-    Js = J / scale
-    A_inv = np.linalg.pinv((A_rows / scale).T @ (A_rows / scale), rcond=1e-12, hermitian=True)
+    groups, Js, A_inv = _scaled_information(f, penalty)
     out, dofs = {}, {}
     for g, r in loo.items():
         r = np.atleast_1d(np.asarray(r, float))
