@@ -337,8 +337,10 @@ def details(d: Diagnosis) -> dict:
         failed=failed(d),
         located=[dict(node=t.node, members=list(t.members), S=num(t.S), aicc=num(t.aicc),
                       heldout_rmse=num(t.heldout_rmse), values=t.values,
-                      ranges=list(t.ranges))
+                      ranges=list(t.ranges), resolution=list(t.resolution),
+                      smoothing=list(t.smooth), fitted=t.fitted)
                  for t in (d.location.terms if d.location is not None else ())],
+        located_choices=(d.location.details or {}) if d.location is not None else {},
         decision=dec.decision, overdispersion=dec.c_hat, weak_evidence=rk.weak,
         timing=d.timing)
     return clean(out)
