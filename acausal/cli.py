@@ -1143,6 +1143,7 @@ def _sweep_units(mf, cm, params, measures):
 SWEEP_POINT_BYTES = 600     # a sweep point in the main process, per column (+ 400 bytes):
                             # 1.1 kB measured for 1 parameter and 1 measure, x 1.5
 MAX_POINTS = 1_000_000      # the sweep's default work budget
+SWEEP_SAY_PREPARING = 100_000   # a grid this large says so before its bar shows
 
 
 @main.command()
@@ -1208,6 +1209,10 @@ def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max
             task = functools.partial(sweep_task, os.path.abspath(file),
                                      max_memory=max(per_worker, 50e6))
             units = _sweep_units(mf, cm, [name for name, _ in specs], measures)
+            if n_points >= SWEEP_SAY_PREPARING and not no_progress:
+                # (about 3 s per 1e6 points before the bar, more on a loaded host)
+                click.echo(f"sweep: preparing {n_points:,} points (the grid, the "
+                           "checkpoint, what is already done)", err=True)
             points = grid(specs)
             with terminate_on_sigterm(), _resumable(out), \
                     Watchdog(limit, max_wall, "the sweep"), \

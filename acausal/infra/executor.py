@@ -406,6 +406,8 @@ def exit_soon(code: int = 130, grace: float = EXIT_GRACE_S) -> None:
                              "interruption: ended\n")
             sys.stderr.flush()
         finally:
+            from .descendants import end
+            end(grace=1.0)     # os._exit skips atexit: the model file's processes too
             os._exit(_EXITING["code"])
     threading.Thread(target=later, daemon=True, name="acausal-exit-soon").start()
 

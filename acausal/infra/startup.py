@@ -10,7 +10,8 @@ interrupts as Ctrl-C does (KeyboardInterrupt: the command's one-line
 'interrupted'), SIGTERM and SIGHUP included, with the process's end armed
 (:func:`acausal.infra.executor.exit_soon`). Commands that save work install
 their own handlers over these while they run. A signal the process was
-started ignoring (``nohup``: SIGHUP) stays ignored.
+started ignoring (``nohup``: SIGHUP) stays ignored. No process the command
+started outlives it (:mod:`acausal.infra.descendants`).
 """
 import os
 import signal
@@ -44,7 +45,13 @@ def _handler(signum, frame):
 
 
 def guard() -> None:
-    """Install the handlers (where a signal has its default action)."""
+    """Install the handlers (where a signal has its default action); make
+    the command end its model file's own processes when it ends
+    (:mod:`acausal.infra.descendants`)."""
+    import atexit
+    from . import descendants
+    descendants.adopt()
+    atexit.register(descendants.end)   # registered first: runs last
     defaults = {"SIGINT": signal.default_int_handler}
     _STATE["starting"] = True
     for name in _NAMES:

@@ -6,6 +6,10 @@ noticed (a third battery):
   Python); the values are the per-row callback's, to the last bit but for
   ``x**2`` (libm's ``pow`` against numpy's ``x*x``: one ulp);
 """
+import os
+import signal
+import time
+
 import numpy as np
 import pytest
 
@@ -73,3 +77,151 @@ def test_a_large_result_is_written_without_a_python_call_per_row(tmp_path, monke
     np.testing.assert_array_equal(data[:, 0], ref[:, 0])
     _, ulps = _ulps(data, ref)
     assert ulps.max() <= 2.0
+
+
+# -- no process outlives its command ----------------------------------------------------------
+
+SPAWNING = """\
+import os, subprocess, time
+from pathlib import Path
+from acausal import Experiment, Model
+from acausal.mechanics.translational import Fixed, Mass, Spring
+
+child = subprocess.Popen(["sleep", "300"])
+# a grandchild whose parent (the shell) ends at once: an orphan
+shell = subprocess.run(["sh", "-c", "sleep 301 >/dev/null 2>&1 & echo $!"],
+                       capture_output=True, text=True)
+Path({pids!r}).write_text(f"{{child.pid}} {{shell.stdout.strip()}}")
+time.sleep({wait})
+model = Model()
+model.body = Mass(m=4.0, s=0.2, v=0.0)
+model.k = Spring(c=100.0, s_rel0=0.0)
+model.wall = Fixed()
+model.connect(model.wall.flange, model.k.flange_a)
+model.connect(model.k.flange_b, model.body.flange)
+experiment = Experiment(t_end=1.0)
+"""
+
+
+def _alive(pid):
+    import psutil
+    try:
+        return psutil.Process(pid).status() != psutil.STATUS_ZOMBIE
+    except psutil.NoSuchProcess:
+        return False
+
+
+@pytest.mark.parametrize("sig", [None, signal.SIGINT, signal.SIGTERM])
+def test_a_model_files_own_processes_end_with_the_command(tmp_path, sig):
+    """A model file that starts ``sleep 300`` (and a shell's background
+    ``sleep`` whose shell has ended) left both running after the command
+    ended, normally or by a signal to the command alone."""
+    pids = tmp_path / "pids.txt"
+    model = tmp_path / "spawning.py"
+    model.write_text(SPAWNING.format(pids=str(pids), wait=0 if sig is None else 60))
+    proc = h.cli(["simulate", model], h.env(tmp_path / "log"))
+    try:
+        if sig is not None:
+            h.wait_for(lambda: pids.exists() and len(pids.read_text().split()) == 2, proc)
+            proc.send_signal(sig)
+        _, err = proc.communicate(timeout=60)
+        assert proc.returncode == (0 if sig is None else 130), err
+        assert "Traceback" not in err
+        started = [int(p) for p in pids.read_text().split()]
+        assert len(started) == 2
+        deadline = time.monotonic() + 2.0   # the command's exit has ended them
+        while any(_alive(p) for p in started) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not [p for p in started if _alive(p)]
+    finally:
+        for p in pids.read_text().split() if pids.exists() else []:
+            try:
+                os.kill(int(p), signal.SIGKILL)
+            except OSError:
+                pass
+
+
+# -- a large sweep's first seconds ------------------------------------------------------------
+
+def test_the_sweep_keys_are_the_points_reprs():
+    """The keys made with one repr per distinct value are the per-point
+    ones (0.0 and -0.0, equal as dict keys, keep their own reprs)."""
+    from acausal.studies.sweep import _key, _keys
+    rng = np.random.default_rng(1)
+    values = [0.0, -0.0, 1e-300, -2.5, 0.1 + 0.2, float(np.float32(0.1))]
+    values += list(rng.normal(size=50))
+    points = [{"a": float(rng.choice(values)), "b": float(rng.choice(values))}
+              for _ in range(2000)]
+    assert _keys(points, ("a", "b")) == [_key(p, ("a", "b")) for p in points]
+    assert _keys([{"a": -0.0}, {"a": 0.0}], ("a",)) == [("-0.0",), ("0.0",)]
+
+
+def test_a_large_sweep_says_it_is_preparing_before_its_bar(tmp_path):
+    """A 1e6-point sweep showed nothing for its first minute (at load: 8.6 s
+    unloaded, 6e6 reprs of the keys); now one line says what it does and
+    the keys take one repr per distinct value (3.2 s to the bar)."""
+    model = h.copy_model("osc_sweep_model.py", tmp_path / "model")
+    proc = h.cli(["sweep", model, "--param", "mass.m=1:2:100000", "--measure", "s_end",
+                  "--out", tmp_path / "s.csv", "--workers", "1", "--max-wall", "3"],
+                 h.env(tmp_path / "log"))
+    _, err = proc.communicate(timeout=120)
+    assert "sweep: preparing 100,000 points" in err, err
+    assert err.startswith("sweep: preparing"), err[:300]   # before the bar
+    assert "Traceback" not in err
+
+
+# -- a tolerance spec written with semicolons ---------------------------------------------------
+
+SPRING = """\
+from acausal import Experiment, Measure, Model
+from acausal.mechanics.translational import Fixed, Mass, Spring
+
+model = Model()
+model.body = Mass(m=4.0, s=0.2, v=0.0)
+model.k = Spring(c=100.0, s_rel0=0.0)
+model.wall = Fixed()
+model.connect(model.wall.flange, model.k.flange_a)
+model.connect(model.k.flange_b, model.body.flange)
+experiment = Experiment(t_end=0.5)
+measures = {"s_end": Measure(lambda res: res.final()["body.s"], unit="m")}
+"""
+
+
+@pytest.fixture
+def spring(tmp_path):
+    path = tmp_path / "spring.py"
+    path.write_text(SPRING)
+    return path
+
+
+@pytest.mark.parametrize("text, expect", [
+    # a spreadsheet's export with ';' between fields: read as such (it gave
+    # one 'expected 5 fields, got 1' line per row)
+    ("k.c; normal; 100; 5; N/m\nbody.m; uniform; 3; 5; kg\n", None),
+    ("name;distribution;a;b;unit\nk.c;uniform;90;110;N/m\n", None),
+    # the same with a decimal comma: one line, naming the cell
+    ("k.c; normal; 100; 5,5; N/m\n", "spec.csv:1: k.c: standard deviation '5,5' is not a "
+                                    "number (a decimal comma?"),
+    # rows on one line separated by ';'
+    ("k.c, normal, 100, 5, N/m; body.m, uniform, 3, 5, kg\n",
+     "spec.csv:1: expected 5 fields 'name, distribution, a, b, unit', got 9 (';' between rows?"),
+    # every row wrong the same way: one line naming the rows
+    ("k.c normal 100 5 N/m\nbody.m uniform 3 5 kg\n",
+     "spec.csv:1,2: expected 5 fields 'name, distribution, a, b, unit', got 1 (fields are "
+     "separated by commas"),
+])
+def test_a_semicolon_spec_is_read_or_one_line(spring, tmp_path, text, expect):
+    from click.testing import CliRunner
+
+    from acausal.cli import main
+    spec = tmp_path / "spec.csv"
+    spec.write_text(text)
+    r = CliRunner().invoke(main, ["tolerance", str(spring), "--spec", str(spec), "-n", "4",
+                                  "--out", str(tmp_path / "t.csv"), "--workers", "1"])
+    if expect is None:
+        assert r.exit_code == 0, r.stderr
+        assert (tmp_path / "t.csv").exists()
+    else:
+        assert r.exit_code == 2
+        lines = r.stderr.strip().splitlines()
+        assert len(lines) == 1 and expect in lines[0], r.stderr
