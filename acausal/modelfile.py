@@ -16,11 +16,13 @@ another one (``from breaker_24kv import build``): its folder, ``$ACAUSAL_MODEL_P
 the current folder's ``models/`` and the bundled ``models/`` are on the path
 (:func:`model_path`).
 """
+import contextlib
 import math
 import os
 import re
 import runpy
 import sys
+import threading
 import traceback
 from dataclasses import dataclass, field
 
@@ -61,11 +63,48 @@ def _error(path, line, message):
     return ModelFileError(f"{where}: {message}", file=path, line=line)
 
 
+class HardExit(BaseException):
+    """``os._exit(code)`` called by a model file's code while the command
+    runs it (see :func:`no_hard_exit`); a BaseException, so that the file's
+    own ``except Exception`` does not swallow it."""
+
+    def __init__(self, code):
+        super().__init__(f"os._exit({code!r})")
+        self.code = code
+
+
+@contextlib.contextmanager
+def no_hard_exit():
+    """While the block runs the model file's code (its reading, a measure,
+    its plot), ``os._exit`` called from this thread of this process raises
+    :class:`HardExit`: ``os._exit(7)`` ended the command with exit 7 and no
+    word, results unsaid. A process the file forks, or another thread,
+    still exits as it asked (multiprocessing's children end by
+    ``os._exit``)."""
+    real, pid, thread = os._exit, os.getpid(), threading.get_ident()
+
+    def _exit(code):
+        if os.getpid() == pid and threading.get_ident() == thread:
+            raise HardExit(code)
+        real(code)
+    os._exit = _exit
+    try:
+        yield
+    finally:
+        if os._exit is _exit:
+            os._exit = real
+
+
 def _run(path):
     """The namespace of the model file ``path`` after running it; any
     exception it raises becomes a ModelFileError naming its line."""
     try:
-        return runpy.run_path(path, run_name="__acausal_model__")
+        with no_hard_exit():
+            return runpy.run_path(path, run_name="__acausal_model__")
+    except HardExit as exc:
+        raise _error(path, _line(exc, path), f"the model file called {exc} while it was "
+                     "being read: a model file binds 'model', it does not end the "
+                     "command") from None
     except SyntaxError as exc:  # also a bad encoding or a NUL byte
         line = exc.lineno if os.path.abspath(exc.filename or path) == path else None
         raise _error(path, line or _bad_byte_line(path), f"syntax error: {exc.msg}") from None
@@ -303,8 +342,9 @@ def evaluate_measures(mf, result):
     out = {}
     for name, fn in mf.measures.items():
         try:
-            out[name] = float(fn(result))
-        except (Exception, SystemExit) as exc:   # sys.exit() in a measure: it failed
+            with no_hard_exit():
+                out[name] = float(fn(result))
+        except (Exception, SystemExit, HardExit) as exc:   # sys.exit() in a measure: it failed
             raise ModelFileError(f"{mf.path}: measure {name!r} failed: "
                                  f"{type(exc).__name__}: {exc}") from None
     return out
@@ -334,8 +374,9 @@ def measure_values(mf, result):
     values, missing = {}, {}
     for name, fn in mf.measures.items():
         try:
-            values[name] = float(fn(result))
-        except (Exception, SystemExit) as exc:  # noqa: BLE001 - the model file's code:
+            with no_hard_exit():
+                values[name] = float(fn(result))
+        except (Exception, SystemExit, HardExit) as exc:  # noqa: BLE001 - the model file's code:
             # reported, not raised (a measure's sys.exit() ended the command, results unsaid)
             values[name] = float("nan")
             missing[name] = f"{type(exc).__name__}: {exc}"
@@ -351,8 +392,9 @@ def call_plot(mf, result, path):
     (a plot function that raised ended the command with a traceback, after
     the run and its CSV)."""
     try:
-        mf.namespace["plot"](result, path)
-    except (Exception, SystemExit) as exc:  # noqa: BLE001 - the model file's code
+        with no_hard_exit():
+            mf.namespace["plot"](result, path)
+    except (Exception, SystemExit, HardExit) as exc:  # noqa: BLE001 - the model file's code
         raise _error(mf.path, _line(exc, mf.path), f"its plot(result, path) failed: "
                      f"{type(exc).__name__}: {_short(exc)}") from None
 

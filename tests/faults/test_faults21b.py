@@ -225,3 +225,42 @@ def test_a_semicolon_spec_is_read_or_one_line(spring, tmp_path, text, expect):
         assert r.exit_code == 2
         lines = r.stderr.strip().splitlines()
         assert len(lines) == 1 and expect in lines[0], r.stderr
+
+
+# -- os._exit in a model file -------------------------------------------------------------------
+
+def test_os_exit_while_a_model_file_is_read_is_one_line(tmp_path):
+    """``os._exit(7)`` in a model file ended the command with exit 7 and no
+    word; a measure's ended it after the run with the results unsaid."""
+    model = tmp_path / "bye.py"
+    model.write_text("import os\nfrom acausal import Model\nmodel = Model()\n"
+                     "try:\n    os._exit(7)\nexcept Exception:\n    pass\n")
+    proc = h.cli(["simulate", model], h.env(tmp_path / "log"))
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 2, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and f"{model}:5: the model file called os._exit(7)" in lines[0]
+
+    measured = tmp_path / "measured.py"
+    measured.write_text(SPRING.replace('measures = {', 'import os\nmeasures = {"bye": '
+                                       'lambda res: os._exit(7), '))
+    out = tmp_path / "o.csv"
+    proc = h.cli(["simulate", measured, "--out", out], h.env(tmp_path / "log"))
+    stdout, err = proc.communicate(timeout=60)
+    assert proc.returncode == 0, err
+    assert "bye = missing" in stdout and "os._exit(7)" in stdout and "s_end = " in stdout
+    assert out.exists()
+
+
+def test_a_forked_child_of_a_model_file_still_exits_as_asked(tmp_path):
+    """The replaced os._exit raises only in the reading thread of the
+    command's process: multiprocessing's forked children end by
+    os._exit and must still do so."""
+    model = tmp_path / "forks.py"
+    model.write_text(SPRING + "import multiprocessing as mp\n"
+                     "ctx = mp.get_context('fork')\n"
+                     "p = ctx.Process(target=abs, args=(1,))\np.start()\np.join(20)\n"
+                     "assert p.exitcode == 0, p.exitcode\n")
+    proc = h.cli(["simulate", model], h.env(tmp_path / "log"))
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 0, err
