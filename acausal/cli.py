@@ -95,6 +95,9 @@ class _Number(click.ParamType):
             self.fail(f"{value!r} must be > 0", param, ctx)
         if self.kind == "fraction" and not 0 < x < 1:
             self.fail(f"{value!r} must be between 0 and 1", param, ctx)
+        if self.kind == "atol" and not ATOL_RANGE[0] <= x <= ATOL_RANGE[1]:
+            self.fail(f"{value!r} is outside the accepted range {ATOL_RANGE[0]:g} to "
+                      f"{ATOL_RANGE[1]:g} (SI units of the unknowns)", param, ctx)
         if self.kind == "count":
             if x != int(x) or x < 1:
                 self.fail(f"{value!r} must be a whole number >= 1", param, ctx)
@@ -104,8 +107,12 @@ class _Number(click.ParamType):
         return x
 
 
-FINITE, POSITIVE, FRACTION, COUNT = (_Number(k) for k in ("finite", "positive", "fraction",
-                                                           "count"))
+# --atol: what an absolute tolerance in SI units can mean: above 1e3 every
+# position, speed and force of a mechanism counts as zero; below 1e-20 no
+# solution gets closer than the relative tolerance makes it
+ATOL_RANGE = (1e-20, 1e3)
+FINITE, POSITIVE, FRACTION, COUNT, ATOL = (_Number(k) for k in ("finite", "positive", "fraction",
+                                                                 "count", "atol"))
 
 
 def _size(ctx, param, value):
@@ -326,7 +333,7 @@ MAX_MEMORY_HELP = ("memory limit of the command (4GB, 512MB, ...; default $ACAUS
 @click.option("--plot", type=click.Path(dir_okay=False), help="write a figure (PNG, PDF...)")
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object")
 @click.option("--rtol", type=FRACTION, help="relative tolerance (0 < rtol < 1)")
-@click.option("--atol", type=POSITIVE, help="absolute tolerance (> 0)")
+@click.option("--atol", type=ATOL, help="absolute tolerance (1e-20 to 1e3, SI units)")
 @click.option("--max-rows", type=COUNT, default=None, metavar="N",
               help="most output rows to store (default 1e6): a larger grid is refused")
 @click.option("--max-wall", type=POSITIVE, metavar="SECONDS",
@@ -1072,6 +1079,17 @@ def _trace_span_warnings(mf, ds):
                   "check the time column's unit, or the experiment's t0 and t_end")
 
 
+def _diagnosis_data_warnings(file, data):
+    """The data warnings calibrate gives (trace samples outside the model
+    file's run) before a diagnosis: it said nothing of a trace to 50 s
+    against a 0.3 s run. The dataset is read here once more (the diagnosis
+    reads its own); the compiled model is the process's cached one."""
+    from .modelfile import compile_file
+    from .studies import calibrate as cal
+    mf, _ = compile_file(file)
+    _trace_span_warnings(mf, cal.model_dataset(file, data))
+
+
 AT_BOUND = 1e-4     # of a range: a fitted value this close to a bound is at it
 
 
@@ -1491,6 +1509,7 @@ def diagnose(file, data, json_opt, json_file, report_dir, scheduler, workers, ma
             n_workers = workers or (default_workers() if scheduler is None else 1)
             check_estimate((n_workers + 1) * PROCESS_BYTES, limit,
                            f"a diagnosis on {n_workers} workers", "use fewer --workers")
+            _diagnosis_data_warnings(file, data)
             with terminate_on_sigterm(), _resumable(f"{report_dir}/checkpoint"), \
                     Watchdog(limit, max_wall, "the diagnosis"):
                 out = run_diagnosis(file, data, out_dir=report_dir, scheduler=scheduler,
@@ -1550,6 +1569,13 @@ def fmu(file, out, outputs, inputs, measures, fmu_backend):
     """Export a model file as an FMU (FMI 2.0 Co-Simulation)."""
     from .interop.fmu import export_fmu
     try:
+        for option, names in (("--output", outputs), ("--input", inputs)):
+            twice = sorted({x for x in names if names.count(x) > 1})
+            if twice:   # (an output given twice was exported twice, silently)
+                raise UsageError(f"{option} {twice[0]} is given twice", variable=twice[0])
+        both = sorted(set(outputs) & set(inputs))
+        if both:
+            raise UsageError(f"{both[0]} is given as --input and as --output", variable=both[0])
         _check_output(out, "--out")
         _check_distinct([("--out", out)], [file])
         with _quiet_warnings():      # a model file's own warnings: one line, counted

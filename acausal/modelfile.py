@@ -255,6 +255,11 @@ def _check_experiment(exp, path):
                 (" (or 0: the solver's steps)" if name == "output_step" else "")
     if bad is None and _positive(exp.rtol) and not _number(exp.rtol) < 1:
         bad = f"rtol = {exp.rtol!r} must be below 1 (a relative tolerance)"
+    options = getattr(exp, "options", None)
+    if bad is None and options:   # a field no run reads: the settings were silently ignored
+        bad = (f"options = {options!r} is not read by any run: give the settings as "
+               "Experiment's own arguments (t_end, t0, rtol, atol, output_step, max_step, "
+               "atol_algebraic, dense_step, stop)")
     stop = getattr(exp, "stop", None)
     if bad is None and stop is not None and not isinstance(stop, Stop):
         bad = (f"stop = {stop!r} must be an acausal.Stop, e.g. Stop('hook.phi', '<=', -0.1) "

@@ -264,3 +264,137 @@ def test_a_forked_child_of_a_model_file_still_exits_as_asked(tmp_path):
     proc = h.cli(["simulate", model], h.env(tmp_path / "log"))
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 0, err
+
+
+# -- small faults left alone last session: one line each at the input stage --------------------
+
+def _one_line(r, code=2):
+    assert "Traceback" not in (r.output + r.stderr)
+    assert r.exit_code == code, (r.exit_code, r.output, r.stderr)
+    errors = [ln for ln in r.stderr.splitlines() if "error:" in ln]
+    assert len(errors) == 1, r.stderr
+    return errors[0]
+
+
+def _invoke(args):
+    from click.testing import CliRunner
+
+    from acausal.cli import main
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+def test_experiment_options_are_not_silently_ignored(tmp_path):
+    """Experiment(options={...}) was a field no run reads: accepted, ignored."""
+    model = tmp_path / "opt.py"
+    model.write_text(SPRING.replace("Experiment(t_end=0.5)",
+                                    "Experiment(t_end=0.5, options={'max_steps': 10})"))
+    line = _one_line(_invoke(["simulate", model]))
+    assert f"{model}:10: experiment options = {{'max_steps': 10}} is not read by any run" in line
+    model.write_text(SPRING.replace("Experiment(t_end=0.5)", "Experiment(tend=0.5)"))
+    assert "unexpected keyword argument 'tend'" in _one_line(_invoke(["simulate", model]))
+
+
+@pytest.mark.parametrize("value", ["1e300", "1e4", "0", "1e-30"])
+def test_an_absurd_absolute_tolerance_is_refused(spring, value):
+    """--atol 1e300 was accepted (every unknown then counts as zero)."""
+    line = _one_line(_invoke(["simulate", spring, "--atol", value]))
+    assert "--atol" in line and "outside the accepted range 1e-20 to 1000" in line
+
+
+def test_a_sensible_absolute_tolerance_still_runs(spring):
+    r = _invoke(["simulate", spring, "--atol", "1e-3"])
+    assert r.exit_code == 0, r.stderr
+
+
+ODD_UNIT = """\
+from acausal import Component, Eq, Experiment, Model, Parameter, Variable, der
+
+
+class Decay(Component):
+    \"\"\"x' = -k x.\"\"\"
+    k = Parameter(1.0, unit={unit!r}, desc="rate")
+    x = Variable(start=1.0, fixed=True, unit="m", desc="x")
+
+    def equations(self):
+        return [Eq(der(self.x), -self.k * self.x)]
+
+
+model = Model()
+model.decay = Decay()
+experiment = Experiment(t_end=0.5)
+"""
+
+
+@pytest.mark.parametrize("unit, said", [
+    ("furlongs/s", "units: decay.k: unit 'furlongs/s' is not an SI unit (1 furlongs/s = "
+                   "201.168 m/s): values are in SI units, declare 'm/s'"),
+    ("bogons", "units: decay.k: unit 'bogons' is not a unit"),
+])
+def test_a_unit_that_is_not_si_or_not_a_unit_is_named(tmp_path, unit, said):
+    """Unit 'furlongs' passed ``check`` (values are SI: it labelled an SI
+    value with a unit 201 times larger); an unknown one passed unread."""
+    model = tmp_path / "odd.py"
+    model.write_text(ODD_UNIT.format(unit=unit))
+    assert said in _one_line(_invoke(["check", model]))
+
+
+@pytest.mark.parametrize("unit", ["1/s", "Hz", "rad/s2"])
+def test_si_units_and_modelica_notation_pass(tmp_path, unit):
+    model = tmp_path / "odd.py"
+    model.write_text(ODD_UNIT.format(unit=unit))
+    r = _invoke(["check", model])
+    assert "not a unit" not in r.stderr and "not an SI unit" not in r.stderr, r.stderr
+
+
+def test_an_fmu_output_given_twice_is_refused(spring, tmp_path):
+    out = tmp_path / "x.fmu"
+    line = _one_line(_invoke(["fmu", spring, "--out", out, "--output", "body.s",
+                              "--output", "body.s"]))
+    assert "--output body.s is given twice" in line and not out.exists()
+
+
+def test_diagnose_says_trace_samples_lie_outside_the_run(tmp_path):
+    """calibrate and simulate warn of trace samples outside the run; the
+    diagnosis compared them with the run's last value without a word."""
+    from .test_battery21 import dataset, model_file
+    model = model_file(tmp_path)          # t_end = 0.1 s
+    data = dataset(tmp_path / "data")
+    (data / "E1.csv").write_text("time [s],body.s [m]\n0,0\n0.05,0.02\n5,0.025\n50,0.025\n")
+    proc = h.cli(["diagnose", model, data, "--report", tmp_path / "rep", "--max-wall", "1",
+                  "--workers", "1", "--no-progress"], h.env(tmp_path / "log"))
+    _, err = proc.communicate(timeout=120)
+    warn = [ln for ln in err.splitlines() if "E1.csv" in ln and "outside" in ln]
+    assert len(warn) == 1, err
+    assert "2 after t_end = 0.1 s (to 50 s) of its 4 samples lie outside" in warn[0]
+    assert "Traceback" not in err
+
+
+NO_ROOT = """\
+from acausal import Component, Eq, Experiment, Model, Variable, der
+
+
+class Odd(Component):
+    \"\"\"v' = z with z**2 + 1 = 0: no real z.\"\"\"
+    z = Variable(start=0.5, unit="m/s", desc="z")
+    v = Variable(start=0.0, fixed=True, unit="m", desc="v")
+
+    def equations(self):
+        return [Eq(der(self.v), self.z), Eq(self.z**2 + 1, 0)]
+
+
+model = Model()
+model.odd = Odd()
+experiment = Experiment(t_end=0.5)
+"""
+
+
+@pytest.mark.parametrize("backend", ["sundae", "compiled"])
+def test_initial_equations_without_a_real_solution_are_said_so(tmp_path, backend):
+    """z**2 + 1 = 0 was reported as inconsistent fixed starts, or as another
+    equation violated by 2.4e-9."""
+    model = tmp_path / "noroot.py"
+    model.write_text(NO_ROOT)
+    line = _one_line(_invoke(["--backend", backend, "simulate", model]))
+    assert "the initial equations have no real solution near the start values: equation 2 " \
+        "(Odd) of odd: odd.z**2 + 1 = 0 stays at 1" in line, line
+    assert "odd.z = " in line and "inconsistent fixed" not in line
