@@ -17,10 +17,12 @@ declared ranges get one warning line each.
 import contextlib
 from dataclasses import dataclass
 import json
+import errno
 import math
 import os
 import signal
 import sys
+import time
 import warnings
 
 import click
@@ -48,6 +50,58 @@ def _warn(text):
     click.echo(f"acausal: warning: {_one_line(text)}", err=True)
 
 
+# errors of a write to standard output: a closed pipe (| head), a full device
+_STDOUT_ERRNOS = (errno.EPIPE, errno.ENOSPC, errno.EIO, errno.EBADF)
+
+
+def _drop_stdout():
+    """Point standard output at /dev/null, so that the interpreter's own
+    flush at exit does not fail again with a second message."""
+    try:
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, sys.stdout.fileno())
+        os.close(null)
+    except (OSError, ValueError, AttributeError):
+        pass
+
+
+THREAD_GRACE_S = 1.0   # a model file's thread has this long to end with the command
+
+
+def _end_past_model_threads(code):
+    """End the command even if a thread a model file started is still
+    running: Python waits at exit for every non-daemon thread, so a file
+    with a ``threading.Thread(target=time.sleep, args=(300,))`` made the
+    command hang after its results (and a SIGTERM then gave a traceback
+    from the interpreter's shutdown). Such a thread gets a grace of
+    ``THREAD_GRACE_S``, then one line, and the process ends with ``code``
+    (its descendants first). Only in the command's own process."""
+    import threading
+
+    from .infra import startup
+    if not startup.is_command():
+        return
+    deadline = time.monotonic() + THREAD_GRACE_S
+    for t in threading.enumerate():
+        if t is not threading.main_thread() and not t.daemon:
+            t.join(max(deadline - time.monotonic(), 0.0))
+    left = [t for t in threading.enumerate()
+            if t is not threading.main_thread() and not t.daemon and t.is_alive()]
+    if not left:
+        return
+    _warn(f"{len(left)} thread(s) the model file started still run(s) at the end "
+          f"({left[0].name}): not waited for")
+    from .infra.descendants import end
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError, AttributeError):
+            pass
+    end()
+    code = code if isinstance(code, int) else (0 if code is None else 1)
+    os._exit(code)
+
+
 class _Group(click.Group):
     """The command group, whose usage errors (an unknown option, a value of
     the wrong type) are one line, like every other error: ``acausal
@@ -59,6 +113,24 @@ class _Group(click.Group):
             return super().main(args, prog_name, complete_var, standalone_mode, **extra)
         from .infra import startup
         startup.started()
+        if sys.stdout is None:      # started with stdout closed (>&-): the output is dropped
+            sys.stdout = open(os.devnull, "w")
+        try:
+            self._main(args, prog_name, complete_var, **extra)
+        except OSError as exc:
+            if exc.errno not in _STDOUT_ERRNOS:
+                raise
+            _drop_stdout()
+            click.echo(f"acausal: error: the output could not be written to standard output: "
+                       f"{exc.strerror or exc}", err=True)
+            _end_past_model_threads(2)
+            sys.exit(2)
+        except SystemExit as exc:
+            _end_past_model_threads(exc.code)
+            raise
+        _end_past_model_threads(0)
+
+    def _main(self, args, prog_name, complete_var, **extra):
         try:
             return super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
         except click.exceptions.Abort:
@@ -531,7 +603,8 @@ def _interruptible():
     if not _in_main_thread():
         yield phase
         return
-    names = [n for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n)]
+    from .infra.startup import STOP_SIGNALS
+    names = [n for n in STOP_SIGNALS if hasattr(signal, n)]
     old = {n: signal.signal(getattr(signal, n), handler) for n in names}
     sim.STOP.armed = True
     try:

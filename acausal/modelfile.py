@@ -95,11 +95,46 @@ def no_hard_exit():
             os._exit = real
 
 
+@contextlib.contextmanager
+def _command_state():
+    """The command's own state as it was before the model file ran: its
+    working folder (an ``os.chdir`` in the file sent ``--out rel.csv`` to
+    ``/rel.csv``), its standard streams (a file that closed stdout ended the
+    command with a traceback), its signal handlers (one that ignored SIGINT
+    made Ctrl-C do nothing) and numpy's error handling. What the file does
+    for itself while it is read is its own affair."""
+    import signal
+
+    import numpy as np
+    cwd = os.getcwd()
+    streams = (sys.stdin, sys.stdout, sys.stderr)
+    from .infra.startup import STOP_SIGNALS
+    names = [n for n in STOP_SIGNALS if hasattr(signal, n)]
+    main = threading.current_thread() is threading.main_thread()
+    handlers = {n: signal.getsignal(getattr(signal, n)) for n in names} if main else {}
+    errs = np.geterr()
+    try:
+        yield
+    finally:
+        if os.getcwd() != cwd:
+            os.chdir(cwd)
+        sys.stdin, sys.stdout, sys.stderr = streams
+        for name, fd in (("stdout", 1), ("stderr", 2)):
+            stream = getattr(sys, name)
+            if stream is not None and stream.closed:   # closed by the file: a new one on its fd
+                setattr(sys, name, open(fd, "w", buffering=1, closefd=False,
+                                        encoding=stream.encoding, errors=stream.errors))
+        for n, h in handlers.items():
+            if h is not None and signal.getsignal(getattr(signal, n)) is not h:
+                signal.signal(getattr(signal, n), h)
+        np.seterr(**errs)
+
+
 def _run(path):
     """The namespace of the model file ``path`` after running it; any
     exception it raises becomes a ModelFileError naming its line."""
     try:
-        with no_hard_exit():
+        with no_hard_exit(), _command_state():
             return runpy.run_path(path, run_name="__acausal_model__")
     except HardExit as exc:
         raise _error(path, _line(exc, path), f"the model file called {exc} while it was "
@@ -169,7 +204,9 @@ def load_model_file(path):
     (its imports searched in :func:`model_path`)."""
     path = os.path.abspath(path)
     if not os.path.isfile(path):
-        raise ModelFileError(f"{path}: no such model file", file=path)
+        what = "no such model file" if not os.path.exists(path) else \
+            "not a regular file (a model file is a Python script)"
+        raise ModelFileError(f"{path}: {what}", file=path)
     added = [f for f in model_path(path) if f not in sys.path]
     sys.path[0:0] = added
     try:
@@ -218,8 +255,9 @@ def _collect(ns, path):
 
 
 def _number(v):
-    """``v`` as a float, or None if it is not a real number."""
-    if isinstance(v, bool):
+    """``v`` as a float, or None if it is not a real number (a text is not
+    one: ``t_end="1"`` passed the checks and failed later with a traceback)."""
+    if isinstance(v, (bool, str, bytes)):
         return None
     try:
         return float(v)
@@ -320,6 +358,36 @@ def _conditions(ns, path):
 _CACHE = {}
 
 
+def _check_names(mf, cm, path):
+    """``conditions`` and ``free_parameters`` name free parameters of the
+    model, and a condition's unit has its parameter's dimension (a
+    ``free_parameters`` entry the model lacks, or a condition range in
+    furlongs for a force, passed without a word)."""
+    from .data.units import parse_unit
+    for what, names in (("conditions", mf.conditions), ("free_parameters", mf.free)):
+        for name in names:
+            try:
+                cm.param_index(name)
+            except AcausalError as exc:
+                raise _bad(path, what, f"{what}: {exc}") from None
+    units = {e.name: e.unit for e in cm.params}
+    for name, (_, _, unit) in mf.conditions.items():
+        if not unit:
+            continue
+        try:
+            given = parse_unit(unit).dimensionality
+        except Exception:  # noqa: BLE001 - pint raises several kinds on what it cannot read
+            raise _bad(path, "conditions", f"conditions[{name!r}]: unit {unit!r} is not a "
+                       "unit") from None
+        try:
+            own = parse_unit(units.get(name) or "1").dimensionality
+        except Exception:  # noqa: BLE001 - the parameter's unit unreadable: nothing to compare
+            continue
+        if given != own:
+            raise _bad(path, "conditions", f"conditions[{name!r}]: unit {unit!r} does "
+                       f"not have the dimension of {name}'s unit [{units.get(name)}]")
+
+
 def compile_file(path):
     """(ModelFile, CompiledModel) for a model file, compiled once per process
     and file version."""
@@ -332,11 +400,7 @@ def compile_file(path):
     if mf.experiment.stop is not None:
         mf.model.event(mf.experiment.stop.event(mf.model))
     cm = compile_model(mf.model)
-    for name in mf.conditions:
-        try:
-            cm.param_index(name)
-        except AcausalError as exc:
-            raise ModelFileError(f"{apath}: conditions: {exc}") from None
+    _check_names(mf, cm, apath)
     _CACHE[key] = (mf, cm)
     return mf, cm
 

@@ -18,7 +18,12 @@ import signal
 import sys
 
 _STATE = {"starting": False}
-_NAMES = ("SIGINT", "SIGTERM", "SIGHUP")
+# the signals that stop the command as Ctrl-C does, keeping what it finished:
+# SIGUSR1 and SIGXCPU are what batch systems send before they kill a job at
+# its time limit (SLURM's --signal, a CPU-time ulimit); they ended the
+# command silently, its partial results lost
+STOP_SIGNALS = ("SIGINT", "SIGTERM", "SIGHUP", "SIGUSR1", "SIGXCPU")
+_NAMES = STOP_SIGNALS
 
 
 def is_command(argv=None, orig_argv=None) -> bool:

@@ -8,6 +8,8 @@ noticed (a third battery):
 """
 import os
 import signal
+import subprocess
+import sys
 import time
 
 import numpy as np
@@ -398,3 +400,109 @@ def test_initial_equations_without_a_real_solution_are_said_so(tmp_path, backend
     assert "the initial equations have no real solution near the start values: equation 2 " \
         "(Odd) of odd: odd.z**2 + 1 = 0 stays at 1" in line, line
     assert "odd.z = " in line and "inconsistent fixed" not in line
+
+
+# -- the third battery: what a model file does to the command's process, other signals ----------
+
+def test_a_model_file_that_changes_folder_does_not_move_the_output(spring, tmp_path,
+                                                                   monkeypatch):
+    """os.chdir('/') in a model file sent ``--out rel.csv`` to /rel.csv."""
+    model = tmp_path / "moves.py"
+    model.write_text(SPRING + "import os\nos.chdir('/')\n")
+    here = tmp_path / "here"
+    here.mkdir()
+    monkeypatch.chdir(here)
+    r = _invoke(["simulate", model, "--out", "rel.csv"])
+    assert r.exit_code == 0, r.stderr
+    assert (here / "rel.csv").exists() and os.getcwd() == str(here)
+
+
+@pytest.mark.parametrize("extra, said", [
+    ("experiment = Experiment(t_end='1')\n", ":12: experiment t_end = '1' must be a finite "
+                                             "number"),
+    ("free_parameters = {'k.cc': (1.0, 2.0)}\n", ":12: free_parameters: the model has no "
+                                                  "parameter 'k.cc'"),
+    ("conditions = {'k.c': (50.0, 150.0, 'furlong')}\n",
+     ":12: conditions['k.c']: unit 'furlong' does not have the dimension of k.c's unit [N/m]"),
+])
+def test_model_file_bindings_checked_in_one_line(tmp_path, extra, said):
+    """t_end='1' gave a TypeError traceback; a free parameter the model
+    lacks and a condition range in furlongs for a stiffness passed."""
+    model = tmp_path / "m.py"
+    model.write_text(SPRING + extra)
+    assert said in _one_line(_invoke(["simulate", model]))
+
+
+def test_a_model_file_that_is_not_a_regular_file_is_said_so(tmp_path):
+    fifo = tmp_path / "fifo.py"
+    os.mkfifo(fifo)
+    assert "not a regular file" in _one_line(_invoke(["simulate", fifo]))
+
+
+def _long_spring(tmp_path, extra=""):
+    model = tmp_path / "long.py"
+    model.write_text(SPRING.replace("Experiment(t_end=0.5)",
+                                    "Experiment(t_end=1e6, rtol=1e-8, atol=1e-10, "
+                                    "output_step=10.0)") + extra)
+    return model
+
+
+@pytest.mark.parametrize("sig, extra", [
+    (signal.SIGUSR1, ""),                # a batch system's warning before its kill
+    (signal.SIGXCPU, ""),                # a CPU-time limit's
+    (signal.SIGINT, "import signal\nsignal.signal(signal.SIGINT, signal.SIG_IGN)\n"),
+])
+def test_other_stop_signals_keep_the_partial_result(tmp_path, sig, extra):
+    """SIGUSR1 and SIGXCPU (SLURM's --signal, ulimit -t) ended the command
+    silently with its rows lost; a model file that ignored SIGINT made
+    Ctrl-C do nothing."""
+    model, out = _long_spring(tmp_path, extra), tmp_path / "o.csv"
+    err_path = tmp_path / "err.txt"
+    with open(err_path, "w") as err:
+        proc = subprocess.Popen([sys.executable, "-m", "acausal.cli", "simulate", str(model),
+                                 "--out", str(out), "--progress"], env=h.env(tmp_path / "log"),
+                                stdout=subprocess.PIPE, stderr=err, text=True)
+        h.wait_for(lambda: "simulate:" in err_path.read_text(), proc)
+        proc.send_signal(sig)
+        proc.communicate(timeout=60)
+    text = err_path.read_text()
+    assert proc.returncode == 130, text
+    assert f"by an interruption ({signal.Signals(sig).name})" in text and "Traceback" not in text
+    assert len(np.loadtxt(out, delimiter=",", skiprows=1, usecols=0)) > 10
+
+
+def test_a_model_files_thread_does_not_hold_the_command(tmp_path):
+    """A non-daemon thread started by the model file made the command hang
+    after its results (Python waits for it at exit), and a SIGTERM then
+    gave a traceback from the interpreter's shutdown."""
+    model = tmp_path / "threaded.py"
+    model.write_text(SPRING + "import threading, time\n"
+                     "threading.Thread(target=time.sleep, args=(300,)).start()\n")
+    proc = h.cli(["simulate", model], h.env(tmp_path / "log"))
+    out, err = proc.communicate(timeout=60)
+    assert proc.returncode == 0, err
+    assert "s_end = " in out
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "thread(s) the model file started still run(s)" in lines[0]
+
+
+@pytest.mark.parametrize("how", ["closed by the model file", "a full device"])
+def test_standard_output_that_cannot_be_written(tmp_path, how):
+    """sys.stdout.close() in a model file, or stdout on /dev/full: a
+    traceback at the first line printed."""
+    model = tmp_path / "m.py"
+    if how == "closed by the model file":
+        model.write_text(SPRING + "import sys\nsys.stdout.close()\n")
+        proc = h.cli(["simulate", model], h.env(tmp_path / "log"))
+        out, err = proc.communicate(timeout=60)
+        assert proc.returncode == 0 and "s_end = " in out and not err.strip(), err
+    else:
+        model.write_text(SPRING)
+        with open("/dev/full", "w") as full:
+            proc = subprocess.Popen([sys.executable, "-m", "acausal.cli", "simulate", str(model)],
+                                    env=h.env(tmp_path / "log"), stdout=full,
+                                    stderr=subprocess.PIPE, text=True)
+            _, err = proc.communicate(timeout=60)
+        assert proc.returncode == 2
+        assert err.strip().splitlines() == ["acausal: error: the output could not be written "
+                                             "to standard output: No space left on device"]
