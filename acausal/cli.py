@@ -198,6 +198,20 @@ def _size(ctx, param, value):
         raise click.BadParameter(str(exc)) from None
 
 
+# formats a CSV written under their name would pretend to be (--out o.xlsx
+# wrote CSV text that a spreadsheet refuses to open)
+_NOT_CSV = (".xlsx", ".xls", ".ods", ".json", ".npz", ".npy", ".parquet", ".h5", ".hdf5",
+            ".mat", ".png", ".pdf", ".svg", ".gif", ".mp4", ".py", ".fmu", ".zip")
+
+
+def _check_csv(path, option):
+    """Refuse a CSV output named as another format."""
+    ext = os.path.splitext(os.fspath(path))[1].lower() if path is not None else ""
+    if ext in _NOT_CSV:
+        raise UsageError(f"{option} {path}: this output is written as CSV text; name it "
+                         f".csv (not {ext})")
+
+
 def _check_output(path, option, *, plot=False, create=False):
     """Refuse, before anything runs, an output path that cannot be written:
     its folder missing (unless ``create``: made now) or not writable, the
@@ -336,6 +350,8 @@ def _parse_sets(sets):
         if "=" not in item:
             raise UsageError(f"--set {item!r}: expected PATH=VALUE")
         k, v = item.split("=", 1)
+        if not k.strip():
+            raise UsageError(f"--set {item!r}: the name before '=' is missing")
         if k.strip() in out:     # (the last one silently won)
             raise UsageError(f"--set {item!r}: {k.strip()} is set twice", variable=k.strip())
         try:
@@ -438,6 +454,7 @@ def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, max_rows, max_wa
             _check_output(out, "--out")
             _check_output(plot, "--plot", plot=True)
             _check_distinct([("--out", out), ("--plot", plot)], [file])
+            _check_csv(out, "--out")
             params = _parse_sets(sets)
             mf, cm = compile_file(file)
             cm.param_vector(cm.split_overrides(params)[0])   # names, bounds: errors first
@@ -1036,6 +1053,7 @@ def _calibrate(cal, compile_file, file, data, fit, method, experiments, profile)
                   else _csv_list(experiments, "--experiments"))
     mf, cm = compile_file(file)
     ds = thin_traces(cal.model_dataset(file, data), say=True)
+    _condition_bounds(cm, ds)
     _condition_warnings(mf, ds)
     _trace_span_warnings(mf, ds)
     ds, held = cal.split(ds, chosen)
@@ -1114,6 +1132,22 @@ def _residual(name, value, mf=None):
             f"{v.size} samples")
 
 
+def _condition_bounds(cm, ds):
+    """A condition value outside its parameter's own bounds is an error
+    naming the experiment (it was a warning about the model file's range,
+    then an error that named neither the experiment nor the data)."""
+    from .errors import ParameterError
+    entries = {e.name: e for e in cm.params}
+    for exp in ds.experiments:
+        for name, v in exp.conditions.items():
+            if name in entries:
+                try:
+                    entries[name].decl.check_bounds(v, name)
+                except ParameterError as exc:
+                    raise UsageError(f"experiment {exp.name} of the data: {exc}",
+                                     variable=name) from None
+
+
 def _condition_warnings(mf, ds):
     """One line per experiment condition outside the range the model file
     declares (``conditions``), with a hint when a unit would explain it."""
@@ -1153,14 +1187,16 @@ def _trace_span_warnings(mf, ds):
 
 
 def _diagnosis_data_warnings(file, data):
-    """The data warnings calibrate gives (trace samples outside the model
-    file's run) before a diagnosis: it said nothing of a trace to 50 s
+    """The data checks calibrate makes (a condition outside its parameter's
+    bounds; trace samples outside the model file's run) before a diagnosis: it said nothing of a trace to 50 s
     against a 0.3 s run. The dataset is read here once more (the diagnosis
     reads its own); the compiled model is the process's cached one."""
     from .modelfile import compile_file
     from .studies import calibrate as cal
-    mf, _ = compile_file(file)
-    _trace_span_warnings(mf, cal.model_dataset(file, data))
+    mf, cm = compile_file(file)
+    ds = cal.model_dataset(file, data)
+    _condition_bounds(cm, ds)
+    _trace_span_warnings(mf, ds)
 
 
 AT_BOUND = 1e-4     # of a range: a fitted value this close to a bound is at it
@@ -1277,6 +1313,7 @@ def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max
             _check_output(out, "--out", create=True)
             _check_output(plot, "--plot", plot=True, create=True)
             _check_distinct([("--out", out), ("--plot", plot)], [file])
+            _check_csv(out, "--out")
             specs = [parse_param(p, max_points) for p in params]
             n_points = math.prod(len(v) for _, v in specs)
             if n_points > max_points:
@@ -1377,6 +1414,7 @@ def tolerance(file, spec, n, sampling, seed, measures, out, plot_prefix, json_pa
             if plot_prefix:
                 _check_output(plot_prefix + "_hist.png", "--plot", plot=True, create=True)
             _check_distinct([("--out", out), ("--json", json_path)], [file, spec])
+            _check_csv(out, "--out")
             tol.check_n(n, sampling)
             mf, cm = compile_file(file)
             dists = tol.parse_spec(spec, cm)

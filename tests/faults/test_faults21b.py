@@ -506,3 +506,32 @@ def test_standard_output_that_cannot_be_written(tmp_path, how):
         assert proc.returncode == 2
         assert err.strip().splitlines() == ["acausal: error: the output could not be written "
                                              "to standard output: No space left on device"]
+
+
+@pytest.mark.parametrize("args, said", [
+    (["simulate", "{m}", "--out", "{t}/o.xlsx"], "--out {t}/o.xlsx: this output is written as "
+                                                  "CSV text; name it .csv (not .xlsx)"),
+    (["sweep", "{m}", "--param", "k.c=10:20:3", "--measure", "s_end", "--out", "{t}/s.json"],
+     "name it .csv (not .json)"),
+    (["simulate", "{m}", "--set", "=5"], "--set '=5': the name before '=' is missing"),
+])
+def test_outputs_named_as_another_format_and_nameless_sets(spring, tmp_path, args, said):
+    """--out o.xlsx wrote CSV text a spreadsheet refuses; --set =5 said
+    'the model has no parameter '''."""
+    args = [a.format(m=spring, t=tmp_path) for a in args]
+    assert said.format(t=tmp_path) in _one_line(_invoke(args))
+    assert not list(tmp_path.glob("o.xlsx")) and not list(tmp_path.glob("s.json"))
+
+
+def test_a_condition_outside_its_parameters_bounds_names_the_experiment(tmp_path):
+    """F = -1 N in the data gave a warning about the model file's range,
+    then an error naming neither the experiment nor the data."""
+    from .test_battery21 import model_file
+    model = model_file(tmp_path)
+    data = tmp_path / "data"
+    data.mkdir()
+    (data / "experiments.csv").write_text("name,F [N],s_end [mm]\nE1,1.0,25.0\nE2,-1.0,20.0\n")
+    r = _invoke(["calibrate", model, data, "--fit", "k.c"])
+    line = _one_line(r)
+    assert "experiment E2 of the data: parameter F = -1 [N] must be >= 0" in line
+    assert not [ln for ln in r.stderr.splitlines() if "warning" in ln]
