@@ -1193,8 +1193,11 @@ def _diagnosis_data_warnings(file, data):
     reads its own); the compiled model is the process's cached one."""
     from .modelfile import compile_file
     from .studies import calibrate as cal
-    mf, cm = compile_file(file)
-    ds = cal.model_dataset(file, data)
+    try:
+        mf, cm = compile_file(file)
+        ds = cal.model_dataset(file, data)
+    except AcausalError:      # the diagnosis reads them again and says what is wrong
+        return
     _condition_bounds(cm, ds)
     _trace_span_warnings(mf, ds)
 
@@ -1684,9 +1687,6 @@ def fmu(file, out, outputs, inputs, measures, fmu_backend):
             twice = sorted({x for x in names if names.count(x) > 1})
             if twice:   # (an output given twice was exported twice, silently)
                 raise UsageError(f"{option} {twice[0]} is given twice", variable=twice[0])
-        both = sorted(set(outputs) & set(inputs))
-        if both:
-            raise UsageError(f"{both[0]} is given as --input and as --output", variable=both[0])
         _check_output(out, "--out")
         _check_distinct([("--out", out)], [file])
         with _quiet_warnings():      # a model file's own warnings: one line, counted
