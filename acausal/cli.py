@@ -620,7 +620,7 @@ def _interruptible():
     if not _in_main_thread():
         yield phase
         return
-    from .infra.startup import STOP_SIGNALS
+    from .infra.signals import STOP_SIGNALS
     names = [n for n in STOP_SIGNALS if hasattr(signal, n)]
     old = {n: signal.signal(getattr(signal, n), handler) for n in names}
     sim.STOP.armed = True

@@ -108,7 +108,7 @@ def _command_state():
     import numpy as np
     cwd = os.getcwd()
     streams = (sys.stdin, sys.stdout, sys.stderr)
-    from .infra.startup import STOP_SIGNALS
+    from .infra.signals import STOP_SIGNALS
     names = [n for n in STOP_SIGNALS if hasattr(signal, n)]
     main = threading.current_thread() is threading.main_thread()
     handlers = {n: signal.getsignal(getattr(signal, n)) for n in names} if main else {}

@@ -281,7 +281,7 @@ def _die_with_parent(parent: int) -> None:
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     import warnings
     warnings.simplefilter("ignore")   # numpy/scipy warnings: not a wall on the terminal
-    from .startup import STOP_SIGNALS
+    from .signals import STOP_SIGNALS
     for name in STOP_SIGNALS[2:]:    # SIGHUP, SIGUSR1, SIGXCPU: as SIGTERM
         if hasattr(signal, name):
             signal.signal(getattr(signal, name), signal.SIG_DFL)
@@ -371,7 +371,7 @@ def terminate_on_sigterm():
         exit_soon()   # whatever the unwinding meets, the process ends
         raise KeyboardInterrupt(f"terminated by signal {signum}")
 
-    from .startup import STOP_SIGNALS
+    from .signals import STOP_SIGNALS
     names = [n for n in STOP_SIGNALS if n != "SIGINT" and hasattr(signal, n)]
     old = {n: signal.signal(getattr(signal, n), handler) for n in names}
     try:

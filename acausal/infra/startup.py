@@ -17,12 +17,9 @@ import os
 import signal
 import sys
 
+from .signals import STOP_SIGNALS
+
 _STATE = {"starting": False}
-# the signals that stop the command as Ctrl-C does, keeping what it finished:
-# SIGUSR1 and SIGXCPU are what batch systems send before they kill a job at
-# its time limit (SLURM's --signal, a CPU-time ulimit); they ended the
-# command silently, its partial results lost
-STOP_SIGNALS = ("SIGINT", "SIGTERM", "SIGHUP", "SIGUSR1", "SIGXCPU")
 _NAMES = STOP_SIGNALS
 
 

@@ -113,7 +113,8 @@ def _alive(pid):
         return False
 
 
-@pytest.mark.parametrize("sig", [None, signal.SIGINT, signal.SIGTERM])
+@pytest.mark.parametrize("sig", [None, pytest.param(signal.SIGINT, marks=pytest.mark.slow),
+                                 signal.SIGTERM])
 def test_a_model_files_own_processes_end_with_the_command(tmp_path, sig):
     """A model file that starts ``sleep 300`` (and a shell's background
     ``sleep`` whose shell has ended) left both running after the command
@@ -158,6 +159,7 @@ def test_the_sweep_keys_are_the_points_reprs():
     assert _keys([{"a": -0.0}, {"a": 0.0}], ("a",)) == [("-0.0",), ("0.0",)]
 
 
+@pytest.mark.slow
 def test_a_large_sweep_says_it_is_preparing_before_its_bar(tmp_path):
     """A 1e6-point sweep showed nothing for its first minute (at load: 8.6 s
     unloaded, 6e6 reprs of the keys); now one line says what it does and
@@ -355,6 +357,7 @@ def test_an_fmu_output_given_twice_is_refused(spring, tmp_path):
     assert "--output body.s is given twice" in line and not out.exists()
 
 
+@pytest.mark.slow
 def test_diagnose_says_trace_samples_lie_outside_the_run(tmp_path):
     """calibrate and simulate warn of trace samples outside the run; the
     diagnosis compared them with the run's last value without a word."""
@@ -449,8 +452,9 @@ def _long_spring(tmp_path, extra=""):
 
 @pytest.mark.parametrize("sig, extra", [
     (signal.SIGUSR1, ""),                # a batch system's warning before its kill
-    (signal.SIGXCPU, ""),                # a CPU-time limit's
-    (signal.SIGINT, "import signal\nsignal.signal(signal.SIGINT, signal.SIG_IGN)\n"),
+    pytest.param(signal.SIGXCPU, "", marks=pytest.mark.slow),   # a CPU-time limit's
+    pytest.param(signal.SIGINT, "import signal\nsignal.signal(signal.SIGINT, signal.SIG_IGN)\n",
+                 marks=pytest.mark.slow),
 ])
 def test_other_stop_signals_keep_the_partial_result(tmp_path, sig, extra):
     """SIGUSR1 and SIGXCPU (SLURM's --signal, ulimit -t) ended the command
@@ -486,7 +490,8 @@ def test_a_model_files_thread_does_not_hold_the_command(tmp_path):
     assert len(lines) == 1 and "thread(s) the model file started still run(s)" in lines[0]
 
 
-@pytest.mark.parametrize("how", ["closed by the model file", "a full device"])
+@pytest.mark.parametrize("how", [pytest.param("closed by the model file",
+                                              marks=pytest.mark.slow), "a full device"])
 def test_standard_output_that_cannot_be_written(tmp_path, how):
     """sys.stdout.close() in a model file, or stdout on /dev/full: a
     traceback at the first line printed."""
