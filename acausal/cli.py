@@ -76,17 +76,14 @@ def _end_past_model_threads(code):
     from the interpreter's shutdown). Such a thread gets a grace of
     ``THREAD_GRACE_S``, then one line, and the process ends with ``code``
     (its descendants first). Only in the command's own process."""
-    import threading
-
     from .infra import startup
-    if not startup.is_command():
+    if not startup.is_command() or "acausal.modelfile" not in sys.modules:
         return
+    from .modelfile import STARTED_THREADS
     deadline = time.monotonic() + THREAD_GRACE_S
-    for t in threading.enumerate():
-        if t is not threading.main_thread() and not t.daemon:
-            t.join(max(deadline - time.monotonic(), 0.0))
-    left = [t for t in threading.enumerate()
-            if t is not threading.main_thread() and not t.daemon and t.is_alive()]
+    for t in STARTED_THREADS:
+        t.join(max(deadline - time.monotonic(), 0.0))
+    left = [t for t in STARTED_THREADS if t.is_alive()]
     if not left:
         return
     _warn(f"{len(left)} thread(s) the model file started still run(s) at the end "

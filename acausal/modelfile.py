@@ -95,6 +95,9 @@ def no_hard_exit():
             os._exit = real
 
 
+STARTED_THREADS = []   # non-daemon threads model files started while read (see the CLI's end)
+
+
 @contextlib.contextmanager
 def _command_state():
     """The command's own state as it was before the model file ran: its
@@ -113,9 +116,12 @@ def _command_state():
     main = threading.current_thread() is threading.main_thread()
     handlers = {n: signal.getsignal(getattr(signal, n)) for n in names} if main else {}
     errs = np.geterr()
+    before = set(threading.enumerate())
     try:
         yield
     finally:
+        STARTED_THREADS.extend(t for t in threading.enumerate()
+                               if t not in before and not t.daemon)
         if os.getcwd() != cwd:
             os.chdir(cwd)
         sys.stdin, sys.stdout, sys.stderr = streams

@@ -41,8 +41,18 @@ def _handler(signum, frame):
         os.write(2, f"acausal: interrupted ({name}) while starting: nothing done\n".encode())
         os._exit(130)
     if signum != signal.SIGINT:
-        from .executor import exit_soon
-        exit_soon(130)      # whatever the unwinding meets, the process ends
+        try:
+            from .executor import exit_soon
+        except ImportError:
+            # the signal came while executor itself was being imported (a
+            # sweep's first seconds): its half-made module has no exit_soon,
+            # and the ImportError was a traceback; the process ends anyway
+            import threading
+            timer = threading.Timer(20.0, os._exit, (130,))
+            timer.daemon = True
+            timer.start()
+        else:
+            exit_soon(130)      # whatever the unwinding meets, the process ends
     raise KeyboardInterrupt(name)
 
 

@@ -474,11 +474,13 @@ def _collect_windowed(executor, todo: list, submit: Callable, on_row: Callable[[
                       bar, window: int) -> None:
     """Submit ``todo`` in order, at most ``window`` unfinished at a time;
     record each as it finishes; cancel the rest if anything goes wrong."""
+    from ..infra.executor import check_interrupted
     inflight: dict = {}
     nxt = 0
     failed = 0
     try:
         while nxt < len(todo) or inflight:
+            check_interrupted()
             while nxt < len(todo) and len(inflight) < window:
                 inflight[submit(todo[nxt])] = todo[nxt]
                 nxt += 1
