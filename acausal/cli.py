@@ -17,10 +17,12 @@ declared ranges get one warning line each.
 import contextlib
 from dataclasses import dataclass
 import json
+import errno
 import math
 import os
 import signal
 import sys
+import time
 import warnings
 
 import click
@@ -48,6 +50,55 @@ def _warn(text):
     click.echo(f"acausal: warning: {_one_line(text)}", err=True)
 
 
+# errors of a write to standard output: a closed pipe (| head), a full device
+_STDOUT_ERRNOS = (errno.EPIPE, errno.ENOSPC, errno.EIO, errno.EBADF)
+
+
+def _drop_stdout():
+    """Point standard output at /dev/null, so that the interpreter's own
+    flush at exit does not fail again with a second message."""
+    try:
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, sys.stdout.fileno())
+        os.close(null)
+    except (OSError, ValueError, AttributeError):
+        pass
+
+
+THREAD_GRACE_S = 1.0   # a model file's thread has this long to end with the command
+
+
+def _end_past_model_threads(code):
+    """End the command even if a thread a model file started is still
+    running: Python waits at exit for every non-daemon thread, so a file
+    with a ``threading.Thread(target=time.sleep, args=(300,))`` made the
+    command hang after its results (and a SIGTERM then gave a traceback
+    from the interpreter's shutdown). Such a thread gets a grace of
+    ``THREAD_GRACE_S``, then one line, and the process ends with ``code``
+    (its descendants first). Only in the command's own process."""
+    from .infra import startup
+    if not startup.is_command() or "acausal.modelfile" not in sys.modules:
+        return
+    from .modelfile import STARTED_THREADS
+    deadline = time.monotonic() + THREAD_GRACE_S
+    for t in STARTED_THREADS:
+        t.join(max(deadline - time.monotonic(), 0.0))
+    left = [t for t in STARTED_THREADS if t.is_alive()]
+    if not left:
+        return
+    _warn(f"{len(left)} thread(s) the model file started still run(s) at the end "
+          f"({left[0].name}): not waited for")
+    from .infra.descendants import end
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError, AttributeError):
+            pass
+    end()
+    code = code if isinstance(code, int) else (0 if code is None else 1)
+    os._exit(code)
+
+
 class _Group(click.Group):
     """The command group, whose usage errors (an unknown option, a value of
     the wrong type) are one line, like every other error: ``acausal
@@ -59,6 +110,24 @@ class _Group(click.Group):
             return super().main(args, prog_name, complete_var, standalone_mode, **extra)
         from .infra import startup
         startup.started()
+        if sys.stdout is None:      # started with stdout closed (>&-): the output is dropped
+            sys.stdout = open(os.devnull, "w")
+        try:
+            self._main(args, prog_name, complete_var, **extra)
+        except OSError as exc:
+            if exc.errno not in _STDOUT_ERRNOS:
+                raise
+            _drop_stdout()
+            click.echo(f"acausal: error: the output could not be written to standard output: "
+                       f"{exc.strerror or exc}", err=True)
+            _end_past_model_threads(2)
+            sys.exit(2)
+        except SystemExit as exc:
+            _end_past_model_threads(exc.code)
+            raise
+        _end_past_model_threads(0)
+
+    def _main(self, args, prog_name, complete_var, **extra):
         try:
             return super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
         except click.exceptions.Abort:
@@ -95,6 +164,9 @@ class _Number(click.ParamType):
             self.fail(f"{value!r} must be > 0", param, ctx)
         if self.kind == "fraction" and not 0 < x < 1:
             self.fail(f"{value!r} must be between 0 and 1", param, ctx)
+        if self.kind == "atol" and not ATOL_RANGE[0] <= x <= ATOL_RANGE[1]:
+            self.fail(f"{value!r} is outside the accepted range {ATOL_RANGE[0]:g} to "
+                      f"{ATOL_RANGE[1]:g} (SI units of the unknowns)", param, ctx)
         if self.kind == "count":
             if x != int(x) or x < 1:
                 self.fail(f"{value!r} must be a whole number >= 1", param, ctx)
@@ -104,8 +176,12 @@ class _Number(click.ParamType):
         return x
 
 
-FINITE, POSITIVE, FRACTION, COUNT = (_Number(k) for k in ("finite", "positive", "fraction",
-                                                           "count"))
+# --atol: what an absolute tolerance in SI units can mean: above 1e3 every
+# position, speed and force of a mechanism counts as zero; below 1e-20 no
+# solution gets closer than the relative tolerance makes it
+ATOL_RANGE = (1e-20, 1e3)
+FINITE, POSITIVE, FRACTION, COUNT, ATOL = (_Number(k) for k in ("finite", "positive", "fraction",
+                                                                 "count", "atol"))
 
 
 def _size(ctx, param, value):
@@ -117,6 +193,20 @@ def _size(ctx, param, value):
         return parse_size(value, f"--{param.name.replace('_', '-')}")
     except UsageError as exc:
         raise click.BadParameter(str(exc)) from None
+
+
+# formats a CSV written under their name would pretend to be (--out o.xlsx
+# wrote CSV text that a spreadsheet refuses to open)
+_NOT_CSV = (".xlsx", ".xls", ".ods", ".json", ".npz", ".npy", ".parquet", ".h5", ".hdf5",
+            ".mat", ".png", ".pdf", ".svg", ".gif", ".mp4", ".py", ".fmu", ".zip")
+
+
+def _check_csv(path, option):
+    """Refuse a CSV output named as another format."""
+    ext = os.path.splitext(os.fspath(path))[1].lower() if path is not None else ""
+    if ext in _NOT_CSV:
+        raise UsageError(f"{option} {path}: this output is written as CSV text; name it "
+                         f".csv (not {ext})")
 
 
 def _check_output(path, option, *, plot=False, create=False):
@@ -257,6 +347,8 @@ def _parse_sets(sets):
         if "=" not in item:
             raise UsageError(f"--set {item!r}: expected PATH=VALUE")
         k, v = item.split("=", 1)
+        if not k.strip():
+            raise UsageError(f"--set {item!r}: the name before '=' is missing")
         if k.strip() in out:     # (the last one silently won)
             raise UsageError(f"--set {item!r}: {k.strip()} is set twice", variable=k.strip())
         try:
@@ -326,7 +418,7 @@ MAX_MEMORY_HELP = ("memory limit of the command (4GB, 512MB, ...; default $ACAUS
 @click.option("--plot", type=click.Path(dir_okay=False), help="write a figure (PNG, PDF...)")
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object")
 @click.option("--rtol", type=FRACTION, help="relative tolerance (0 < rtol < 1)")
-@click.option("--atol", type=POSITIVE, help="absolute tolerance (> 0)")
+@click.option("--atol", type=ATOL, help="absolute tolerance (1e-20 to 1e3, SI units)")
 @click.option("--max-rows", type=COUNT, default=None, metavar="N",
               help="most output rows to store (default 1e6): a larger grid is refused")
 @click.option("--max-wall", type=POSITIVE, metavar="SECONDS",
@@ -359,6 +451,7 @@ def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, max_rows, max_wa
             _check_output(out, "--out")
             _check_output(plot, "--plot", plot=True)
             _check_distinct([("--out", out), ("--plot", plot)], [file])
+            _check_csv(out, "--out")
             params = _parse_sets(sets)
             mf, cm = compile_file(file)
             cm.param_vector(cm.split_overrides(params)[0])   # names, bounds: errors first
@@ -524,7 +617,8 @@ def _interruptible():
     if not _in_main_thread():
         yield phase
         return
-    names = [n for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n)]
+    from .infra.signals import STOP_SIGNALS
+    names = [n for n in STOP_SIGNALS if hasattr(signal, n)]
     old = {n: signal.signal(getattr(signal, n), handler) for n in names}
     sim.STOP.armed = True
     try:
@@ -956,6 +1050,7 @@ def _calibrate(cal, compile_file, file, data, fit, method, experiments, profile)
                   else _csv_list(experiments, "--experiments"))
     mf, cm = compile_file(file)
     ds = thin_traces(cal.model_dataset(file, data), say=True)
+    _condition_bounds(cm, ds)
     _condition_warnings(mf, ds)
     _trace_span_warnings(mf, ds)
     ds, held = cal.split(ds, chosen)
@@ -1034,6 +1129,22 @@ def _residual(name, value, mf=None):
             f"{v.size} samples")
 
 
+def _condition_bounds(cm, ds):
+    """A condition value outside its parameter's own bounds is an error
+    naming the experiment (it was a warning about the model file's range,
+    then an error that named neither the experiment nor the data)."""
+    from .errors import ParameterError
+    entries = {e.name: e for e in cm.params}
+    for exp in ds.experiments:
+        for name, v in exp.conditions.items():
+            if name in entries:
+                try:
+                    entries[name].decl.check_bounds(v, name)
+                except ParameterError as exc:
+                    raise UsageError(f"experiment {exp.name} of the data: {exc}",
+                                     variable=name) from None
+
+
 def _condition_warnings(mf, ds):
     """One line per experiment condition outside the range the model file
     declares (``conditions``), with a hint when a unit would explain it."""
@@ -1070,6 +1181,22 @@ def _trace_span_warnings(mf, ds):
             _warn(f"{where}: {' and '.join(parts)} of its {t.size:,} samples lie outside the "
                   "model file's run, where they are compared with its first or last value: "
                   "check the time column's unit, or the experiment's t0 and t_end")
+
+
+def _diagnosis_data_warnings(file, data):
+    """The data checks calibrate makes (a condition outside its parameter's
+    bounds; trace samples outside the model file's run) before a diagnosis: it said nothing of a trace to 50 s
+    against a 0.3 s run. The dataset is read here once more (the diagnosis
+    reads its own); the compiled model is the process's cached one."""
+    from .modelfile import compile_file
+    from .studies import calibrate as cal
+    try:
+        mf, cm = compile_file(file)
+        ds = cal.model_dataset(file, data)
+    except AcausalError:      # the diagnosis reads them again and says what is wrong
+        return
+    _condition_bounds(cm, ds)
+    _trace_span_warnings(mf, ds)
 
 
 AT_BOUND = 1e-4     # of a range: a fitted value this close to a bound is at it
@@ -1143,6 +1270,7 @@ def _sweep_units(mf, cm, params, measures):
 SWEEP_POINT_BYTES = 600     # a sweep point in the main process, per column (+ 400 bytes):
                             # 1.1 kB measured for 1 parameter and 1 measure, x 1.5
 MAX_POINTS = 1_000_000      # the sweep's default work budget
+SWEEP_SAY_PREPARING = 100_000   # a grid this large says so before its bar shows
 
 
 @main.command()
@@ -1185,6 +1313,7 @@ def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max
             _check_output(out, "--out", create=True)
             _check_output(plot, "--plot", plot=True, create=True)
             _check_distinct([("--out", out), ("--plot", plot)], [file])
+            _check_csv(out, "--out")
             specs = [parse_param(p, max_points) for p in params]
             n_points = math.prod(len(v) for _, v in specs)
             if n_points > max_points:
@@ -1208,6 +1337,10 @@ def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max
             task = functools.partial(sweep_task, os.path.abspath(file),
                                      max_memory=max(per_worker, 50e6))
             units = _sweep_units(mf, cm, [name for name, _ in specs], measures)
+            if n_points >= SWEEP_SAY_PREPARING and not no_progress:
+                # (about 3 s per 1e6 points before the bar, more on a loaded host)
+                click.echo(f"sweep: preparing {n_points:,} points (the grid, the "
+                           "checkpoint, what is already done)", err=True)
             points = grid(specs)
             with terminate_on_sigterm(), _resumable(out), \
                     Watchdog(limit, max_wall, "the sweep"), \
@@ -1281,6 +1414,7 @@ def tolerance(file, spec, n, sampling, seed, measures, out, plot_prefix, json_pa
             if plot_prefix:
                 _check_output(plot_prefix + "_hist.png", "--plot", plot=True, create=True)
             _check_distinct([("--out", out), ("--json", json_path)], [file, spec])
+            _check_csv(out, "--out")
             tol.check_n(n, sampling)
             mf, cm = compile_file(file)
             dists = tol.parse_spec(spec, cm)
@@ -1486,6 +1620,7 @@ def diagnose(file, data, json_opt, json_file, report_dir, scheduler, workers, ma
             n_workers = workers or (default_workers() if scheduler is None else 1)
             check_estimate((n_workers + 1) * PROCESS_BYTES, limit,
                            f"a diagnosis on {n_workers} workers", "use fewer --workers")
+            _diagnosis_data_warnings(file, data)
             with terminate_on_sigterm(), _resumable(f"{report_dir}/checkpoint"), \
                     Watchdog(limit, max_wall, "the diagnosis"):
                 out = run_diagnosis(file, data, out_dir=report_dir, scheduler=scheduler,
@@ -1545,6 +1680,10 @@ def fmu(file, out, outputs, inputs, measures, fmu_backend):
     """Export a model file as an FMU (FMI 2.0 Co-Simulation)."""
     from .interop.fmu import export_fmu
     try:
+        for option, names in (("--output", outputs), ("--input", inputs)):
+            twice = sorted({x for x in names if names.count(x) > 1})
+            if twice:   # (an output given twice was exported twice, silently)
+                raise UsageError(f"{option} {twice[0]} is given twice", variable=twice[0])
         _check_output(out, "--out")
         _check_distinct([("--out", out)], [file])
         with _quiet_warnings():      # a model file's own warnings: one line, counted

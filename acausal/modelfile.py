@@ -16,11 +16,13 @@ another one (``from breaker_24kv import build``): its folder, ``$ACAUSAL_MODEL_P
 the current folder's ``models/`` and the bundled ``models/`` are on the path
 (:func:`model_path`).
 """
+import contextlib
 import math
 import os
 import re
 import runpy
 import sys
+import threading
 import traceback
 from dataclasses import dataclass, field
 
@@ -61,11 +63,89 @@ def _error(path, line, message):
     return ModelFileError(f"{where}: {message}", file=path, line=line)
 
 
+class HardExit(BaseException):
+    """``os._exit(code)`` called by a model file's code while the command
+    runs it (see :func:`no_hard_exit`); a BaseException, so that the file's
+    own ``except Exception`` does not swallow it."""
+
+    def __init__(self, code):
+        super().__init__(f"os._exit({code!r})")
+        self.code = code
+
+
+@contextlib.contextmanager
+def no_hard_exit():
+    """While the block runs the model file's code (its reading, a measure,
+    its plot), ``os._exit`` called from this thread of this process raises
+    :class:`HardExit`: ``os._exit(7)`` ended the command with exit 7 and no
+    word, results unsaid. A process the file forks, or another thread,
+    still exits as it asked (multiprocessing's children end by
+    ``os._exit``)."""
+    real, pid, thread = os._exit, os.getpid(), threading.get_ident()
+
+    def _exit(code):
+        if os.getpid() == pid and threading.get_ident() == thread:
+            raise HardExit(code)
+        real(code)
+    os._exit = _exit
+    try:
+        yield
+    finally:
+        if os._exit is _exit:
+            os._exit = real
+
+
+STARTED_THREADS = []   # non-daemon threads model files started while read (see the CLI's end)
+
+
+@contextlib.contextmanager
+def _command_state():
+    """The command's own state as it was before the model file ran: its
+    working folder (an ``os.chdir`` in the file sent ``--out rel.csv`` to
+    ``/rel.csv``), its standard streams (a file that closed stdout ended the
+    command with a traceback), its signal handlers (one that ignored SIGINT
+    made Ctrl-C do nothing) and numpy's error handling. What the file does
+    for itself while it is read is its own affair."""
+    import signal
+
+    import numpy as np
+    cwd = os.getcwd()
+    streams = (sys.stdin, sys.stdout, sys.stderr)
+    from .infra.signals import STOP_SIGNALS
+    names = [n for n in STOP_SIGNALS if hasattr(signal, n)]
+    main = threading.current_thread() is threading.main_thread()
+    handlers = {n: signal.getsignal(getattr(signal, n)) for n in names} if main else {}
+    errs = np.geterr()
+    before = set(threading.enumerate())
+    try:
+        yield
+    finally:
+        STARTED_THREADS.extend(t for t in threading.enumerate()
+                               if t not in before and not t.daemon)
+        if os.getcwd() != cwd:
+            os.chdir(cwd)
+        sys.stdin, sys.stdout, sys.stderr = streams
+        for name, fd in (("stdout", 1), ("stderr", 2)):
+            stream = getattr(sys, name)
+            if stream is not None and stream.closed:   # closed by the file: a new one on its fd
+                setattr(sys, name, open(fd, "w", buffering=1, closefd=False,
+                                        encoding=stream.encoding, errors=stream.errors))
+        for n, h in handlers.items():
+            if h is not None and signal.getsignal(getattr(signal, n)) is not h:
+                signal.signal(getattr(signal, n), h)
+        np.seterr(**errs)
+
+
 def _run(path):
     """The namespace of the model file ``path`` after running it; any
     exception it raises becomes a ModelFileError naming its line."""
     try:
-        return runpy.run_path(path, run_name="__acausal_model__")
+        with no_hard_exit(), _command_state():
+            return runpy.run_path(path, run_name="__acausal_model__")
+    except HardExit as exc:
+        raise _error(path, _line(exc, path), f"the model file called {exc} while it was "
+                     "being read: a model file binds 'model', it does not end the "
+                     "command") from None
     except SyntaxError as exc:  # also a bad encoding or a NUL byte
         line = exc.lineno if os.path.abspath(exc.filename or path) == path else None
         raise _error(path, line or _bad_byte_line(path), f"syntax error: {exc.msg}") from None
@@ -130,7 +210,9 @@ def load_model_file(path):
     (its imports searched in :func:`model_path`)."""
     path = os.path.abspath(path)
     if not os.path.isfile(path):
-        raise ModelFileError(f"{path}: no such model file", file=path)
+        what = "no such model file" if not os.path.exists(path) else \
+            "not a regular file (a model file is a Python script)"
+        raise ModelFileError(f"{path}: {what}", file=path)
     added = [f for f in model_path(path) if f not in sys.path]
     sys.path[0:0] = added
     try:
@@ -179,8 +261,9 @@ def _collect(ns, path):
 
 
 def _number(v):
-    """``v`` as a float, or None if it is not a real number."""
-    if isinstance(v, bool):
+    """``v`` as a float, or None if it is not a real number (a text is not
+    one: ``t_end="1"`` passed the checks and failed later with a traceback)."""
+    if isinstance(v, (bool, str, bytes)):
         return None
     try:
         return float(v)
@@ -216,6 +299,11 @@ def _check_experiment(exp, path):
                 (" (or 0: the solver's steps)" if name == "output_step" else "")
     if bad is None and _positive(exp.rtol) and not _number(exp.rtol) < 1:
         bad = f"rtol = {exp.rtol!r} must be below 1 (a relative tolerance)"
+    options = getattr(exp, "options", None)
+    if bad is None and options:   # a field no run reads: the settings were silently ignored
+        bad = (f"options = {options!r} is not read by any run: give the settings as "
+               "Experiment's own arguments (t_end, t0, rtol, atol, output_step, max_step, "
+               "atol_algebraic, dense_step, stop)")
     stop = getattr(exp, "stop", None)
     if bad is None and stop is not None and not isinstance(stop, Stop):
         bad = (f"stop = {stop!r} must be an acausal.Stop, e.g. Stop('hook.phi', '<=', -0.1) "
@@ -276,6 +364,36 @@ def _conditions(ns, path):
 _CACHE = {}
 
 
+def _check_names(mf, cm, path):
+    """``conditions`` and ``free_parameters`` name free parameters of the
+    model, and a condition's unit has its parameter's dimension (a
+    ``free_parameters`` entry the model lacks, or a condition range in
+    furlongs for a force, passed without a word)."""
+    from .data.units import parse_unit
+    for what, names in (("conditions", mf.conditions), ("free_parameters", mf.free)):
+        for name in names:
+            try:
+                cm.param_index(name)
+            except AcausalError as exc:
+                raise _bad(path, what, f"{what}: {exc}") from None
+    units = {e.name: e.unit for e in cm.params}
+    for name, (_, _, unit) in mf.conditions.items():
+        if not unit:
+            continue
+        try:
+            given = parse_unit(unit).dimensionality
+        except Exception:  # noqa: BLE001 - pint raises several kinds on what it cannot read
+            raise _bad(path, "conditions", f"conditions[{name!r}]: unit {unit!r} is not a "
+                       "unit") from None
+        try:
+            own = parse_unit(units.get(name) or "1").dimensionality
+        except Exception:  # noqa: BLE001 - the parameter's unit unreadable: nothing to compare
+            continue
+        if given != own:
+            raise _bad(path, "conditions", f"conditions[{name!r}]: unit {unit!r} does "
+                       f"not have the dimension of {name}'s unit [{units.get(name)}]")
+
+
 def compile_file(path):
     """(ModelFile, CompiledModel) for a model file, compiled once per process
     and file version."""
@@ -288,11 +406,7 @@ def compile_file(path):
     if mf.experiment.stop is not None:
         mf.model.event(mf.experiment.stop.event(mf.model))
     cm = compile_model(mf.model)
-    for name in mf.conditions:
-        try:
-            cm.param_index(name)
-        except AcausalError as exc:
-            raise ModelFileError(f"{apath}: conditions: {exc}") from None
+    _check_names(mf, cm, apath)
     _CACHE[key] = (mf, cm)
     return mf, cm
 
@@ -303,8 +417,9 @@ def evaluate_measures(mf, result):
     out = {}
     for name, fn in mf.measures.items():
         try:
-            out[name] = float(fn(result))
-        except (Exception, SystemExit) as exc:   # sys.exit() in a measure: it failed
+            with no_hard_exit():
+                out[name] = float(fn(result))
+        except (Exception, SystemExit, HardExit) as exc:   # sys.exit() in a measure: it failed
             raise ModelFileError(f"{mf.path}: measure {name!r} failed: "
                                  f"{type(exc).__name__}: {exc}") from None
     return out
@@ -334,8 +449,9 @@ def measure_values(mf, result):
     values, missing = {}, {}
     for name, fn in mf.measures.items():
         try:
-            values[name] = float(fn(result))
-        except (Exception, SystemExit) as exc:  # noqa: BLE001 - the model file's code:
+            with no_hard_exit():
+                values[name] = float(fn(result))
+        except (Exception, SystemExit, HardExit) as exc:  # noqa: BLE001 - the model file's code:
             # reported, not raised (a measure's sys.exit() ended the command, results unsaid)
             values[name] = float("nan")
             missing[name] = f"{type(exc).__name__}: {exc}"
@@ -351,8 +467,9 @@ def call_plot(mf, result, path):
     (a plot function that raised ended the command with a traceback, after
     the run and its CSV)."""
     try:
-        mf.namespace["plot"](result, path)
-    except (Exception, SystemExit) as exc:  # noqa: BLE001 - the model file's code
+        with no_hard_exit():
+            mf.namespace["plot"](result, path)
+    except (Exception, SystemExit, HardExit) as exc:  # noqa: BLE001 - the model file's code
         raise _error(mf.path, _line(exc, mf.path), f"its plot(result, path) failed: "
                      f"{type(exc).__name__}: {_short(exc)}") from None
 

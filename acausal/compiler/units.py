@@ -106,15 +106,18 @@ class _Dimensions:
     def __init__(self, flat):
         self.units = {}
         self.values = {}
+        self.declared = {}    # path -> the unit text as declared
         for path, info in flat.params.items():
             if not getattr(info.decl, "unit_declared", True):
                 continue
+            self.declared[path] = info.decl.unit
             self.units[info.symbol] = self._unit_text(info.decl.unit, path, flat)
             if isinstance(info.value, (int, float)) and not isinstance(info.value, bool):
                 self.values[info.symbol] = sp.Float(info.value)
         for table in (flat.variables, flat.discretes):
             for path, info in table.items():
                 if info.unit_declared:
+                    self.declared[path] = info.unit
                     self.units[info.symbol] = self._unit_text(info.unit, path, flat)
 
     @staticmethod
@@ -243,6 +246,10 @@ def check_units(flat, owners=None):
     class name, for the message."""
     dims = _Dimensions(flat)
     owners = owners or getattr(flat, "owners", {}) or {}
+    for path, unit in dims.declared.items():
+        why = _not_si(unit, path, flat)
+        if why:
+            raise ModelError(f"units: {path}: unit {unit!r} {why}")
     for eq in flat.equations:
         residuals, conditions = _residuals(eq.expr)
         try:
@@ -259,6 +266,33 @@ def check_units(flat, owners=None):
                 f"units: {eq.label or 'an equation'} of {label} is not consistent: "
                 f"{_short(a)} is [{show(da)}] but {_short(b)} is [{show(db)}] "
                 f"(in {_short(eq.expr, 160)} = 0)") from None
+
+
+def _not_si(unit, path, flat):
+    """Why a declared unit is refused, or None: one pint cannot read (after
+    Modelica's ``s2`` for ``s^2``), unless it holds a name of its owner's
+    parameters (``N/m^gamma``: an exponent read when it resolves), or one
+    with a dimension that is not a coherent SI unit (``furlongs``, ``mm``,
+    ``kN``: values are SI, so the declared unit must be too; it passed and
+    labelled SI values with it). A scaled pure number (``%`` of a pulse's
+    period) is the equations' business and passes."""
+    text = (unit or "1").strip()
+    if text in ("", "-", "1"):
+        return None
+    owner = path.rsplit(".", 1)[0] if "." in path else ""
+    names = re.findall(r"[A-Za-z_]\w*", text)
+    if any((f"{owner}.{n}" if owner else n) in flat.params for n in names):
+        return None
+    modelica = re.sub(r"(?<=[A-Za-z])(\d+)", r"^\1", text)
+    try:
+        from ..data.units import ureg
+        q = ureg().Quantity(1.0, parse_unit(modelica)).to_base_units()
+    except Exception:  # noqa: BLE001 - pint raises several kinds on what it cannot read
+        return "is not a unit (write SI units: m, kg, s, N, N/m, rad/s...)"
+    if abs(q.magnitude - 1.0) > 1e-12 and dimension(modelica):
+        return (f"is not an SI unit (1 {text} = {q.magnitude:.6g} {show(dimension(modelica))}): "
+                f"values are in SI units, declare {show(dimension(modelica))!r}")
+    return None
 
 
 def _residuals(expr):

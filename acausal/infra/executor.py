@@ -281,8 +281,10 @@ def _die_with_parent(parent: int) -> None:
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     import warnings
     warnings.simplefilter("ignore")   # numpy/scipy warnings: not a wall on the terminal
-    if hasattr(signal, "SIGHUP"):
-        signal.signal(signal.SIGHUP, signal.SIG_DFL)
+    from .signals import STOP_SIGNALS
+    for name in STOP_SIGNALS[2:]:    # SIGHUP, SIGUSR1, SIGXCPU: as SIGTERM
+        if hasattr(signal, name):
+            signal.signal(getattr(signal, name), signal.SIG_DFL)
     if sys.platform.startswith("linux"):
         try:
             libc = ctypes.CDLL(None, use_errno=True)
@@ -337,6 +339,27 @@ def _quiet_broken_pool() -> None:
     threading.excepthook = hook
 
 
+def _quiet_exit_wakeup(pool: cf.ProcessPoolExecutor) -> None:
+    """A signal while the pool starts its workers can leave the pipe that
+    wakes its manager thread closed underneath it; at exit the interpreter
+    wakes that thread once more and printed 'Exception ignored ... OSError:
+    [Errno 9] Bad file descriptor' with a traceback (2 sweeps in 20 given
+    SIGTERM 1.6-1.8 s after their start). That last wake-up of a pool already
+    stopped may fail quietly. (Private state of concurrent.futures, as in
+    :func:`_terminate_workers`.)"""
+    wake = getattr(pool, "_executor_manager_thread_wakeup", None)
+    if wake is None or not hasattr(wake, "wakeup"):
+        return
+    real = wake.wakeup
+
+    def wakeup():
+        try:
+            real()
+        except OSError:
+            pass
+    wake.wakeup = wakeup
+
+
 @contextlib.contextmanager
 def _process_pool(workers: int | None):
     """A local pool whose workers die with this process (see
@@ -346,6 +369,7 @@ def _process_pool(workers: int | None):
     _quiet_broken_pool()     # (before the workers can die: a group's SIGTERM reaches them first)
     pool = cf.ProcessPoolExecutor(max_workers=n, initializer=_die_with_parent,
                                   initargs=(os.getpid(),))
+    _quiet_exit_wakeup(pool)
     try:
         yield Executor("processes", pool, n)
     except BaseException:
@@ -367,13 +391,19 @@ def terminate_on_sigterm():
 
     def handler(signum, frame):
         exit_soon()   # whatever the unwinding meets, the process ends
+        _PENDING["signal"] = signum
+        if _swallowing(frame):
+            return    # raised at the caller's next check (:func:`check_interrupted`)
         raise KeyboardInterrupt(f"terminated by signal {signum}")
 
-    names = [n for n in ("SIGTERM", "SIGHUP") if hasattr(signal, n)]
+    from .signals import STOP_SIGNALS
+    names = [n for n in STOP_SIGNALS if n != "SIGINT" and hasattr(signal, n)]
     old = {n: signal.signal(getattr(signal, n), handler) for n in names}
+    _PENDING["signal"] = None
     try:
         yield
     finally:
+        _PENDING["signal"] = None
         for n, h in old.items():
             signal.signal(getattr(signal, n), h)
 
@@ -406,11 +436,40 @@ def exit_soon(code: int = 130, grace: float = EXIT_GRACE_S) -> None:
                              "interruption: ended\n")
             sys.stderr.flush()
         finally:
+            from .descendants import end
+            end(grace=1.0)     # os._exit skips atexit: the model file's processes too
             os._exit(_EXITING["code"])
     threading.Thread(target=later, daemon=True, name="acausal-exit-soon").start()
 
 
 _EXITING = {"deadline": None, "code": 130}
+_PENDING = {"signal": None}   # a stop signal whose KeyboardInterrupt may have been lost
+# code where Python reports an exception and goes on ('Exception ignored'):
+# the interpreter's at-fork hooks of logging, run while a pool forks its workers
+_SWALLOWING = (os.path.join("logging", "__init__.py"),)
+
+
+def _swallowing(frame) -> bool:
+    """Whether a KeyboardInterrupt raised in ``frame`` would be printed and
+    dropped (a SIGTERM while a sweep's pool forked its workers: 'Exception
+    ignored in _releaseLock', then the sweep ran on until the 20 s hard
+    exit)."""
+    f = frame
+    while f is not None:
+        if f.f_code.co_filename.endswith(_SWALLOWING):
+            return True
+        f = f.f_back
+    return False
+
+
+def check_interrupted() -> None:
+    """Raise the KeyboardInterrupt of a stop signal that arrived where it
+    could not be raised (see :func:`terminate_on_sigterm`); a loop that
+    waits on workers calls this between waits."""
+    sig = _PENDING["signal"]
+    if sig is not None:
+        _PENDING["signal"] = None
+        raise KeyboardInterrupt(f"terminated by signal {sig}")
 
 
 def exit_no_sooner(grace: float) -> None:

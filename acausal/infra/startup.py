@@ -10,14 +10,17 @@ interrupts as Ctrl-C does (KeyboardInterrupt: the command's one-line
 'interrupted'), SIGTERM and SIGHUP included, with the process's end armed
 (:func:`acausal.infra.executor.exit_soon`). Commands that save work install
 their own handlers over these while they run. A signal the process was
-started ignoring (``nohup``: SIGHUP) stays ignored.
+started ignoring (``nohup``: SIGHUP) stays ignored. No process the command
+started outlives it (:mod:`acausal.infra.descendants`).
 """
 import os
 import signal
 import sys
 
+from .signals import STOP_SIGNALS
+
 _STATE = {"starting": False}
-_NAMES = ("SIGINT", "SIGTERM", "SIGHUP")
+_NAMES = STOP_SIGNALS
 
 
 def is_command(argv=None, orig_argv=None) -> bool:
@@ -38,13 +41,29 @@ def _handler(signum, frame):
         os.write(2, f"acausal: interrupted ({name}) while starting: nothing done\n".encode())
         os._exit(130)
     if signum != signal.SIGINT:
-        from .executor import exit_soon
-        exit_soon(130)      # whatever the unwinding meets, the process ends
+        try:
+            from .executor import exit_soon
+        except ImportError:
+            # the signal came while executor itself was being imported (a
+            # sweep's first seconds): its half-made module has no exit_soon,
+            # and the ImportError was a traceback; the process ends anyway
+            import threading
+            timer = threading.Timer(20.0, os._exit, (130,))
+            timer.daemon = True
+            timer.start()
+        else:
+            exit_soon(130)      # whatever the unwinding meets, the process ends
     raise KeyboardInterrupt(name)
 
 
 def guard() -> None:
-    """Install the handlers (where a signal has its default action)."""
+    """Install the handlers (where a signal has its default action); make
+    the command end its model file's own processes when it ends
+    (:mod:`acausal.infra.descendants`)."""
+    import atexit
+    from . import descendants
+    descendants.adopt()
+    atexit.register(descendants.end)   # registered first: runs last
     defaults = {"SIGINT": signal.default_int_handler}
     _STATE["starting"] = True
     for name in _NAMES:

@@ -109,6 +109,10 @@ class PosPow(sp.Function):
         x, g = (printer._print(a) for a in self.args)
         return f"(({x})**({g}) if ({x}) > 0 else 0.0)"
 
+    def _numpycode(self, printer):   # over arrays of rows (acausal.runtime.observe)
+        x, g = (printer._print(a) for a in self.args)
+        return f"_where(({x}) > 0, ({x})**({g}), 0.0)"
+
     def _ccode(self, printer):   # the compiled backend (acausal/codegen_c.py)
         x, g = (printer._print(a) for a in self.args)
         return f"(({x}) > 0 ? pow({x}, {g}) : 0.0)"

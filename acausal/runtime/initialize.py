@@ -345,6 +345,9 @@ def _check(cm, full, J, z, fixed, n):
         return
     names = [name for a, (_, _, name) in enumerate(fixed) if bad[n + a]]
     rows = [k for k in range(n) if bad[k]]
+    stuck = _no_real_solution(cm, full, J, z, rows)
+    if stuck is not None:   # a component's own explanation first (a loop that cannot close)
+        raise _component_explanation(cm, rows, f"; {stuck}") or stuck
     if names:
         detail = ", ".join(f"{nm} = {v:g}" for (_, v, nm) in fixed if nm in names)
         owners = [cm.flat.owner_of(sp.Symbol(nm)) for nm in names]
@@ -363,6 +366,36 @@ def _check(cm, full, J, z, fixed, n):
     if hint is not None:
         raise hint
     raise InitializationError(f"no consistent initial point found{detail}")
+
+
+NO_SOLUTION_REACH = 1e-3   # see _no_real_solution
+
+
+def _no_real_solution(cm, full, J, z, rows):
+    """An InitializationError for a violated equation at a minimum of its
+    residual that is not a zero (``x**2 + 1 = 0``: the iteration ends at
+    x = 0 with 1 left, its derivative 0), or None. Such a row changes by
+    less than ``NO_SOLUTION_REACH`` of its residual when every unknown moves
+    by its own size: no real solution near the starts, whatever the fixed
+    starts are (it was reported as inconsistent fixed starts, or as another
+    equation violated by rounding)."""
+    if not rows or J.shape[1] == 0:
+        return None
+    reach = np.asarray(abs(J) @ (np.abs(z) + 1.0)).ravel()
+    k = max(rows, key=lambda r: abs(full[r]) / (reach[r] + 1e-300))
+    if not abs(full[k]) > 1e-8 or reach[k] >= NO_SOLUTION_REACH * abs(full[k]):
+        return None
+    origin = cm.dae.origins[k]
+    what = origin.describe() if hasattr(origin, "describe") else str(origin)
+    slots = cm.slot_names()
+    cols = np.flatnonzero(np.asarray(abs(J[k]).todense() if hasattr(J, "todense")
+                                     else np.abs(J[k])).ravel()[:len(slots)] > 0)
+    unknowns = ", ".join(f"{slots[j][0]} = {z[j]:.6g}" for j in cols[:4] if slots[j]) or \
+        "its unknowns"
+    return InitializationError(
+        f"the initial equations have no real solution near the start values: {what} stays "
+        f"at {full[k]:.3g} where its residual has a minimum, not a zero ({unknowns}); "
+        "check the equation's signs and terms")
 
 
 def _component_explanation(cm, rows, detail, paths=()):

@@ -6,6 +6,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..errors import UnknownNameError
+from .observe import observed_rows
 
 
 class Rows(NamedTuple):
@@ -66,16 +67,8 @@ class Result:
         rows only (a block of a large result, or its last row)."""
         if self._obs is not None:
             return self._obs[k0:k1]
-        cm = self.model
-        cache = {}
-        out = np.empty((max(k1 - k0, 0), len(cm.var_names)))
-        for i, k in enumerate(range(k0, k1)):
-            key = tuple(self.d[k]) if self.d.size else ()
-            cb = cache.get(key)
-            if cb is None:
-                cb = cache[key] = cm.callbacks(self.p, list(key))
-            out[i] = cb.observe(self.t[k], self.y[k], self.yp[k])
-        return out
+        return observed_rows(self.model, self.p, self.t[k0:k1], self.y[k0:k1],
+                             self.yp[k0:k1], self.d[k0:k1] if self.d.size else self.d)
 
     def _block(self, names, k0, k1):
         """Columns ``names`` at rows ``k0:k1`` (as ``self[name][k0:k1]``,

@@ -226,6 +226,31 @@ def _parse_row(cm, cells, path, line):
     return Dist(name, kind, lo, hi, _model_unit(cm, name) or "1", ", ".join(cells))
 
 
+def _separator(lines):
+    """The spec's field separator: ',' unless its first row reads as the 5
+    fields with ';' (a spreadsheet's export in a locale with decimal
+    commas) or a tab and not with ','."""
+    for text in lines:
+        if not text.strip() or text.lstrip().startswith("#"):
+            continue
+        for sep in (",", ";", "\t"):
+            if len(next(csv.reader([text], delimiter=sep))) == 5:
+                return sep
+        return ","
+    return ","
+
+
+def _hint(cells, sep):
+    """What a row that does not read probably means."""
+    if sep == "," and len(cells) > 5 and any(";" in c for c in cells):
+        return " (';' between rows? put each row on its own line)"
+    if sep != "," and any(re.fullmatch(r"[-+]?\d+,\d+", c) for c in cells):
+        return " (a decimal comma? write numbers with a point: 1.5)"
+    if len(cells) == 1:
+        return " (fields are separated by commas: 'k.c, normal, 100, 5, N/m')"
+    return ""
+
+
 def parse_spec(path: str | os.PathLike, cm) -> list[Dist]:
     """The distributions of spec CSV ``path`` for compiled model ``cm``.
 
@@ -244,7 +269,9 @@ def parse_spec(path: str | os.PathLike, cm) -> list[Dist]:
                if not isinstance(exc, FileNotFoundError) else "no such file")
         raise UsageError(f"{path}: cannot read the tolerance spec: {why}") from None
     dists, bad, seen = [], [], {}
-    for line, row in enumerate(csv.reader(text.splitlines()), start=1):
+    lines = text.splitlines()
+    sep = _separator(lines)
+    for line, row in enumerate(csv.reader(lines, delimiter=sep), start=1):
         cells = [c.strip() for c in row]
         if not cells or not any(cells) or cells[0].startswith("#"):
             continue
@@ -256,13 +283,19 @@ def parse_spec(path: str | os.PathLike, cm) -> list[Dist]:
             msg = exc.message if isinstance(exc, AcausalError) else str(exc)
             if isinstance(exc, DataError):
                 msg = f"{cells[0]}: {msg}"
-            bad.append(f"{path}:{line}: {' '.join(msg.split())}")
+            bad.append((line, " ".join(msg.split()) + _hint(cells, sep)))
             continue
         if dist.name in seen:
-            bad.append(f"{path}:{line}: {dist.name}: already given on line {seen[dist.name]}")
+            bad.append((line, f"{dist.name}: already given on line {seen[dist.name]}"))
             continue
         seen[dist.name] = line
         dists.append(dist)
+    # rows wrong in the same way (a file whose every row has one field) are
+    # one line naming them all; other bad rows one line each
+    grouped = {}
+    for line, msg in bad:
+        grouped.setdefault(msg, []).append(line)
+    bad = [f"{path}:{','.join(map(str, ls))}: {msg}" for msg, ls in grouped.items()]
     if bad:
         raise SpecError(bad)
     if not dists:
