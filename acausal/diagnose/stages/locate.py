@@ -16,7 +16,10 @@ error (the PRESS residuals of the penalised Gauss-Newton step: no
 simulation), and the coarsest, then smoothest, whose error is within
 ``CV_TIE`` of the best is fitted in full (output error, from that step) at the nodes whose
 linearised error is within ``REFINE_WITHIN`` of the best (at most
-``REFINE_MAX``); the other nodes keep their linearised scores.
+``REFINE_MAX``); the other nodes keep their linearised scores. The best
+node's setting is then chosen again from the Jacobians at its fitted point
+(:func:`_rechoose`: far from the calibrated point, the linearised ranking
+can be wrong), and the lowest exact held-out error of those fits is kept.
 
 When a single cause is named, the term is also fitted beside it at the
 located node (the cause's parameters refitted with it: :func:`_beside`);
@@ -348,6 +351,11 @@ class Choice:
     pins: np.ndarray
     table: tuple = ()
 
+    @property
+    def setting(self) -> tuple:
+        """(position knots, velocity knots, smoothing x, smoothing v)."""
+        return self.n_x, self.n_v, self.lam_x, self.lam_v
+
 
 def _transform(n_x, n_v, nf_x, nf_v):
     T = np.zeros((nf_x + nf_v, n_x + n_v))
@@ -626,7 +634,7 @@ def locate(ctx, problem, cal, dec, rk) -> Location:
             f"{k}: {v}" for k, v in failed.items()), details=dict(failed=failed))
     graph = _graph(problem)
     # the term is linear in its weights: refined from the linearised step
-    # (with the free parameters' step) only, on the whole record
+    # (with the free parameters' step) only, through the growing windows
     cands = [chosen_candidate(nd, graph, n) for nd in fitted]
     tasks = [_free_step(t, nd) for t, nd in zip(fit_tasks(problem.one_start(), cal, cands),
                                                 fitted)]
@@ -696,9 +704,9 @@ class _Again:
 
 
 def _at_fit(ctx, problem, cal, node: _Node, r):
-    """(:class:`Columns` of the node's finest splines at the fitted point,
-    the fitted weights on those splines, the free parameters' offset from
-    their calibrated values, per unit of scale). The columns' residuals
+    """(:class:`Columns` of the node's finest splines at the fit ``r``'s
+    point, the free parameters' offset there from their calibrated values,
+    per unit of scale). The columns' residuals
     are shifted by the term's own part, r0 - Jg w, so that a resolution's
     absolute weights enter the linear problem (a coarser spline need not
     reproduce the fitted one)."""
@@ -723,9 +731,9 @@ def _at_fit(ctx, problem, cal, node: _Node, r):
 
 def _rechoose(ctx, problem, cal, node: _Node, r, graph, c_hat) -> _Again:
     """The best node's resolution and smoothing chosen again at its fitted
-    point, up to ``RECHOOSE`` times, each time at the last fit's point. The first choice linearises at the
-    calibrated model, where a strong out-of-library force is far from zero,
-    and can rank the settings wrongly: on the torsion rig's threshold law
+    point, up to ``RECHOOSE`` times, each time at the last fit's point. The
+    first choice linearises at the calibrated model, where a strong
+    out-of-library force is far from zero, and can rank the settings wrongly: on the torsion rig's threshold law
     (51 floors) it predicted 1.54 floors held-out for 9 x 9 knots, which
     reached 2.35 when fitted, and 3.59 for 9 x 17, which reached 1.07. At a
     fitted point whose residuals are near the noise the linearised ranking
@@ -733,10 +741,10 @@ def _rechoose(ctx, problem, cal, node: _Node, r, graph, c_hat) -> _Again:
     fitted in full from its step (growing windows); the lowest exact
     held-out error of all the fits is kept. Stops when a choice repeats."""
     n = cal.fit.n
-    key = (node.choice.n_x, node.choice.n_v, node.choice.lam_x, node.choice.lam_v)
-    tried = {key: float(heldout_rms(r.loo))}
-    best_node, best_r, best_t, n_sim, error = node, r, None, 0, None
-    cur_node, cur_r = node, r
+    best = float(heldout_rms(r.loo))
+    tried = {node.choice.setting: best}
+    best_node = best_t = error = None
+    cur_node, cur_r, n_sim = node, r, 0
     for _ in range(RECHOOSE):
         c, offset = _at_fit(ctx, problem, cal, cur_node, cur_r)
         n_sim += c.n_sim
@@ -744,7 +752,7 @@ def _rechoose(ctx, problem, cal, node: _Node, r, graph, c_hat) -> _Again:
             error = c.error
             break
         ch = choose(c, node.ranges, n)
-        key = (ch.n_x, ch.n_v, ch.lam_x, ch.lam_v)
+        key = ch.setting
         if key in tried:
             break
         k_f = c.Jf.shape[1]
@@ -761,13 +769,13 @@ def _rechoose(ctx, problem, cal, node: _Node, r, graph, c_hat) -> _Again:
         t = _term(got, n, c_hat, new)
         tried[key] = float(t.heldout_rmse)
         cur_node, cur_r = new, got
-        if t.heldout_rmse < heldout_rms(best_r.loo):
-            best_node, best_r, best_t = new, got, t
+        if t.heldout_rmse < best:
+            best, best_node, best_t = float(t.heldout_rmse), new, t
     summary = dict(tried=[dict(n_x=k[0], n_v=k[1], smooth_x=k[2], smooth_v=k[3], heldout=h)
                           for k, h in tried.items()])
     if error is not None:
         summary["error"] = error
-    return _Again(best_t, n_sim, summary, best_node if best_t is not None else None)
+    return _Again(best_t, n_sim, summary, best_node)
 
 
 def beside_rows(rk) -> list:
