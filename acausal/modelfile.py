@@ -411,15 +411,25 @@ def compile_file(path):
     return mf, cm
 
 
+# what the model file's own code (a measure, its plot) may raise and the
+# command reports: its errors, sys.exit and os._exit (see no_hard_exit)
+FILE_CODE_FAILURES = (Exception, SystemExit, HardExit)
+
+
+def _measured(fn, result):
+    """``float(fn(result))``, run as the model file's code."""
+    with no_hard_exit():
+        return float(fn(result))
+
+
 def evaluate_measures(mf, result):
     """name -> float for every measure; a measure that fails raises an error
     naming it."""
     out = {}
     for name, fn in mf.measures.items():
         try:
-            with no_hard_exit():
-                out[name] = float(fn(result))
-        except (Exception, SystemExit, HardExit) as exc:   # sys.exit() in a measure: it failed
+            out[name] = _measured(fn, result)
+        except FILE_CODE_FAILURES as exc:   # sys.exit() in a measure: it failed
             raise ModelFileError(f"{mf.path}: measure {name!r} failed: "
                                  f"{type(exc).__name__}: {exc}") from None
     return out
@@ -449,9 +459,8 @@ def measure_values(mf, result):
     values, missing = {}, {}
     for name, fn in mf.measures.items():
         try:
-            with no_hard_exit():
-                values[name] = float(fn(result))
-        except (Exception, SystemExit, HardExit) as exc:  # noqa: BLE001 - the model file's code:
+            values[name] = _measured(fn, result)
+        except FILE_CODE_FAILURES as exc:  # noqa: BLE001 - the model file's code:
             # reported, not raised (a measure's sys.exit() ended the command, results unsaid)
             values[name] = float("nan")
             missing[name] = f"{type(exc).__name__}: {exc}"
@@ -469,7 +478,7 @@ def call_plot(mf, result, path):
     try:
         with no_hard_exit():
             mf.namespace["plot"](result, path)
-    except (Exception, SystemExit, HardExit) as exc:  # noqa: BLE001 - the model file's code
+    except FILE_CODE_FAILURES as exc:  # noqa: BLE001 - the model file's code
         raise _error(mf.path, _line(exc, mf.path), f"its plot(result, path) failed: "
                      f"{type(exc).__name__}: {_short(exc)}") from None
 

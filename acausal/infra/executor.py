@@ -282,7 +282,7 @@ def _die_with_parent(parent: int) -> None:
     import warnings
     warnings.simplefilter("ignore")   # numpy/scipy warnings: not a wall on the terminal
     from .signals import STOP_SIGNALS
-    for name in STOP_SIGNALS[2:]:    # SIGHUP, SIGUSR1, SIGXCPU: as SIGTERM
+    for name in (n for n in STOP_SIGNALS if n not in ("SIGINT", "SIGTERM")):   # as SIGTERM
         if hasattr(signal, name):
             signal.signal(getattr(signal, name), signal.SIG_DFL)
     if sys.platform.startswith("linux"):

@@ -20,7 +20,6 @@ import sys
 from .signals import STOP_SIGNALS
 
 _STATE = {"starting": False}
-_NAMES = STOP_SIGNALS
 
 
 def is_command(argv=None, orig_argv=None) -> bool:
@@ -66,11 +65,11 @@ def guard() -> None:
     atexit.register(descendants.end)   # registered first: runs last
     defaults = {"SIGINT": signal.default_int_handler}
     _STATE["starting"] = True
-    for name in _NAMES:
+    for name in STOP_SIGNALS:
         sig = getattr(signal, name, None)
         if sig is None:
             continue
-        if signal.getsignal(sig) in (defaults.get(name, signal.SIG_DFL),):
+        if signal.getsignal(sig) == defaults.get(name, signal.SIG_DFL):
             signal.signal(sig, _handler)
 
 
