@@ -14,6 +14,29 @@ ROOT = Path(__file__).resolve().parents[2]
 HERE = Path(__file__).resolve().parent
 
 
+# A mass on a spring to a wall (4 kg, 100 N/m, released at 0.2 m): the
+# model of the model files these tests write, each with its own experiment,
+# measures or misbehaviour around it
+SPRING_IMPORTS = """\
+from acausal import Experiment, Measure, Model
+from acausal.mechanics.translational import Fixed, Mass, Spring
+"""
+SPRING_MODEL = """\
+model = Model()
+model.body = Mass(m=4.0, s=0.2, v=0.0)
+model.k = Spring(c=100.0, s_rel0=0.0)
+model.wall = Fixed()
+model.connect(model.wall.flange, model.k.flange_a)
+model.connect(model.k.flange_b, model.body.flange)
+"""
+
+
+def spring_file(tail):
+    """The text of a spring model file ending with ``tail`` (its
+    experiment and measures)."""
+    return SPRING_IMPORTS + "\n" + SPRING_MODEL + tail
+
+
 def copy_model(name, folder):
     """Copy a model file of this folder into ``folder`` (its own folder: the
     checkpoint hashes the model's neighbours)."""

@@ -86,22 +86,14 @@ def test_a_large_result_is_written_without_a_python_call_per_row(tmp_path, monke
 SPAWNING = """\
 import os, subprocess, time
 from pathlib import Path
-from acausal import Experiment, Model
-from acausal.mechanics.translational import Fixed, Mass, Spring
-
+""" + h.SPRING_IMPORTS + """
 child = subprocess.Popen(["sleep", "300"])
 # a grandchild whose parent (the shell) ends at once: an orphan
 shell = subprocess.run(["sh", "-c", "sleep 301 >/dev/null 2>&1 & echo $!"],
                        capture_output=True, text=True)
 Path({pids!r}).write_text(f"{{child.pid}} {{shell.stdout.strip()}}")
 time.sleep({wait})
-model = Model()
-model.body = Mass(m=4.0, s=0.2, v=0.0)
-model.k = Spring(c=100.0, s_rel0=0.0)
-model.wall = Fixed()
-model.connect(model.wall.flange, model.k.flange_a)
-model.connect(model.k.flange_b, model.body.flange)
-experiment = Experiment(t_end=1.0)
+""" + h.SPRING_MODEL + """experiment = Experiment(t_end=1.0)
 """
 
 
@@ -176,19 +168,10 @@ def test_a_large_sweep_says_it_is_preparing_before_its_bar(tmp_path):
 
 # -- a tolerance spec written with semicolons ---------------------------------------------------
 
-SPRING = """\
-from acausal import Experiment, Measure, Model
-from acausal.mechanics.translational import Fixed, Mass, Spring
-
-model = Model()
-model.body = Mass(m=4.0, s=0.2, v=0.0)
-model.k = Spring(c=100.0, s_rel0=0.0)
-model.wall = Fixed()
-model.connect(model.wall.flange, model.k.flange_a)
-model.connect(model.k.flange_b, model.body.flange)
+SPRING = h.spring_file("""\
 experiment = Experiment(t_end=0.5)
 measures = {"s_end": Measure(lambda res: res.final()["body.s"], unit="m")}
-"""
+""")
 
 
 @pytest.fixture

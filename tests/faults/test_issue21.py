@@ -39,19 +39,10 @@ from . import helpers as h
 
 ROOT = Path(__file__).resolve().parents[2]
 
-LONG_SPRING = """\
-from acausal import Experiment, Model
-from acausal.mechanics.translational import Fixed, Mass, Spring
-
-model = Model()
-model.body = Mass(m=4.0, s=0.2, v=0.0)
-model.k = Spring(c=100.0, s_rel0=0.0)
-model.wall = Fixed()
-model.connect(model.wall.flange, model.k.flange_a)
-model.connect(model.k.flange_b, model.body.flange)
+LONG_SPRING = h.spring_file("""\
 experiment = Experiment(t_end=1e6, rtol=1e-8, atol=1e-10, output_step={step})
 measures = {{"s_end": lambda res: res.final()["body.s"]}}
-"""
+""")
 
 
 def run_py(code, timeout=60):

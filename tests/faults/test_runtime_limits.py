@@ -24,6 +24,8 @@ from acausal import LimitError, SolverError
 from acausal.cli import main
 from acausal.modelfile import compile_file
 
+from . import helpers as h
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 DRAG = """\
@@ -47,20 +49,11 @@ DRAG = """\
     measures = {"first_slip": first_slip, "s_end": lambda res: res.final()["block.s"]}
     """
 
-SPRING = """\
-    from acausal import Experiment, Model
-    from acausal.mechanics.translational import Fixed, Mass, Spring
-
-    model = Model()
-    model.body = Mass(m=4.0, s=0.2, v=0.0)
-    model.k = Spring(c=100.0, s_rel0=0.0)
-    model.wall = Fixed()
-    model.connect(model.wall.flange, model.k.flange_a)
-    model.connect(model.k.flange_b, model.body.flange)
-    experiment = Experiment(t_end=1.0, rtol=1e-8, atol=1e-10, output_step=1e-3)
-    measures = {"s_end": lambda res: res.final()["body.s"],
-                "v_end": lambda res: res.final()["body.v"]}
-    """
+SPRING = h.spring_file("""\
+experiment = Experiment(t_end=1.0, rtol=1e-8, atol=1e-10, output_step=1e-3)
+measures = {"s_end": lambda res: res.final()["body.s"],
+            "v_end": lambda res: res.final()["body.v"]}
+""")
 
 BLOWUP = """\
     from acausal import Experiment, Model

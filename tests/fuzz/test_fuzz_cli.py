@@ -23,6 +23,7 @@ from click.testing import CliRunner
 
 from acausal.cli import main
 from acausal.errors import AcausalError
+from tests.faults.helpers import spring_file
 from tests.fuzz import mutate as mu
 
 pytestmark = pytest.mark.fuzz
@@ -30,19 +31,10 @@ pytestmark = pytest.mark.fuzz
 ROOT = Path(__file__).resolve().parents[2]
 LIMIT_S = 20.0
 
-SPRING = """\
-from acausal import Experiment, Model
-from acausal.mechanics.translational import Fixed, Mass, Spring
-
-model = Model()
-model.body = Mass(m=4.0, s=0.2, v=0.0)
-model.k = Spring(c=100.0, s_rel0=0.0)
-model.wall = Fixed()
-model.connect(model.wall.flange, model.k.flange_a)
-model.connect(model.k.flange_b, model.body.flange)
+SPRING = spring_file("""\
 experiment = Experiment(t_end=0.2, rtol=1e-6, atol=1e-8, output_step=1e-3)
 measures = {"s_end": lambda res: res.final()["body.s"]}
-"""
+""")
 
 NUMBERS = ["-1", "0", "nan", "inf", "-inf", "1e6", "1e-300", "1e300", "abc", "", " ", "1,5",
            "0x10", "1_000", "3", "0.5", "1e999", "-0.0", "2.5e", "None"]
