@@ -6,7 +6,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..errors import UnknownNameError
-from .observe import observed_rows
+from .observe import observed_column, observed_rows
 
 
 class Rows(NamedTuple):
@@ -46,6 +46,7 @@ class Result:
         self.status = status
         self.message = message
         self._obs = None
+        self._columns = {}    # variable index -> its column (observed_column), read alone
         self.sensitivities = sensitivities
 
     # -- access ----------------------------------------------------------------
@@ -119,7 +120,9 @@ class Result:
             k = None
         if k is not None:
             j = cm.y_column(name) if self._obs is None and self.y.ndim == 2 else None
-            return self.y[:, j] if j is not None else self._observed()[:, k]
+            if j is not None:
+                return self.y[:, j]
+            return self._observed()[:, k] if self._obs is not None else self._column(k)
         for j, dsc in enumerate(cm.discretes):
             if dsc.symbol.name == name:
                 return self.d[:, j]
@@ -128,6 +131,18 @@ class Result:
                 return np.full(len(self.t), self.p[j])
         raise UnknownNameError(f"no variable {name!r} in the result; try one of: "
                        + ", ".join(self.names[:12]) + (" ..." if len(self.names) > 12 else ""))
+
+    def _column(self, k):
+        """Observed variable ``k`` alone (:func:`.observe.observed_column`),
+        or from the whole matrix when it cannot be vectorised."""
+        col = self._columns.get(k)
+        if col is None:
+            col = observed_column(self.model, k, self.p, self.t, self.y, self.yp,
+                                  self.d)
+            if col is None:
+                return self._observed()[:, k]
+            self._columns[k] = col
+        return col
 
     def __contains__(self, name):
         try:
