@@ -102,7 +102,7 @@ class RunOptions:
 
 def _output_times(t0, t_end, output_step, output_times):
     if output_times is not None:
-        ts = np.asarray(sorted(output_times), dtype=float)
+        ts = np.sort(np.asarray(output_times, dtype=float).ravel())
         return ts[(ts >= t0) & (ts <= t_end)]
     if output_step == 0:   # every internal step of the solver
         return np.array([t0, t_end], dtype=float)

@@ -113,7 +113,7 @@ def weighted_residuals(model, dataset: Dataset, params: dict, simulate,
                 continue
             r = meas[m] - y
             raw[e.name][m] = r
-            vec.append(r / sigma(dataset, m, y))
+            vec.append(np.atleast_1d(np.asarray(r / sigma(dataset, m, y), float)))
             groups.append(e.name)
             names.append(m)
         if e.trace is None:
@@ -123,10 +123,10 @@ def weighted_residuals(model, dataset: Dataset, params: dict, simulate,
                 continue
             r = np.interp(e.trace.time, res.t, res[var]) - ys
             raw[e.name][var] = r
-            vec.extend(r / sigma(dataset, var, ys))
-            groups.extend([e.name] * len(ys))
-            names.extend([var] * len(ys))
-    return WeightedResiduals(np.asarray(vec, float), groups, names, raw)
+            vec.append(np.asarray(r / sigma(dataset, var, ys), float).ravel())
+            groups += [e.name] * len(ys)
+            names += [var] * len(ys)
+    return WeightedResiduals(np.concatenate(vec) if vec else np.zeros(0), groups, names, raw)
 
 
 def weighted_jacobian(model, dataset: Dataset, params: dict, names, simulate,
