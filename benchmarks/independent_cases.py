@@ -17,6 +17,7 @@ wall (s) and simulations.
 """
 import argparse
 import json
+import os
 import sys
 import tempfile
 import time
@@ -44,6 +45,13 @@ def laws_of(case, effect):
     return datawriter.scaled(case.truth, case.laws, effect)
 
 
+def _children_cpu(before):
+    """CPU seconds of the worker processes ended since ``before`` (os.times)."""
+    now = os.times()
+    return (now.children_user - before.children_user) + \
+        (now.children_system - before.children_system)
+
+
 def describe(laws):
     return "; ".join(f"{l.kind}@{l.site} " + ", ".join(f"{k}={v:.4g}" for k, v in l.values.items())
                      for l in laws) or "none"
@@ -57,9 +65,12 @@ def run_one(case, effect, seed, workers=2, keep=None):
         data = base / "data"
         _, events = datawriter.write(data, case.truth, laws, seed=seed)
         t0 = time.perf_counter()
-        cpu0 = time.process_time()
-        out = diagnose(case.model, data, out_dir=base / "out", workers=workers, progress=False,
-                       plots=False)
+        cpu0, ch0 = time.process_time(), os.times()
+        # workers 0: every task in this process (what a profiler such as
+        # py-spy sees: ``py-spy record -f raw -o x.raw -- python ... --workers 0``)
+        out = diagnose(case.model, data, out_dir=base / "out",
+                       workers=None if workers == 0 else workers, progress=False, plots=False,
+                       scheduler="serial" if workers == 0 else None)
         wall = time.perf_counter() - t0
         det = json.loads((base / "out" / "candidates.json").read_text())
     j = J.judge(case, laws, out, TIED)
@@ -75,6 +86,7 @@ def run_one(case, effect, seed, workers=2, keep=None):
                 heldout_before=out["gain"]["before"]["heldout"],
                 heldout_after=out["gain"]["after"]["heldout"],
                 wall_s=wall, cpu_s_main=time.process_time() - cpu0,
+                cpu_s_children=_children_cpu(ch0),
                 n_sim=timing.get("n_sim"), weak=det.get("weak_evidence"),
                 sticks=sum(1 for ev in events.values() for e in ev if e[1] == "stick"),
                 ranking=out.get("ranking", [])[:3])
@@ -103,7 +115,8 @@ def main(argv=None):
     ap.add_argument("--cases", default=",".join(C.CASES))
     ap.add_argument("--effects", default=",".join(str(e) for e in EFFECTS))
     ap.add_argument("--seeds", default=",".join(str(s) for s in SEEDS))
-    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--workers", type=int, default=2,
+                    help="processes of each diagnosis (0: every task in this process)")
     ap.add_argument("--log", default=str(HERE.parent / "docs" / "independent_cases.jsonl"))
     ap.add_argument("--out", default=str(HERE.parent / "docs" / "independent_cases.md"))
     ap.add_argument("--label", default="", help="a heading for the table (code version)")
