@@ -1267,8 +1267,13 @@ def _sweep_units(mf, cm, params, measures):
     return units
 
 
-SWEEP_POINT_BYTES = 600     # a sweep point in the main process, per column (+ 400 bytes):
-                            # 1.1 kB measured for 1 parameter and 1 measure, x 1.5
+# a finished sweep point in the main process: its CSV cells and its returned row,
+# SWEEP_POINT_BASE bytes + SWEEP_POINT_BYTES per column (parameters, measures and
+# 3 more); measured at the end of a serial sweep of a Grid (peak RSS): 1,283 B for
+# 6 columns, 1,509 B for 8 (113 B per column): these are about 1.25 x that
+SWEEP_POINT_BASE = 700
+SWEEP_POINT_BYTES = 150
+TOLERANCE_RUN_BYTES = 600   # a tolerance study's run, per column (+ 400 bytes), as before
 MAX_POINTS = 1_000_000      # the sweep's default work budget
 SWEEP_SAY_PREPARING = 100_000   # a grid this large says so before its bar shows
 
@@ -1322,7 +1327,7 @@ def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max
                                     "parameter, or raise --max-points")
             limit = memory_limit(max_memory)
             n_workers = workers or (default_workers() if scheduler is None else 1)
-            per_point = 400 + SWEEP_POINT_BYTES * (len(specs) + len(measures) + 3)
+            per_point = SWEEP_POINT_BASE + SWEEP_POINT_BYTES * (len(specs) + len(measures) + 3)
             main_need = PROCESS_BYTES + n_points * per_point
             check_estimate(main_need + n_workers * PROCESS_BYTES, limit,
                            f"a sweep of {n_points:,} points on {n_workers} workers",
@@ -1432,7 +1437,7 @@ def tolerance(file, spec, n, sampling, seed, measures, out, plot_prefix, json_pa
                                     "--max-points")
             limit = memory_limit(max_memory)
             n_workers = workers or (default_workers() if scheduler is None else 1)
-            main_need = PROCESS_BYTES + runs * (400 + SWEEP_POINT_BYTES * (
+            main_need = PROCESS_BYTES + runs * (400 + TOLERANCE_RUN_BYTES * (
                 len(dists) + len(measures) + 3))
             check_estimate(main_need + n_workers * PROCESS_BYTES, limit,
                            f"a tolerance study of {runs:,} simulations on {n_workers} workers",

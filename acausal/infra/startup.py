@@ -11,7 +11,7 @@ interrupts as Ctrl-C does (KeyboardInterrupt: the command's one-line
 (:func:`acausal.infra.executor.exit_soon`). Commands that save work install
 their own handlers over these while they run. A signal the process was
 started ignoring (``nohup``: SIGHUP) stays ignored. No process the command
-started outlives it (:mod:`acausal.infra.descendants`).
+started outlives it, even when it is SIGKILLed (:mod:`acausal.infra.descendants`).
 """
 import os
 import signal
@@ -62,6 +62,7 @@ def guard() -> None:
     import atexit
     from . import descendants
     descendants.adopt()
+    descendants.watch()    # before any thread: it forks
     atexit.register(descendants.end)   # registered first: runs last
     defaults = {"SIGINT": signal.default_int_handler}
     _STATE["starting"] = True

@@ -1,0 +1,224 @@
+"""Issue 21, the fourth pass: what the last session left failing and a new
+battery of bad inputs and kills (``faults21c``).
+
+* SIGKILL of the command left a model file's own processes running (no
+  handler runs): a watchdog process forked first thing ends them;
+"""
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import psutil
+import pytest
+
+from acausal.infra import descendants
+
+from . import helpers as h
+
+ROOT = h.ROOT
+
+
+# -- SIGKILL: no process outlives the command ------------------------------------------------
+
+SPAWNING = """\
+import os, subprocess, time
+from pathlib import Path
+""" + h.SPRING_IMPORTS + """
+child = subprocess.Popen(["sleep", "300"])
+# a grandchild whose parent (the shell) ends at once: an orphan
+orphan = subprocess.run(["sh", "-c", "sleep 301 >/dev/null 2>&1 & echo $!"],
+                        capture_output=True, text=True).stdout.strip()
+# one in a session (and process group) of its own
+alone = subprocess.run(["sh", "-c", "setsid sleep 302 >/dev/null 2>&1 & echo $!"],
+                       capture_output=True, text=True).stdout.strip()
+Path({pids!r}).write_text(f"{{child.pid}} {{orphan}} {{alone}}")
+time.sleep(120)
+""" + h.SPRING_MODEL + """experiment = Experiment(t_end=1.0)
+measures = {{"s_end": Measure(lambda res: res.final()["body.s"], unit="m")}}
+"""
+
+
+def _alive(pid):
+    try:
+        return psutil.Process(pid).status() != psutil.STATUS_ZOMBIE
+    except psutil.NoSuchProcess:
+        return False
+
+
+def _spawning_command(tmp_path, command):
+    pids = tmp_path / "pids.txt"
+    model = tmp_path / "spawning.py"
+    model.write_text(SPAWNING.format(pids=str(pids)))
+    data = tmp_path / "data"
+    data.mkdir()
+    (data / "experiments.csv").write_text("name,s_end [m]\nE1,0.1\n")
+    args = {"simulate": ["simulate", model],
+            "sweep": ["sweep", model, "--param", "k.c=10:20:3", "--measure", "s_end",
+                      "--out", tmp_path / "s.csv"],
+            "calibrate": ["calibrate", model, data, "--fit", "k.c"],
+            "diagnose": ["diagnose", model, data, "--report", tmp_path / "rep"],
+            "fmu": ["fmu", model, "-o", tmp_path / "m.fmu"]}[command]
+    return h.cli(args, h.env(tmp_path / "log")), pids
+
+
+@pytest.mark.parametrize("command", [
+    "simulate", *(pytest.param(c, marks=pytest.mark.slow)
+                  for c in ("sweep", "calibrate", "diagnose", "fmu"))])
+def test_sigkill_of_the_command_leaves_no_process_of_its_model_file(tmp_path, command):
+    """A model file's ``sleep 300``, a shell's orphaned background ``sleep``
+    and a ``setsid sleep`` outlived a SIGKILL of the command (no handler
+    runs): the watchdog ends them within a second or so, and ends itself.
+    A process of the command's own group that is not its descendant (here
+    a sibling ``sleep``) is left alone: the watchdog never kills a group."""
+    sibling = subprocess.Popen(["sleep", "60"])     # the test's, in the same process group
+    proc, pids = _spawning_command(tmp_path, command)
+    started = []
+    try:
+        h.wait_for(lambda: pids.exists() and len(pids.read_text().split()) == 3, proc)
+        started = [int(p) for p in pids.read_text().split()]
+        watchdogs = [p for p in psutil.Process(proc.pid).children()
+                     if p.name() == descendants.WATCHDOG_NAME.decode()]
+        assert len(watchdogs) == 1
+        time.sleep(3 * descendants.POLL_S)     # a poll has seen them
+        proc.kill()
+        proc.communicate(timeout=60)
+        deadline = time.monotonic() + 5.0
+        while any(map(_alive, started + [watchdogs[0].pid])) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not [p for p in started if _alive(p)]
+        assert not _alive(watchdogs[0].pid), "the watchdog outlived its work"
+        assert sibling.poll() is None, "a process outside the command was killed"
+    finally:
+        sibling.kill()
+        sibling.wait()
+        for p in started:
+            try:
+                os.kill(p, signal.SIGKILL)
+            except OSError:
+                pass
+
+
+def test_the_watchdog_never_signals_a_pid_given_to_another_process():
+    """A recorded pid whose start time differs is another process now."""
+    other = subprocess.Popen(["sleep", "30"])
+    try:
+        real = descendants._start_time(other.pid)
+        assert real is not None
+        descendants._finish({other.pid: real + 1}, os.getpid())    # same pid, other start
+        time.sleep(0.1)
+        assert other.poll() is None
+        descendants._finish({other.pid: real}, os.getpid())
+        assert other.wait(timeout=5) == -signal.SIGTERM
+    finally:
+        other.kill()
+        other.wait()
+
+
+def test_the_watchdog_ends_when_its_command_ends_normally(tmp_path):
+    """A command that ends by itself takes its watchdog along, at once."""
+    r = subprocess.run([sys.executable, "-c", """
+import os, sys, time
+sys.argv = ["acausal"]
+import numpy as np
+import psutil
+from acausal.infra import descendants
+print(descendants.watchdog_pid())
+"""], capture_output=True, text=True, timeout=120, env=h.env(tmp_path / "log"))
+    pid = int(r.stdout.split()[-1])
+    deadline = time.monotonic() + 5.0
+    while _alive(pid) and time.monotonic() < deadline:
+        time.sleep(0.02)
+    assert not _alive(pid)
+
+
+# -- a million-point grid: arrays, an honest estimate, resume -------------------------------
+
+from acausal.infra.executor import open_executor       # noqa: E402
+from acausal.studies.sweep import Journal, grid, run_sweep   # noqa: E402
+
+
+def _counting_task(calls, stop_after):
+    def task(point):
+        calls.append(point)
+        if len(calls) > stop_after:
+            raise KeyboardInterrupt
+        return {"m": point["a"] * 1000 + point["b"]}
+    return task
+
+
+def test_a_million_point_grid_is_two_arrays_and_starts_at_once(tmp_path):
+    """1000 x 1000 points: the grid holds two arrays (2.9 s to prepare as a
+    million dicts, 4.75 GB estimated, refused), its first point runs
+    within a fraction of a second, and an interrupted run resumes from the
+    checkpoint alone (the CSV lost, as after SIGKILL) at the next point in
+    grid order, saying how many were done."""
+    import tracemalloc
+    a, b = np.linspace(3, 5, 1000), np.linspace(0.1, 0.3, 1000)
+    tracemalloc.start()
+    g = grid([("a", a), ("b", b)])
+    assert len(g) == 1_000_000 and tracemalloc.get_traced_memory()[1] < 1e6
+    tracemalloc.stop()
+    assert g[1001] == {"a": float(a[1]), "b": float(b[1])} and g.place(g.key(1001)) == 1001
+    out = tmp_path / "s.csv"
+    calls = []
+    start = time.perf_counter()
+    with open_executor("serial") as ex, pytest.raises(KeyboardInterrupt):
+        run_sweep(_counting_task(calls, 1500), g, out, executor=ex, measures=["m"],
+                  progress=False)
+    assert time.perf_counter() - start < 5.0
+    out.unlink()                       # only the checkpoint is left, as after a SIGKILL
+    seen, calls = [], []
+    with open_executor("serial") as ex, pytest.raises(KeyboardInterrupt):
+        run_sweep(_counting_task(calls, 0), g, out, executor=ex, measures=["m"],
+                  progress=False, journal=Journal(on_resume=lambda d, n: seen.append((d, n))))
+    assert seen == [(1500, 1_000_000)]
+    assert calls == [g[1500]]          # the next point, nothing done twice
+
+
+def test_a_grid_resumed_after_a_kill_has_every_point_once(tmp_path):
+    """Interrupted twice at random points (the CSV lost once, as after
+    SIGKILL), then finished: every point of the 2-D grid once, in grid
+    order, with its own value."""
+    g = grid([("a", np.arange(40.0)), ("b", np.arange(50.0))])
+    out, done = tmp_path / "s.csv", []
+    for stop, lose_csv in ((700, True), (333, False)):
+        calls = []
+        with open_executor("serial") as ex, pytest.raises(KeyboardInterrupt):
+            run_sweep(_counting_task(calls, stop), g, out, executor=ex, measures=["m"],
+                      progress=False)
+        done += calls[:-1]
+        if lose_csv:
+            out.unlink()
+    calls = []
+    with open_executor("serial") as ex:
+        rows = run_sweep(_counting_task(calls, 10**9), g, out, executor=ex, measures=["m"],
+                         progress=False)
+    done += calls
+    assert sorted((p["a"], p["b"]) for p in done) == [(p["a"], p["b"]) for p in g]
+    assert [(r["a"], r["b"]) for r in rows] == [(p["a"], p["b"]) for p in g]
+    assert all(r["m"] == r["a"] * 1000 + r["b"] for r in rows)
+    written = np.loadtxt(out, delimiter=",", skiprows=1, usecols=(0, 1, 2))
+    np.testing.assert_array_equal(written[:, 2], written[:, 0] * 1000 + written[:, 1])
+    assert len(written) == len(g)
+
+
+def test_the_sweep_memory_estimate_is_not_below_what_a_grid_uses(tmp_path):
+    """The estimate per finished point (SWEEP_POINT_BASE + SWEEP_POINT_BYTES
+    per column) against the memory a finished grid's rows really hold in
+    the main process (CSV cells and returned rows; traced allocations)."""
+    import tracemalloc
+    from acausal.cli import SWEEP_POINT_BASE, SWEEP_POINT_BYTES
+    g = grid([("a", np.linspace(1, 2, 40)), ("b", np.linspace(3, 4, 250))])
+    tracemalloc.start()
+    with open_executor("serial") as ex:
+        rows = run_sweep(_counting_task([], 10**9), g, tmp_path / "s.csv", executor=ex,
+                         measures=["m"], progress=False)
+        held = tracemalloc.get_traced_memory()[1]     # the peak: cells and rows at once
+    tracemalloc.stop()
+    assert len(rows) == 10_000
+    estimate = SWEEP_POINT_BASE + SWEEP_POINT_BYTES * (2 + 1 + 3)
+    print(f"{held / len(g):.0f} B per point, estimate {estimate} B")
+    assert held / len(g) < estimate, (held / len(g), estimate)
