@@ -120,11 +120,14 @@ class _Group(click.Group):
             _drop_stdout()
             click.echo(f"acausal: error: the output could not be written to standard output: "
                        f"{exc.strerror or exc}", err=True)
+            startup.finishing()
             _end_past_model_threads(2)
             sys.exit(2)
         except SystemExit as exc:
+            startup.finishing()
             _end_past_model_threads(exc.code)
             raise
+        startup.finishing()
         _end_past_model_threads(0)
 
     def _main(self, args, prog_name, complete_var, **extra):

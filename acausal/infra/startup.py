@@ -63,7 +63,8 @@ def guard() -> None:
     from . import descendants
     descendants.adopt()
     descendants.watch()    # before any thread: it forks
-    atexit.register(descendants.end)   # registered first: runs last
+    atexit.register(_ignore_stop_signals)   # registered first: runs last
+    atexit.register(descendants.end)       # ... after this one
     defaults = {"SIGINT": signal.default_int_handler}
     _STATE["starting"] = True
     for name in STOP_SIGNALS:
@@ -77,3 +78,45 @@ def guard() -> None:
 def started() -> None:
     """The imports are over: from now on a signal interrupts the command."""
     _STATE["starting"] = False
+
+
+def finishing() -> None:
+    """The command's work is over (its results written or its error said):
+    from now on a stop signal is one line and changes nothing; the process
+    ends as it was ending, its descendants ended
+    (:mod:`acausal.infra.descendants`). A SIGTERM then raised a
+    KeyboardInterrupt inside an atexit function (a traceback); one landing
+    after the interpreter had put back the default handlers killed it with
+    no word (exit 143, seen in ``fmu``): the last atexit function blocks the
+    stop signals then (:func:`_ignore_stop_signals`)."""
+    for name in STOP_SIGNALS:
+        sig = getattr(signal, name, None)
+        if sig is not None and signal.getsignal(sig) is _handler:
+            signal.signal(sig, _late)
+
+
+def _late(signum, frame):
+    name = signal.Signals(signum).name
+    try:
+        os.write(2, f"acausal: {name} while the command was ending, its work done: its "
+                    "results are kept\n".encode())
+    except OSError:
+        pass
+    try:
+        from .executor import exit_soon
+        exit_soon(130)    # whatever the end is waiting for, the process ends
+    except Exception:     # noqa: BLE001 - never a traceback at the command's end
+        pass
+
+
+def _ignore_stop_signals() -> None:
+    """The command's last act before the interpreter's own end: the stop
+    signals are ignored (for the whole process: blocking them in one thread
+    leaves them to the others, numpy's among them), instead of killing it
+    silently once Python has put back their default action (it leaves an
+    ignored signal ignored)."""
+    for name in STOP_SIGNALS:
+        try:
+            signal.signal(getattr(signal, name), signal.SIG_IGN)
+        except (OSError, ValueError, AttributeError):
+            pass

@@ -222,3 +222,56 @@ def test_the_sweep_memory_estimate_is_not_below_what_a_grid_uses(tmp_path):
     estimate = SWEEP_POINT_BASE + SWEEP_POINT_BYTES * (2 + 1 + 3)
     print(f"{held / len(g):.0f} B per point, estimate {estimate} B")
     assert held / len(g) < estimate, (held / len(g), estimate)
+
+
+# -- a signal while the command ends -----------------------------------------------------------
+
+LATE_ATEXIT = h.spring_file("""\
+import atexit, time
+from pathlib import Path
+
+
+def late():
+    Path({marker!r}).write_text("x")
+    time.sleep(3)
+
+
+atexit.register(late)
+experiment = Experiment(t_end=0.1)
+""")
+
+
+def test_a_sigterm_while_the_command_ends_is_one_line_and_keeps_the_result(tmp_path):
+    """A SIGTERM while the command was ending (here: in a model file's
+    atexit function) raised KeyboardInterrupt inside it, a traceback; one
+    after the interpreter had put back the default handlers killed it
+    silently (exit 143). Now: one line, the command's own exit code, the
+    result written."""
+    marker, out = tmp_path / "marker", tmp_path / "o.csv"
+    model = tmp_path / "late.py"
+    model.write_text(LATE_ATEXIT.format(marker=str(marker)))
+    proc = h.cli(["simulate", model, "--out", out], h.env(tmp_path / "log"))
+    h.wait_for(marker.exists, proc)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 0, err
+    assert err.strip().splitlines() == [
+        "acausal: SIGTERM while the command was ending, its work done: its results are kept"]
+    assert len(out.read_text().splitlines()) > 10
+
+
+def test_the_last_act_of_the_command_holds_the_stop_signals():
+    """After the command's last atexit function a stop signal is ignored:
+    the process ends with its own code, not by SIGTERM (numpy's threads
+    running: blocking the signal in the main thread alone let it kill)."""
+    r = subprocess.run([sys.executable, "-c", """
+import os, signal
+import numpy as np
+np.dot(np.ones((300, 300)), np.ones((300, 300)))   # its threads started
+from acausal.infra import startup
+signal.signal(signal.SIGTERM, signal.SIG_DFL)   # as Python leaves it at its very end
+startup._ignore_stop_signals()
+os.kill(os.getpid(), signal.SIGTERM)
+print("still here")
+"""], capture_output=True, text=True, timeout=120, env=dict(os.environ, PYTHONPATH=str(ROOT)))
+    assert r.returncode == 0 and r.stdout.strip() == "still here", (r.returncode, r.stderr)
