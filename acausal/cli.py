@@ -54,6 +54,24 @@ def _warn(text):
 _STDOUT_ERRNOS = (errno.EPIPE, errno.ENOSPC, errno.EIO, errno.EBADF)
 
 
+class _ReaderGone(Exception):
+    """Standard output's reader went away (``acausal variables m | head -1``)."""
+
+
+SIGPIPE_EXIT = 128 + 13
+
+
+def _reader_gone() -> bool:
+    """Whether standard output is a pipe whose reader has closed it."""
+    try:
+        import select
+        poll = select.poll()
+        poll.register(1, select.POLLOUT)
+        return any(ev & select.POLLERR for _, ev in poll.poll(0))
+    except (OSError, ValueError, AttributeError):
+        return False
+
+
 def _drop_stdout():
     """Point standard output at /dev/null, so that the interpreter's own
     flush at exit does not fail again with a second message."""
@@ -114,6 +132,16 @@ class _Group(click.Group):
             sys.stdout = open(os.devnull, "w")
         try:
             self._main(args, prog_name, complete_var, **extra)
+        except (_ReaderGone, BrokenPipeError) as exc:
+            # the reader of the output has had enough (| head): quiet, as a Unix
+            # tool killed by SIGPIPE is, with its status 141 (a pipeline under
+            # `set -o pipefail` sees that not all the output was read)
+            if isinstance(exc, BrokenPipeError) and not _reader_gone():
+                raise
+            _drop_stdout()
+            startup.finishing()
+            _end_past_model_threads(SIGPIPE_EXIT)
+            sys.exit(SIGPIPE_EXIT)
         except OSError as exc:
             if exc.errno not in _STDOUT_ERRNOS:
                 raise
@@ -129,6 +157,14 @@ class _Group(click.Group):
             raise
         startup.finishing()
         _end_past_model_threads(0)
+
+    def invoke(self, ctx):
+        try:
+            return super().invoke(ctx)
+        except BrokenPipeError:
+            if _reader_gone():     # (click would swallow it, and exit 1)
+                raise _ReaderGone() from None
+            raise
 
     def _main(self, args, prog_name, complete_var, **extra):
         try:
@@ -179,10 +215,7 @@ class _Number(click.ParamType):
         return x
 
 
-# --atol: what an absolute tolerance in SI units can mean: above 1e3 every
-# position, speed and force of a mechanism counts as zero; below 1e-20 no
-# solution gets closer than the relative tolerance makes it
-ATOL_RANGE = (1e-20, 1e3)
+from .modelfile import ATOL_RANGE  # noqa: E402  (--atol: what an absolute tolerance can mean)
 FINITE, POSITIVE, FRACTION, COUNT, ATOL = (_Number(k) for k in ("finite", "positive", "fraction",
                                                                  "count", "atol"))
 

@@ -275,3 +275,95 @@ os.kill(os.getpid(), signal.SIGTERM)
 print("still here")
 """], capture_output=True, text=True, timeout=120, env=dict(os.environ, PYTHONPATH=str(ROOT)))
     assert r.returncode == 0 and r.stdout.strip() == "still here", (r.returncode, r.stderr)
+
+
+# -- what the last session noticed and left alone ---------------------------------------------
+
+from click.testing import CliRunner     # noqa: E402
+
+from acausal.cli import main            # noqa: E402
+
+
+def invoke(args):
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+def one_error_line(r, code=2):
+    """The command ended with ``code`` and one 'error:' line, no traceback."""
+    assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
+    assert "Traceback" not in r.output, r.output
+    assert r.exit_code == code, (r.exit_code, r.output)
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "error:" in lines[0], r.stderr
+    return lines[0]
+
+
+def test_a_model_with_no_components_is_refused(tmp_path):
+    """``model = Model()`` and nothing else 'simulated' 500 steps of nothing, exit 0."""
+    path = tmp_path / "empty.py"
+    path.write_text("from acausal import Experiment, Model\nmodel = Model()\n"
+                    "experiment = Experiment(t_end=0.1)\n")
+    line = one_error_line(invoke(["simulate", path]))
+    assert f"{path}:2: 'model' has no components and no equations" in line
+
+
+@pytest.mark.parametrize("atol, ok", [(1e-300, False), (1e-21, False), (1e-20, True),
+                                      (1e3, True), (1e4, False), ({"body.s": 1e-30}, False)])
+def test_an_experiments_atol_has_the_command_lines_range(tmp_path, atol, ok):
+    """--atol refused values outside 1e-20..1e3 (SI) that Experiment(atol=...)
+    in a model file took (the library's own calls still take any value)."""
+    path = tmp_path / "m.py"
+    path.write_text(h.spring_file(f"experiment = Experiment(t_end=0.01, atol={atol!r})\n"))
+    r = invoke(["simulate", path])
+    if ok:
+        assert r.exit_code == 0, r.output
+    else:
+        assert "is outside 1e-20 to 1000 (SI units)" in one_error_line(r)
+
+
+def test_output_to_a_pipe_its_reader_closed_ends_quietly_as_sigpipe_does(tmp_path):
+    """``acausal variables m | head -1`` exited 1 quietly (click's own
+    handling). Now as a Unix tool killed by SIGPIPE: no word, status 141
+    (``set -o pipefail`` sees that the output was not all read)."""
+    proc = subprocess.Popen([sys.executable, "-m", "acausal.cli", "variables",
+                             str(ROOT / "models" / "breaker_24kv.py")], env=h.env(tmp_path / "l"),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()     # the reader is gone before the first line
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=120) == 141 and not err.strip(), (proc.returncode, err)
+
+
+EXITING = h.spring_file("""\
+import atexit, os
+experiment = Experiment(t_end=0.01)
+
+
+@atexit.register
+def bye():
+    os._exit(7)
+
+
+def boom():
+    raise ValueError("late")
+
+
+atexit.register(boom)
+""")
+
+
+def test_a_model_files_exit_functions_are_one_line_each(tmp_path):
+    """``os._exit(7)`` in a model file's atexit function ended the command
+    with 7, silently (and skipped the command's own end); an exception in
+    one was a traceback."""
+    path = tmp_path / "m.py"
+    path.write_text(EXITING)
+    proc = h.cli(["simulate", path], h.env(tmp_path / "log"))
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 0, err
+    lines = err.strip().splitlines()
+    at = {text: i for i, text in enumerate(EXITING.splitlines(), 1)}
+    assert lines == [   # (a decorated function's line is its decorator's)
+        f"acausal: warning: {path}:{at['def boom():']}: the model file's exit function boom() "
+        "failed: ValueError: late: ignored",
+        f"acausal: warning: {path}:{at['@atexit.register']}: the model file's exit function "
+        "bye() called os._exit(7): ignored"], err
