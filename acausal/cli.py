@@ -342,6 +342,10 @@ def _quiet_warnings():
         warnings.simplefilter("ignore", PendingDeprecationWarning)
         with np.errstate(all="ignore"):
             yield
+    own = [w for w in caught if getattr(w.category, "said_alone", False)]
+    for w in own:
+        _warn(str(w.message))
+    caught = [w for w in caught if w not in own]
     if caught:
         kinds = {}
         for w in caught:
@@ -513,7 +517,8 @@ def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, max_rows, max_wa
                     click.echo(f"acausal: partial results up to t = {res.t[-1]:.6g} s written "
                                f"to {out}", err=True)
             if plot:
-                _plot(mf, res, plot, partial=error is not None)
+                with _writing("--plot", plot):
+                    _plot(mf, res, plot, partial=error is not None)
             # the measures (the model file's code) once the rows are safe, with a
             # --max-wall of their own (one that never returned ignored --max-wall)
             phase.writing = False
@@ -558,6 +563,31 @@ def _write_rows(res, out):
         raise AcausalError(f"--out {out}: writing the {len(res.t):,} rows failed: "
                            f"{exc.strerror or exc}; the run up to t = {res.t[-1]:.6g} s "
                            "is lost with it: free space or write elsewhere") from None
+
+
+@contextlib.contextmanager
+def _writing(option, path, lost=""):
+    """A failed write of ``path`` (a full disk) inside the block is one line
+    naming the option and the file, not 'standard output' (where the
+    command's catch-all put it) nor a traceback; ``lost`` says what became
+    of the work."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.errno not in _STDOUT_ERRNOS + (errno.EACCES, errno.EROFS, errno.EDQUOT):
+            raise
+        raise AcausalError(f"{option} {path}: writing failed: {exc.strerror or exc}"
+                           + (f"; {lost}" if lost else "")) from None
+
+
+def _check_partial(out, option="--out"):
+    """The folder beside ``out`` where finished work is kept must be a
+    folder (a file there gave a FileExistsError traceback at the first
+    finished point)."""
+    partial = os.fspath(out) + ".partial"
+    if os.path.exists(partial) and not os.path.isdir(partial):
+        raise UsageError(f"{option} {out}: {partial}, where the finished work is kept, is a "
+                         "file, not a folder: move it away")
 
 
 def _write_json(path, obj, option, **kw):
@@ -1061,7 +1091,7 @@ def calibrate(file, data, fit, method, experiments, profile, as_json, json_file,
         if json_file:
             _check_output(json_file, "--json-file")
             _check_distinct([("--json-file", json_file)], [file, data])
-        with _quiet_warnings(), _resumable("nothing (a calibration keeps no partial result)"), \
+        with _quiet_warnings(), _resumable(None), \
                 Watchdog(memory_limit(max_memory), max_wall, "the calibration"):
             out, ds, held, mf, cm = _calibrate(cal, compile_file, file, data, fit, method,
                                                experiments, profile)
@@ -1355,6 +1385,7 @@ def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max
             _check_output(plot, "--plot", plot=True, create=True)
             _check_distinct([("--out", out), ("--plot", plot)], [file])
             _check_csv(out, "--out")
+            _check_partial(out)
             specs = [parse_param(p, max_points) for p in params]
             n_points = math.prod(len(v) for _, v in specs)
             if n_points > max_points:
@@ -1379,7 +1410,7 @@ def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max
                                      max_memory=max(per_worker, 50e6))
             units = _sweep_units(mf, cm, [name for name, _ in specs], measures)
             if n_points >= SWEEP_SAY_PREPARING and not no_progress:
-                # (about 3 s per 1e6 points before the bar, more on a loaded host)
+                # (the grid is arrays; a resumed run reads its finished points first)
                 click.echo(f"sweep: preparing {n_points:,} points (the grid, the "
                            "checkpoint, what is already done)", err=True)
             points = grid(specs)
@@ -1388,15 +1419,19 @@ def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max
                     open_executor(scheduler, workers) as ex:
                 journal = Journal(inputs=source_files(file), units=units,
                                   on_resume=_say_resumed("points"))
-                rows = run_sweep(task, points, out, executor=ex, measures=measures,
-                                 progress=not no_progress, journal=journal)
+                with _writing("--out", out, f"the points finished before are in {out} and "
+                              f"{out}.partial/: free space, then run the same command "
+                              "again to resume"):
+                    rows = run_sweep(task, points, out, executor=ex, measures=measures,
+                                     progress=not no_progress, journal=journal)
             if plot:
                 fn = mf.measures[measures[0]]
                 y_unit, y_factor = units.get(measures[0]), 1.0
                 if getattr(fn, "display", None) and y_unit:
                     y_factor, y_unit = fn.shown(1.0)
-                plot_sweep(rows, specs[0][0], measures[0], plot,
-                           x_unit=units.get(specs[0][0]), y_unit=y_unit, y_factor=y_factor)
+                with _writing("--plot", plot, f"the points are in {out}"):
+                    plot_sweep(rows, specs[0][0], measures[0], plot, x_unit=units.get(specs[0][0]),
+                               y_unit=y_unit, y_factor=y_factor)
     except (AcausalError, click.BadParameter) as exc:
         _fail(exc)
     failed = sum(1 for r in rows if r.get("status") != "ok")
@@ -1456,6 +1491,7 @@ def tolerance(file, spec, n, sampling, seed, measures, out, plot_prefix, json_pa
                 _check_output(plot_prefix + "_hist.png", "--plot", plot=True, create=True)
             _check_distinct([("--out", out), ("--json", json_path)], [file, spec])
             _check_csv(out, "--out")
+            _check_partial(out)
             tol.check_n(n, sampling)
             mf, cm = compile_file(file)
             dists = tol.parse_spec(spec, cm)
@@ -1548,7 +1584,8 @@ def _say_resumed(what):
 @contextlib.contextmanager
 def _resumable(where):
     """An interruption (Ctrl-C, SIGTERM) ends with one line saying where the
-    finished work is, and exit code 130."""
+    finished work is (``where``; None: the command keeps none), and exit
+    code 130."""
     from .infra.budget import tripped
     from .infra.executor import exit_soon
     try:
@@ -1556,12 +1593,12 @@ def _resumable(where):
     except KeyboardInterrupt:
         exit_soon(130)
         why = tripped()
+        kept = (f"finished work is saved in {where}: run the same command again to resume"
+                if where is not None else "a calibration keeps no partial result")
         if why:
-            click.echo(f"acausal: error: stopped: {why}; finished work is saved in {where}: "
-                       "run the same command again to resume", err=True)
+            click.echo(f"acausal: error: stopped: {why}; {kept}", err=True)
             sys.exit(3)
-        click.echo(f"acausal: interrupted; finished work is saved in {where}: run the same "
-                   "command again to resume", err=True)
+        click.echo(f"acausal: interrupted; {kept}", err=True)
         sys.exit(130)
 
 

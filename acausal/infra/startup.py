@@ -63,6 +63,8 @@ def guard() -> None:
     from . import descendants
     descendants.adopt()
     descendants.watch()    # before any thread: it forks
+    if hasattr(os, "register_at_fork"):
+        os.register_at_fork(after_in_child=_child_defaults)
     atexit.register(_ignore_stop_signals)   # registered first: runs last
     atexit.register(descendants.end)       # ... after this one
     defaults = {"SIGINT": signal.default_int_handler}
@@ -107,6 +109,22 @@ def _late(signum, frame):
         exit_soon(130)    # whatever the end is waiting for, the process ends
     except Exception:     # noqa: BLE001 - never a traceback at the command's end
         pass
+
+
+def _child_defaults() -> None:
+    """A process forked by the command (a model file's multiprocessing pool)
+    does not inherit the command's stop handlers: they raised
+    KeyboardInterrupt in it, and ending such a process (the command's end,
+    its watchdog) printed its traceback on the command's stderr. It ends
+    as a plain process does; one that wants handlers sets its own (the
+    command's own pool workers do)."""
+    for name in STOP_SIGNALS:
+        sig = getattr(signal, name, None)
+        try:
+            if sig is not None and callable(signal.getsignal(sig)):
+                signal.signal(sig, signal.SIG_DFL)
+        except (OSError, ValueError):
+            pass
 
 
 def _ignore_stop_signals() -> None:

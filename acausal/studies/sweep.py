@@ -51,6 +51,14 @@ _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*$")
 _MAX_ERROR_CHARS = 500
 
 
+class ResumeWarning(RuntimeWarning):
+    """What resuming a sweep left out of a previous run's files (a cut last
+    line, malformed rows, damaged checkpoint records): the command line
+    prints each as its own line, not among the numerical libraries'."""
+
+    said_alone = True
+
+
 class SweepAborted(RuntimeError):
     """The executor failed (not the task); finished points are saved in the CSV."""
 
@@ -356,7 +364,8 @@ def _repair_tail(path: Path) -> None:
         data = f.read()
         if data and not data.endswith(b"\n"):
             f.truncate(data.rfind(b"\n") + 1)
-            warnings.warn(f"{path}: dropped an incomplete last line", RuntimeWarning, stacklevel=3)
+            warnings.warn(f"{path}: dropped an incomplete last line (a run killed while "
+                          "writing it); that point will be recomputed", ResumeWarning, stacklevel=3)
 
 
 def column_label(name: str, units: Mapping[str, str] | None) -> str:
@@ -394,6 +403,14 @@ def _load_cells(path: Path, params: Sequence[str], measures: Sequence[str]) -> t
     if not path.exists() or path.stat().st_size == 0:
         return None, {}
     _repair_tail(path)
+    try:
+        return _read_cells(path, params, measures)
+    except (UnicodeDecodeError, csv.Error) as exc:   # not a CSV this sweep wrote
+        raise UsageError(f"{path} is not a sweep's CSV ({_one_line(exc)}); use another "
+                         "out_csv (or delete it)") from None
+
+
+def _read_cells(path: Path, params: Sequence[str], measures: Sequence[str]):
     with open(path, newline="", encoding="utf-8") as f:
         reader = csv.reader(f)
         header = next(reader, None)
@@ -413,7 +430,7 @@ def _load_cells(path: Path, params: Sequence[str], measures: Sequence[str]) -> t
                 bad += 1
     if bad:
         warnings.warn(f"{path}: ignored {bad} malformed line(s); those points will be recomputed",
-                      RuntimeWarning, stacklevel=3)
+                      ResumeWarning, stacklevel=3)
     return header, cells_by_key
 
 
@@ -486,7 +503,7 @@ def _open_journal(out_csv: Path, params, measures, checkpoint, inputs, units=Non
                 store.ignored += 1
         if store.ignored:
             warnings.warn(f"{store.path}: ignored {store.ignored} damaged record(s); those points "
-                          "will be recomputed", RuntimeWarning, stacklevel=3)
+                          "will be recomputed", ResumeWarning, stacklevel=3)
     return _Journal(out_csv, store, header or [*params, *measures, *RESERVED], cells, units)
 
 

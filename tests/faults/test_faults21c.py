@@ -367,3 +367,153 @@ def test_a_model_files_exit_functions_are_one_line_each(tmp_path):
         "failed: ValueError: late: ignored",
         f"acausal: warning: {path}:{at['@atexit.register']}: the model file's exit function "
         "bye() called os._exit(7): ignored"], err
+
+
+# -- a fourth battery: bad inputs and kills no earlier battery tried ---------------------------
+# (each fixed fault with the line it gave before; the inputs that were already
+# one clear line are listed in the session's report)
+
+BATTERY_SPRING = """\
+from acausal import Experiment, Model
+from acausal.mechanics.translational import Fixed, Force, Mass, Spring
+
+model = Model()
+F = model.parameter("F", 1.0, "N", "drive force", min=0.0, max=100.0)
+model.wall = Fixed()
+model.body = Mass(m=0.1, s=0.0, v=0.0)
+model.k = Spring(c=40.0, s_rel0=0.0)
+model.drive = Force(f=F)
+model.connect(model.wall.flange, model.k.flange_a)
+model.connect(model.k.flange_b, model.body.flange, model.drive.flange)
+experiment = Experiment(t_end=0.1, rtol=1e-6, atol=1e-9, output_step=1e-3)
+measures = {"s_end": lambda res: res.final()["body.s"]}
+conditions = {"F": (0.1, 10.0, "N")}
+free_parameters = {"k.c": (10.0, 160.0)}
+"""
+
+
+@pytest.fixture
+def bspring(tmp_path):
+    path = tmp_path / "spring.py"
+    path.write_text(BATTERY_SPRING)
+    return path
+
+
+def _folder(tmp_path, experiments, **files):
+    d = tmp_path / "data"
+    d.mkdir()
+    (d / "experiments.csv").write_text(experiments)
+    for name, text in files.items():
+        (d / name).write_text(text)
+    return d
+
+
+@pytest.mark.parametrize("experiments, said", [
+    # calibrate said "every experiment is marked 'validate'; nothing to calibrate to"
+    ("name,F [N],s_end [mm]\n", "experiments.csv:1: no experiments: a header and no rows"),
+    # "column 'name': bad experiment name ''"
+    ("name,F,s_end\n,N,mm\nE1,1,25\n", "experiments.csv:2: column 'name': a row of units under "
+     "the header: write each unit in its header, in brackets ('F [N]')")])
+def test_a_data_folder_wrong_in_a_new_way_is_one_line_saying_what(tmp_path, bspring,
+                                                                    experiments, said):
+    data = _folder(tmp_path, experiments)
+    line = one_error_line(invoke(["calibrate", bspring, data, "--fit", "k.c"]))
+    assert said in line, line
+
+
+@pytest.mark.parametrize("kind", ["folder", "fifo"])
+@pytest.mark.parametrize("name", ["experiments.csv", "E1.csv"])
+def test_a_data_file_that_is_a_folder_or_a_pipe_is_named_so(tmp_path, bspring, kind, name):
+    """'file not found' for a file that is there (a folder, a named pipe)."""
+    data = _folder(tmp_path, "name,F [N],s_end [mm]\nE1,1.0,25.0\n")
+    (data / name).unlink(missing_ok=True)
+    (data / name).mkdir() if kind == "folder" else os.mkfifo(data / name)
+    line = one_error_line(invoke(["calibrate", bspring, data, "--fit", "k.c"]))
+    assert f"{data / name}: " + ("a folder, not a file" if kind == "folder" else
+                                 "not a regular file (a CSV file is expected)") in line, line
+
+
+@pytest.fixture
+def tiny_disk(tmp_path):
+    """A 64 kB tmpfs (a full disk), else /dev/full's folder is no use: skip."""
+    where = tmp_path / "full"
+    where.mkdir()
+    r = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", str(where)],
+                       capture_output=True)
+    if r.returncode != 0:
+        pytest.skip("no tmpfs can be mounted here (not root)")
+    (where / "filler").write_bytes(b"x" * 60_000)
+    yield where
+    subprocess.run(["umount", str(where)], capture_output=True)
+
+
+def test_a_full_disk_is_named_with_the_file_not_standard_output(tmp_path, bspring, tiny_disk):
+    """--plot and a sweep's --out on a full disk said 'the output could not
+    be written to standard output' (the catch-all for stdout's errors)."""
+    long = tmp_path / "long.py"
+    long.write_text(BATTERY_SPRING.replace("t_end=0.1", "t_end=5.0"))
+    line = one_error_line(invoke(["simulate", long, "--plot", tiny_disk / "o.png"]))
+    assert line == f"acausal: error: --plot {tiny_disk / 'o.png'}: writing failed: No space " \
+        "left on device", line
+    out = tiny_disk / "s.csv"
+    line = one_error_line(invoke(["sweep", bspring, "--param", "k.c=10:150:300", "--measure",
+                                  "s_end", "--out", out, "--workers", "1", "--no-progress"]))
+    assert f"--out {out}: writing failed: No space left on device; the points finished " \
+        f"before are in {out} and {out}.partial/" in line, line
+
+
+@pytest.mark.parametrize("damage, said", [
+    ("binary", "is not a sweep's CSV (UnicodeDecodeError"),           # was a traceback
+    ("partial is a file", ".partial, where the finished work is kept, is a file, not a "
+                          "folder: move it away")])                    # FileExistsError
+def test_a_damaged_resume_file_is_one_line(tmp_path, bspring, damage, said):
+    out = tmp_path / "s.csv"
+    if damage == "binary":
+        out.write_bytes(b"\x00\x01garbage\xff\xfe\n")
+    else:
+        (tmp_path / "s.csv.partial").write_text("not a folder")
+    line = one_error_line(invoke(["sweep", bspring, "--param", "k.c=10:20:3", "--measure",
+                                  "s_end", "--out", out, "--workers", "1", "--no-progress"]))
+    assert said in line, line
+
+
+def test_a_resumed_csv_cut_mid_line_is_said_as_the_sweeps_own_warning(tmp_path, bspring):
+    """It was counted among 'the numerical libraries warned during the run'."""
+    out = tmp_path / "s.csv"
+    out.write_text("k.c,s_end,status,error,wall_s\n10.0,0.01,ok,,0.1\n15.0,0.0")
+    r = invoke(["sweep", bspring, "--param", "k.c=10:20:3", "--measure", "s_end", "--out", out,
+                "--workers", "1", "--no-progress"])
+    assert r.exit_code == 0, r.output
+    lines = r.stderr.strip().splitlines()
+    assert lines[-1] == f"acausal: warning: {out}: dropped an incomplete last line (a run " \
+        "killed while writing it); that point will be recomputed", r.stderr
+    assert not any("numerical libraries" in ln for ln in lines), r.stderr
+
+
+POOL = """\
+import multiprocessing, time
+from pathlib import Path
+pool = multiprocessing.get_context("fork").Pool(2)
+waiting = pool.map_async(time.sleep, [300, 300])
+Path({pids!r}).write_text(" ".join(str(p.pid) for p in pool._pool))
+time.sleep(120)
+""" + h.SPRING_IMPORTS + h.SPRING_MODEL
+
+
+def test_a_model_files_forked_pool_ends_without_a_traceback(tmp_path):
+    """A model file's multiprocessing pool (forked: the command's stop
+    handlers inherited) printed two KeyboardInterrupt tracebacks on the
+    command's stderr when the watchdog ended it after a SIGKILL."""
+    pids, model = tmp_path / "pids", tmp_path / "pool.py"
+    model.write_text(POOL.format(pids=str(pids)))
+    proc = h.cli(["simulate", model], h.env(tmp_path / "log"))
+    h.wait_for(lambda: pids.exists() and len(pids.read_text().split()) == 2, proc)
+    workers = [int(p) for p in pids.read_text().split()]
+    time.sleep(3 * descendants.POLL_S)
+    proc.kill()
+    _, err = proc.communicate(timeout=60)
+    deadline = time.monotonic() + 5.0
+    while any(map(_alive, workers)) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not [p for p in workers if _alive(p)]
+    assert "Traceback" not in err and not err.strip(), err
