@@ -169,6 +169,10 @@ class _Group(click.Group):
     def _main(self, args, prog_name, complete_var, **extra):
         try:
             return super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
+        except AcausalError as exc:
+            # one that a command let through (ACAUSAL_MAX_MEMORY=lots, read before
+            # simulate's own catch, was a traceback): one line all the same
+            _fail(exc)
         except click.exceptions.Abort:
             click.echo("acausal: interrupted", err=True)
             sys.exit(130)
@@ -1335,9 +1339,11 @@ def _sweep_units(mf, cm, params, measures):
 
 # a finished sweep point in the main process: its CSV cells and its returned row,
 # SWEEP_POINT_BASE bytes + SWEEP_POINT_BYTES per column (parameters, measures and
-# 3 more); measured at the end of a serial sweep of a Grid (peak RSS): 1,283 B for
-# 6 columns, 1,509 B for 8 (113 B per column): these are about 1.25 x that
-SWEEP_POINT_BASE = 700
+# 3 more); measured at the end of a serial sweep of a Grid (peak RSS over the
+# start): 1,283 B for 6 columns, 1,509 B for 8 (113 B per column) at 1e5 points;
+# traced allocations at their peak grow by up to 1,724 B per point for 6 columns
+# between 500 and 2,500 points (dicts doubling): 1,900 B for 6 columns covers both
+SWEEP_POINT_BASE = 1000
 SWEEP_POINT_BYTES = 150
 TOLERANCE_RUN_BYTES = 600   # a tolerance study's run, per column (+ 400 bytes), as before
 MAX_POINTS = 1_000_000      # the sweep's default work budget

@@ -208,20 +208,25 @@ def test_a_grid_resumed_after_a_kill_has_every_point_once(tmp_path):
 def test_the_sweep_memory_estimate_is_not_below_what_a_grid_uses(tmp_path):
     """The estimate per finished point (SWEEP_POINT_BASE + SWEEP_POINT_BYTES
     per column) against the memory a finished grid's rows really hold in
-    the main process (CSV cells and returned rows; traced allocations)."""
+    the main process at their peak (CSV cells and returned rows; traced
+    allocations, per point between a 500- and a 2,500-point grid)."""
     import tracemalloc
     from acausal.cli import SWEEP_POINT_BASE, SWEEP_POINT_BYTES
-    g = grid([("a", np.linspace(1, 2, 40)), ("b", np.linspace(3, 4, 250))])
-    tracemalloc.start()
-    with open_executor("serial") as ex:
-        rows = run_sweep(_counting_task([], 10**9), g, tmp_path / "s.csv", executor=ex,
-                         measures=["m"], progress=False)
-        held = tracemalloc.get_traced_memory()[1]     # the peak: cells and rows at once
-    tracemalloc.stop()
-    assert len(rows) == 10_000
+
+    def peak(n):
+        g = grid([("a", np.linspace(1, 2, n // 50)), ("b", np.linspace(3, 4, 50))])
+        tracemalloc.start()
+        with open_executor("serial") as ex:
+            rows = run_sweep(_counting_task([], 10**9), g, tmp_path / f"s{n}.csv", executor=ex,
+                             measures=["m"], progress=False)
+            held = tracemalloc.get_traced_memory()[1]     # the peak: cells and rows at once
+        tracemalloc.stop()
+        assert len(rows) == n
+        return held
+    per_point = (peak(2500) - peak(500)) / 2000
     estimate = SWEEP_POINT_BASE + SWEEP_POINT_BYTES * (2 + 1 + 3)
-    print(f"{held / len(g):.0f} B per point, estimate {estimate} B")
-    assert held / len(g) < estimate, (held / len(g), estimate)
+    print(f"{per_point:.0f} B per point, estimate {estimate} B")
+    assert per_point < estimate, (per_point, estimate)
 
 
 # -- a signal while the command ends -----------------------------------------------------------
@@ -233,7 +238,7 @@ from pathlib import Path
 
 def late():
     Path({marker!r}).write_text("x")
-    time.sleep(3)
+    time.sleep(1.5)
 
 
 atexit.register(late)
@@ -517,3 +522,13 @@ def test_a_model_files_forked_pool_ends_without_a_traceback(tmp_path):
         time.sleep(0.05)
     assert not [p for p in workers if _alive(p)]
     assert "Traceback" not in err and not err.strip(), err
+
+
+@pytest.mark.parametrize("command", [["simulate"], ["animate", "--out", "{t}/a.gif"]])
+def test_a_bad_memory_limit_in_the_environment_is_one_line(tmp_path, bspring, command):
+    """ACAUSAL_MAX_MEMORY=lots was read before simulate's (and animate's)
+    own error handling: a UsageError traceback."""
+    args = [command[0], bspring] + [a.format(t=tmp_path) for a in command[1:]]
+    r = CliRunner().invoke(main, [str(a) for a in args], env={"ACAUSAL_MAX_MEMORY": "lots"})
+    assert one_error_line(r) == "acausal: error: ACAUSAL_MAX_MEMORY 'lots': expected a size " \
+        "such as 4GB, 512MB or 2e9 (bytes)"
