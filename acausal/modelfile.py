@@ -149,7 +149,8 @@ def _command_state():
     working folder (an ``os.chdir`` in the file sent ``--out rel.csv`` to
     ``/rel.csv``), its standard streams (a file that closed stdout ended the
     command with a traceback), its signal handlers (one that ignored SIGINT
-    made Ctrl-C do nothing) and numpy's error handling. What the file does
+    made Ctrl-C do nothing), numpy's error handling, the recursion limit,
+    the umask and no timer (the command sets none). What the file does
     for itself while it is read is its own affair."""
     import signal
 
@@ -162,9 +163,20 @@ def _command_state():
     handlers = {n: signal.getsignal(getattr(signal, n)) for n in names} if main else {}
     errs = np.geterr()
     before = set(threading.enumerate())
+    depth = sys.getrecursionlimit()
+    mask = os.umask(0o022)
+    os.umask(mask)
     try:
         yield
     finally:
+        # a recursion limit of 30 (a traceback from the next import), a umask of
+        # 0o777 (the results written unreadable), an alarm set (SIGALRM ended
+        # the command a second later: exit 142 and no word) were the file's
+        sys.setrecursionlimit(depth)
+        os.umask(mask)
+        if main and hasattr(signal, "setitimer"):
+            for timer in (signal.ITIMER_REAL, signal.ITIMER_VIRTUAL, signal.ITIMER_PROF):
+                signal.setitimer(timer, 0)
         STARTED_THREADS.extend(t for t in threading.enumerate()
                                if t not in before and not t.daemon)
         if os.getcwd() != cwd:

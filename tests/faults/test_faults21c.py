@@ -532,3 +532,22 @@ def test_a_bad_memory_limit_in_the_environment_is_one_line(tmp_path, bspring, co
     r = CliRunner().invoke(main, [str(a) for a in args], env={"ACAUSAL_MAX_MEMORY": "lots"})
     assert one_error_line(r) == "acausal: error: ACAUSAL_MAX_MEMORY 'lots': expected a size " \
         "such as 4GB, 512MB or 2e9 (bytes)"
+
+
+def test_a_model_file_leaves_no_recursion_limit_umask_or_alarm_behind(tmp_path):
+    """sys.setrecursionlimit(30) in a model file gave a RecursionError
+    traceback from the command's next import; os.umask(0o777) wrote the
+    results unreadable; signal.alarm(1) killed the command a second later
+    (exit 142, no word)."""
+    path = tmp_path / "m.py"
+    path.write_text(h.spring_file("import os, signal, sys\nsys.setrecursionlimit(30)\n"
+                                  "os.umask(0o777)\nsignal.alarm(1)\n"
+                                  "experiment = Experiment(t_end=0.01)\n"))
+    depth, mask = sys.getrecursionlimit(), os.umask(0o022)
+    os.umask(mask)
+    out = tmp_path / "o.csv"
+    r = invoke(["simulate", path, "--out", out])
+    assert r.exit_code == 0, r.output
+    assert sys.getrecursionlimit() == depth and os.umask(mask) == mask
+    assert signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0)
+    assert out.stat().st_mode & 0o777 == 0o666 & ~mask
