@@ -540,7 +540,8 @@ def test_a_model_file_leaves_no_recursion_limit_umask_or_alarm_behind(tmp_path):
     results unreadable; signal.alarm(1) killed the command a second later
     (exit 142, no word)."""
     path = tmp_path / "m.py"
-    path.write_text(h.spring_file("import os, signal, sys\nsys.setrecursionlimit(30)\n"
+    path.write_text(h.spring_file("import inspect, os, signal, sys\n"
+                                  "sys.setrecursionlimit(len(inspect.stack()) + 20)\n"
                                   "os.umask(0o777)\nsignal.alarm(1)\n"
                                   "experiment = Experiment(t_end=0.01)\n"))
     depth, mask = sys.getrecursionlimit(), os.umask(0o022)
