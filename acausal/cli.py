@@ -1393,6 +1393,12 @@ def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max
             _check_csv(out, "--out")
             _check_partial(out)
             specs = [parse_param(p, max_points) for p in params]
+            others = [name for name, v in specs[1:] if len(v) > 1 and name != specs[0][0]]
+            if plot and len(others) > 1:   # (found after the whole sweep had run)
+                raise UsageError(f"--plot {plot}: draws the first measure against the first "
+                                 f"parameter ({specs[0][0]}), a line per value of one other, "
+                                 f"but this sweep also varies {', '.join(others)}: vary at most "
+                                 "one besides the first, or plot from the CSV")
             n_points = math.prod(len(v) for _, v in specs)
             if n_points > max_points:
                 raise _budget_error(f"the grid has {n_points:,} points, more than the limit "

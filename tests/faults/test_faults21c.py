@@ -552,3 +552,22 @@ def test_a_model_file_leaves_no_recursion_limit_umask_or_alarm_behind(tmp_path):
     assert sys.getrecursionlimit() == depth and os.umask(mask) == mask
     assert signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0)
     assert out.stat().st_mode & 0o777 == 0o666 & ~mask
+
+
+@pytest.mark.parametrize("params, ok", [
+    (["k.c=10,20", "F=1,2", "body.m=0.1,0.2"], False), (["F=1", "k.c=10,20", "body.m=0.1,0.2"], False),
+    pytest.param(["k.c=10,20", "F=1", "body.m=0.1,0.2"], True, marks=pytest.mark.slow)])
+def test_a_sweep_plot_that_cannot_be_drawn_is_refused_before_the_sweep(tmp_path, bspring,
+                                                                        params, ok):
+    """Three varied parameters and --plot ran the whole sweep, then said
+    'rows vary in [...]; pass by=' (the Python API's advice), exit 2."""
+    args = ["sweep", bspring, "--measure", "s_end", "--out", tmp_path / "s.csv", "--plot",
+            tmp_path / "s.png", "--workers", "1", "--no-progress"]
+    for p in params:
+        args += ["--param", p]
+    r = invoke(args)
+    if ok:
+        assert r.exit_code == 0 and (tmp_path / "s.png").exists(), r.output
+    else:
+        assert "a line per value of one other, but this sweep also varies" in one_error_line(r)
+        assert not (tmp_path / "s.csv").exists()
