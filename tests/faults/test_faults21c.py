@@ -289,18 +289,14 @@ from click.testing import CliRunner     # noqa: E402
 from acausal.cli import main            # noqa: E402
 
 
-def invoke(args):
-    return CliRunner().invoke(main, [str(a) for a in args])
+invoke = h.invoke
 
 
 def one_error_line(r, code=2):
-    """The command ended with ``code`` and one 'error:' line, no traceback."""
-    assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
-    assert "Traceback" not in r.output, r.output
-    assert r.exit_code == code, (r.exit_code, r.output)
-    lines = r.stderr.strip().splitlines()
-    assert len(lines) == 1 and "error:" in lines[0], r.stderr
-    return lines[0]
+    """:func:`helpers.one_error_line`, and that line alone on stderr."""
+    line = h.one_error_line(r, code)
+    assert r.stderr.strip().splitlines() == [line], r.stderr
+    return line
 
 
 def test_a_model_with_no_components_is_refused(tmp_path):
@@ -378,23 +374,7 @@ def test_a_model_files_exit_functions_are_one_line_each(tmp_path):
 # (each fixed fault with the line it gave before; the inputs that were already
 # one clear line are listed in the session's report)
 
-BATTERY_SPRING = """\
-from acausal import Experiment, Model
-from acausal.mechanics.translational import Fixed, Force, Mass, Spring
-
-model = Model()
-F = model.parameter("F", 1.0, "N", "drive force", min=0.0, max=100.0)
-model.wall = Fixed()
-model.body = Mass(m=0.1, s=0.0, v=0.0)
-model.k = Spring(c=40.0, s_rel0=0.0)
-model.drive = Force(f=F)
-model.connect(model.wall.flange, model.k.flange_a)
-model.connect(model.k.flange_b, model.body.flange, model.drive.flange)
-experiment = Experiment(t_end=0.1, rtol=1e-6, atol=1e-9, output_step=1e-3)
-measures = {"s_end": lambda res: res.final()["body.s"]}
-conditions = {"F": (0.1, 10.0, "N")}
-free_parameters = {"k.c": (10.0, 160.0)}
-"""
+BATTERY_SPRING = h.DRIVEN_SPRING
 
 
 @pytest.fixture
