@@ -116,10 +116,12 @@ def _guarded_exit_functions(path):
                 with no_hard_exit():
                     fn(*args, **kw)
             except BaseException as exc:   # noqa: BLE001 - the command is ending: one line
-                what = f"called {exc}" if isinstance(exc, (HardExit, SystemExit)) else \
-                    f"failed: {type(exc).__name__}: {' '.join(str(exc).split())}"
                 if isinstance(exc, SystemExit):
                     what = f"called sys.exit({exc.code!r})"
+                elif isinstance(exc, HardExit):
+                    what = f"called {exc}"
+                else:
+                    what = f"failed: {type(exc).__name__}: {' '.join(str(exc).split())}"
                 try:
                     sys.stderr.write(f"acausal: warning: {where}: the model file's exit "
                                      f"function {name}() {what}: ignored\n")

@@ -89,8 +89,8 @@ def finishing() -> None:
     (:mod:`acausal.infra.descendants`). A SIGTERM then raised a
     KeyboardInterrupt inside an atexit function (a traceback); one landing
     after the interpreter had put back the default handlers killed it with
-    no word (exit 143, seen in ``fmu``): the last atexit function blocks the
-    stop signals then (:func:`_ignore_stop_signals`)."""
+    no word (exit 143, seen in ``fmu``): the last atexit function has the
+    stop signals ignored from then on (:func:`_ignore_stop_signals`)."""
     for name in STOP_SIGNALS:
         sig = getattr(signal, name, None)
         if sig is not None and signal.getsignal(sig) is _handler:
