@@ -54,6 +54,24 @@ def _warn(text):
 _STDOUT_ERRNOS = (errno.EPIPE, errno.ENOSPC, errno.EIO, errno.EBADF)
 
 
+class _ReaderGone(Exception):
+    """Standard output's reader went away (``acausal variables m | head -1``)."""
+
+
+SIGPIPE_EXIT = 128 + 13
+
+
+def _reader_gone() -> bool:
+    """Whether standard output is a pipe whose reader has closed it."""
+    try:
+        import select
+        poll = select.poll()
+        poll.register(1, select.POLLOUT)
+        return any(ev & select.POLLERR for _, ev in poll.poll(0))
+    except (OSError, ValueError, AttributeError):
+        return False
+
+
 def _drop_stdout():
     """Point standard output at /dev/null, so that the interpreter's own
     flush at exit does not fail again with a second message."""
@@ -114,22 +132,47 @@ class _Group(click.Group):
             sys.stdout = open(os.devnull, "w")
         try:
             self._main(args, prog_name, complete_var, **extra)
+        except (_ReaderGone, BrokenPipeError) as exc:
+            # the reader of the output has had enough (| head): quiet, as a Unix
+            # tool killed by SIGPIPE is, with its status 141 (a pipeline under
+            # `set -o pipefail` sees that not all the output was read)
+            if isinstance(exc, BrokenPipeError) and not _reader_gone():
+                raise
+            _drop_stdout()
+            startup.finishing()
+            _end_past_model_threads(SIGPIPE_EXIT)
+            sys.exit(SIGPIPE_EXIT)
         except OSError as exc:
             if exc.errno not in _STDOUT_ERRNOS:
                 raise
             _drop_stdout()
             click.echo(f"acausal: error: the output could not be written to standard output: "
                        f"{exc.strerror or exc}", err=True)
+            startup.finishing()
             _end_past_model_threads(2)
             sys.exit(2)
         except SystemExit as exc:
+            startup.finishing()
             _end_past_model_threads(exc.code)
             raise
+        startup.finishing()
         _end_past_model_threads(0)
+
+    def invoke(self, ctx):
+        try:
+            return super().invoke(ctx)
+        except BrokenPipeError:
+            if _reader_gone():     # (click would swallow it, and exit 1)
+                raise _ReaderGone() from None
+            raise
 
     def _main(self, args, prog_name, complete_var, **extra):
         try:
             return super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
+        except AcausalError as exc:
+            # one that a command let through (ACAUSAL_MAX_MEMORY=lots, read before
+            # simulate's own catch, was a traceback): one line all the same
+            _fail(exc)
         except click.exceptions.Abort:
             click.echo("acausal: interrupted", err=True)
             sys.exit(130)
@@ -176,10 +219,7 @@ class _Number(click.ParamType):
         return x
 
 
-# --atol: what an absolute tolerance in SI units can mean: above 1e3 every
-# position, speed and force of a mechanism counts as zero; below 1e-20 no
-# solution gets closer than the relative tolerance makes it
-ATOL_RANGE = (1e-20, 1e3)
+from .modelfile import ATOL_RANGE  # noqa: E402  (--atol: what an absolute tolerance can mean)
 FINITE, POSITIVE, FRACTION, COUNT, ATOL = (_Number(k) for k in ("finite", "positive", "fraction",
                                                                  "count", "atol"))
 
@@ -306,6 +346,10 @@ def _quiet_warnings():
         warnings.simplefilter("ignore", PendingDeprecationWarning)
         with np.errstate(all="ignore"):
             yield
+    own = [w for w in caught if getattr(w.category, "said_alone", False)]
+    for w in own:
+        _warn(str(w.message))
+    caught = [w for w in caught if w not in own]
     if caught:
         kinds = {}
         for w in caught:
@@ -477,7 +521,8 @@ def simulate(file, t_end, sets, out, plot, as_json, rtol, atol, max_rows, max_wa
                     click.echo(f"acausal: partial results up to t = {res.t[-1]:.6g} s written "
                                f"to {out}", err=True)
             if plot:
-                _plot(mf, res, plot, partial=error is not None)
+                with _writing("--plot", plot):
+                    _plot(mf, res, plot, partial=error is not None)
             # the measures (the model file's code) once the rows are safe, with a
             # --max-wall of their own (one that never returned ignored --max-wall)
             phase.writing = False
@@ -522,6 +567,31 @@ def _write_rows(res, out):
         raise AcausalError(f"--out {out}: writing the {len(res.t):,} rows failed: "
                            f"{exc.strerror or exc}; the run up to t = {res.t[-1]:.6g} s "
                            "is lost with it: free space or write elsewhere") from None
+
+
+@contextlib.contextmanager
+def _writing(option, path, lost=""):
+    """A failed write of ``path`` (a full disk) inside the block is one line
+    naming the option and the file, not 'standard output' (where the
+    command's catch-all put it) nor a traceback; ``lost`` says what became
+    of the work."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.errno not in _STDOUT_ERRNOS + (errno.EACCES, errno.EROFS, errno.EDQUOT):
+            raise
+        raise AcausalError(f"{option} {path}: writing failed: {exc.strerror or exc}"
+                           + (f"; {lost}" if lost else "")) from None
+
+
+def _check_partial(out, option="--out"):
+    """The folder beside ``out`` where finished work is kept must be a
+    folder (a file there gave a FileExistsError traceback at the first
+    finished point)."""
+    partial = os.fspath(out) + ".partial"
+    if os.path.exists(partial) and not os.path.isdir(partial):
+        raise UsageError(f"{option} {out}: {partial}, where the finished work is kept, is a "
+                         "file, not a folder: move it away")
 
 
 def _write_json(path, obj, option, **kw):
@@ -1025,7 +1095,7 @@ def calibrate(file, data, fit, method, experiments, profile, as_json, json_file,
         if json_file:
             _check_output(json_file, "--json-file")
             _check_distinct([("--json-file", json_file)], [file, data])
-        with _quiet_warnings(), _resumable("nothing (a calibration keeps no partial result)"), \
+        with _quiet_warnings(), _resumable(None), \
                 Watchdog(memory_limit(max_memory), max_wall, "the calibration"):
             out, ds, held, mf, cm = _calibrate(cal, compile_file, file, data, fit, method,
                                                experiments, profile)
@@ -1267,8 +1337,15 @@ def _sweep_units(mf, cm, params, measures):
     return units
 
 
-SWEEP_POINT_BYTES = 600     # a sweep point in the main process, per column (+ 400 bytes):
-                            # 1.1 kB measured for 1 parameter and 1 measure, x 1.5
+# a finished sweep point in the main process: its CSV cells and its returned row,
+# SWEEP_POINT_BASE bytes + SWEEP_POINT_BYTES per column (parameters, measures and
+# 3 more); measured at the end of a serial sweep of a Grid (peak RSS over the
+# start): 1,283 B for 6 columns, 1,509 B for 8 (113 B per column) at 1e5 points;
+# traced allocations at their peak grow by up to 1,724 B per point for 6 columns
+# between 500 and 2,500 points (dicts doubling): 1,900 B for 6 columns covers both
+SWEEP_POINT_BASE = 1000
+SWEEP_POINT_BYTES = 150
+TOLERANCE_RUN_BYTES = 600   # a tolerance study's run, per column (+ 400 bytes), as before
 MAX_POINTS = 1_000_000      # the sweep's default work budget
 SWEEP_SAY_PREPARING = 100_000   # a grid this large says so before its bar shows
 
@@ -1314,7 +1391,14 @@ def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max
             _check_output(plot, "--plot", plot=True, create=True)
             _check_distinct([("--out", out), ("--plot", plot)], [file])
             _check_csv(out, "--out")
+            _check_partial(out)
             specs = [parse_param(p, max_points) for p in params]
+            others = [name for name, v in specs[1:] if len(v) > 1 and name != specs[0][0]]
+            if plot and len(others) > 1:   # (found after the whole sweep had run)
+                raise UsageError(f"--plot {plot}: draws the first measure against the first "
+                                 f"parameter ({specs[0][0]}), a line per value of one other, "
+                                 f"but this sweep also varies {', '.join(others)}: vary at most "
+                                 "one besides the first, or plot from the CSV")
             n_points = math.prod(len(v) for _, v in specs)
             if n_points > max_points:
                 raise _budget_error(f"the grid has {n_points:,} points, more than the limit "
@@ -1322,7 +1406,7 @@ def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max
                                     "parameter, or raise --max-points")
             limit = memory_limit(max_memory)
             n_workers = workers or (default_workers() if scheduler is None else 1)
-            per_point = 400 + SWEEP_POINT_BYTES * (len(specs) + len(measures) + 3)
+            per_point = SWEEP_POINT_BASE + SWEEP_POINT_BYTES * (len(specs) + len(measures) + 3)
             main_need = PROCESS_BYTES + n_points * per_point
             check_estimate(main_need + n_workers * PROCESS_BYTES, limit,
                            f"a sweep of {n_points:,} points on {n_workers} workers",
@@ -1338,7 +1422,7 @@ def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max
                                      max_memory=max(per_worker, 50e6))
             units = _sweep_units(mf, cm, [name for name, _ in specs], measures)
             if n_points >= SWEEP_SAY_PREPARING and not no_progress:
-                # (about 3 s per 1e6 points before the bar, more on a loaded host)
+                # (the grid is arrays; a resumed run reads its finished points first)
                 click.echo(f"sweep: preparing {n_points:,} points (the grid, the "
                            "checkpoint, what is already done)", err=True)
             points = grid(specs)
@@ -1347,15 +1431,19 @@ def sweep(file, params, measures, out, plot, scheduler, workers, max_points, max
                     open_executor(scheduler, workers) as ex:
                 journal = Journal(inputs=source_files(file), units=units,
                                   on_resume=_say_resumed("points"))
-                rows = run_sweep(task, points, out, executor=ex, measures=measures,
-                                 progress=not no_progress, journal=journal)
+                with _writing("--out", out, f"the points finished before are in {out} and "
+                              f"{out}.partial/: free space, then run the same command "
+                              "again to resume"):
+                    rows = run_sweep(task, points, out, executor=ex, measures=measures,
+                                     progress=not no_progress, journal=journal)
             if plot:
                 fn = mf.measures[measures[0]]
                 y_unit, y_factor = units.get(measures[0]), 1.0
                 if getattr(fn, "display", None) and y_unit:
                     y_factor, y_unit = fn.shown(1.0)
-                plot_sweep(rows, specs[0][0], measures[0], plot,
-                           x_unit=units.get(specs[0][0]), y_unit=y_unit, y_factor=y_factor)
+                with _writing("--plot", plot, f"the points are in {out}"):
+                    plot_sweep(rows, specs[0][0], measures[0], plot, x_unit=units.get(specs[0][0]),
+                               y_unit=y_unit, y_factor=y_factor)
     except (AcausalError, click.BadParameter) as exc:
         _fail(exc)
     failed = sum(1 for r in rows if r.get("status") != "ok")
@@ -1415,6 +1503,7 @@ def tolerance(file, spec, n, sampling, seed, measures, out, plot_prefix, json_pa
                 _check_output(plot_prefix + "_hist.png", "--plot", plot=True, create=True)
             _check_distinct([("--out", out), ("--json", json_path)], [file, spec])
             _check_csv(out, "--out")
+            _check_partial(out)
             tol.check_n(n, sampling)
             mf, cm = compile_file(file)
             dists = tol.parse_spec(spec, cm)
@@ -1432,7 +1521,7 @@ def tolerance(file, spec, n, sampling, seed, measures, out, plot_prefix, json_pa
                                     "--max-points")
             limit = memory_limit(max_memory)
             n_workers = workers or (default_workers() if scheduler is None else 1)
-            main_need = PROCESS_BYTES + runs * (400 + SWEEP_POINT_BYTES * (
+            main_need = PROCESS_BYTES + runs * (400 + TOLERANCE_RUN_BYTES * (
                 len(dists) + len(measures) + 3))
             check_estimate(main_need + n_workers * PROCESS_BYTES, limit,
                            f"a tolerance study of {runs:,} simulations on {n_workers} workers",
@@ -1507,7 +1596,8 @@ def _say_resumed(what):
 @contextlib.contextmanager
 def _resumable(where):
     """An interruption (Ctrl-C, SIGTERM) ends with one line saying where the
-    finished work is, and exit code 130."""
+    finished work is (``where``; None: the command keeps none), and exit
+    code 130."""
     from .infra.budget import tripped
     from .infra.executor import exit_soon
     try:
@@ -1515,12 +1605,12 @@ def _resumable(where):
     except KeyboardInterrupt:
         exit_soon(130)
         why = tripped()
+        kept = (f"finished work is saved in {where}: run the same command again to resume"
+                if where is not None else "a calibration keeps no partial result")
         if why:
-            click.echo(f"acausal: error: stopped: {why}; finished work is saved in {where}: "
-                       "run the same command again to resume", err=True)
+            click.echo(f"acausal: error: stopped: {why}; {kept}", err=True)
             sys.exit(3)
-        click.echo(f"acausal: interrupted; finished work is saved in {where}: run the same "
-                   "command again to resume", err=True)
+        click.echo(f"acausal: interrupted; {kept}", err=True)
         sys.exit(130)
 
 

@@ -95,6 +95,53 @@ def no_hard_exit():
             os._exit = real
 
 
+@contextlib.contextmanager
+def _guarded_exit_functions(path):
+    """A function the model file registers with ``atexit`` while it is read
+    runs at the command's end under :func:`no_hard_exit`: its ``os._exit(7)``
+    ended the command silently with 7 (the command's own end skipped), its
+    exception printed a traceback; each is now one line naming the file and
+    the function's line, and the command ends as it was ending."""
+    import atexit
+    real_register, real_unregister = atexit.register, atexit.unregister
+    guards = {}
+
+    def register(fn, *args, **kw):
+        code = getattr(fn, "__code__", None)
+        where = f"{path}:{code.co_firstlineno}" if code is not None else path
+        name = getattr(fn, "__name__", repr(fn))
+
+        def guarded():
+            try:
+                with no_hard_exit():
+                    fn(*args, **kw)
+            except BaseException as exc:   # noqa: BLE001 - the command is ending: one line
+                if isinstance(exc, SystemExit):
+                    what = f"called sys.exit({exc.code!r})"
+                elif isinstance(exc, HardExit):
+                    what = f"called {exc}"
+                else:
+                    what = f"failed: {type(exc).__name__}: {' '.join(str(exc).split())}"
+                try:
+                    sys.stderr.write(f"acausal: warning: {where}: the model file's exit "
+                                     f"function {name}() {what}: ignored\n")
+                    sys.stderr.flush()
+                except (OSError, ValueError, AttributeError):
+                    pass
+        guards[fn] = guarded
+        real_register(guarded)
+        return fn
+
+    def unregister(fn):
+        real_unregister(guards.pop(fn, fn))
+    atexit.register, atexit.unregister = register, unregister
+    try:
+        yield
+    finally:
+        if atexit.register is register:
+            atexit.register, atexit.unregister = real_register, real_unregister
+
+
 STARTED_THREADS = []   # non-daemon threads model files started while read (see the CLI's end)
 
 
@@ -104,7 +151,8 @@ def _command_state():
     working folder (an ``os.chdir`` in the file sent ``--out rel.csv`` to
     ``/rel.csv``), its standard streams (a file that closed stdout ended the
     command with a traceback), its signal handlers (one that ignored SIGINT
-    made Ctrl-C do nothing) and numpy's error handling. What the file does
+    made Ctrl-C do nothing), numpy's error handling, the recursion limit,
+    the umask and no timer (the command sets none). What the file does
     for itself while it is read is its own affair."""
     import signal
 
@@ -117,9 +165,20 @@ def _command_state():
     handlers = {n: signal.getsignal(getattr(signal, n)) for n in names} if main else {}
     errs = np.geterr()
     before = set(threading.enumerate())
+    depth = sys.getrecursionlimit()
+    mask = os.umask(0o022)
+    os.umask(mask)
     try:
         yield
     finally:
+        # a recursion limit of 30 (a traceback from the next import), a umask of
+        # 0o777 (the results written unreadable), an alarm set (SIGALRM ended
+        # the command a second later: exit 142 and no word) were the file's
+        sys.setrecursionlimit(depth)
+        os.umask(mask)
+        if main and hasattr(signal, "setitimer"):
+            for timer in (signal.ITIMER_REAL, signal.ITIMER_VIRTUAL, signal.ITIMER_PROF):
+                signal.setitimer(timer, 0)
         STARTED_THREADS.extend(t for t in threading.enumerate()
                                if t not in before and not t.daemon)
         if os.getcwd() != cwd:
@@ -140,7 +199,7 @@ def _run(path):
     """The namespace of the model file ``path`` after running it; any
     exception it raises becomes a ModelFileError naming its line."""
     try:
-        with no_hard_exit(), _command_state():
+        with no_hard_exit(), _command_state(), _guarded_exit_functions(path):
             return runpy.run_path(path, run_name="__acausal_model__")
     except HardExit as exc:
         raise _error(path, _line(exc, path), f"the model file called {exc} while it was "
@@ -249,6 +308,9 @@ def _collect(ns, path):
     if not isinstance(model, Model):
         raise _bad(path, "model", "a model file must bind a Model to the name 'model'"
                    + (f" (found {type(model).__name__})" if model is not None else ""))
+    if not model.children() and not model.equations():   # it "simulated": 500 steps of nothing
+        raise _bad(path, "model", "'model' has no components and no equations: nothing to "
+                   "simulate (add components: model.body = Mass(m=1.0))")
     exp = ns.get("experiment") or Experiment()
     if not isinstance(exp, Experiment):
         raise _bad(path, "experiment", "'experiment' must be an acausal.Experiment")
@@ -277,6 +339,14 @@ def _positive(value):
     return v is not None and math.isfinite(v) and v > 0
 
 
+# an absolute tolerance in SI units can mean something between these: above 1e3
+# every position, speed and force of a mechanism counts as zero; below 1e-20 no
+# solution gets closer than the relative tolerance makes it (the command line's
+# --atol and a model file's Experiment(atol=...) alike; the library's own calls
+# take any positive value)
+ATOL_RANGE = (1e-20, 1e3)
+
+
 def _check_experiment(exp, path):
     """The Experiment's times and tolerances are numbers in range (``atol``
     may also be a dict of tolerances by variable)."""
@@ -297,6 +367,10 @@ def _check_experiment(exp, path):
                 not all(_positive(v) for v in values):
             bad = f"{name} = {value!r} must be a finite number > 0" + \
                 (" (or 0: the solver's steps)" if name == "output_step" else "")
+    if bad is None and not all(ATOL_RANGE[0] <= _number(v) <= ATOL_RANGE[1] for v in tolerances):
+        bad = (f"atol = {atol!r} is outside {ATOL_RANGE[0]:g} to {ATOL_RANGE[1]:g} (SI units): "
+               "above, every position, speed and force counts as zero; below, no solution "
+               "gets closer than rtol makes it")
     if bad is None and _positive(exp.rtol) and not _number(exp.rtol) < 1:
         bad = f"rtol = {exp.rtol!r} must be below 1 (a relative tolerance)"
     options = getattr(exp, "options", None)

@@ -46,6 +46,9 @@ def _experiment_names(table: Table) -> list[str]:
     k, first = table.column("name"), {}
     for line, cells in table.rows:
         name, where = cells[k], (table.file, line, "name")
+        if not name and line == table.rows[0][0] and _looks_like_units(cells, k):
+            raise DataError("a row of units under the header: write each unit in its "
+                            "header, in brackets ('F [N]')", *where)
         if not name or name in _RESERVED or re.search(r"[/\\]", name):
             raise DataError(f"bad experiment name {name!r}", *where)
         if name in first:
@@ -53,6 +56,21 @@ def _experiment_names(table: Table) -> list[str]:
                             f"{first[name]})", *where)
         first[name] = line
     return list(first)
+
+
+def _looks_like_units(cells, k) -> bool:
+    """Whether a row (but its name cell) holds words, none a number: units
+    written on their own line, as spreadsheets often do."""
+    others = [c.strip() for i, c in enumerate(cells) if i != k and c.strip()]
+    if not others:
+        return False
+    for c in others:
+        try:
+            float(c)
+            return False
+        except ValueError:
+            pass
+    return True
 
 
 def _experiment_uses(table: Table) -> list[str]:
@@ -88,6 +106,9 @@ def _read_experiments(folder: Path, parameters, measures, conditions=()
                       ) -> list[MeasuredExperiment]:
     """Experiments of ``experiments.csv``, values in SI, no traces yet."""
     table = read_table(folder / EXPERIMENTS)
+    if not table.rows:   # (calibrate said "every experiment is marked 'validate'")
+        raise DataError("no experiments: a header and no rows under it", table.file,
+                        table.header_line)
     names = _experiment_names(table)
     uses = _experiment_uses(table)
     columns = []  # (name, role, converter, index); headers checked first

@@ -80,8 +80,11 @@ def number(cell: str, required: bool, where: tuple) -> float:
 def _text(path: Path) -> str:
     """The file's text (UTF-8, a BOM allowed); a DataError naming the line
     and column of the first byte that is not UTF-8, or of a NUL byte."""
-    if not path.is_file():
-        raise DataError("file not found", path)
+    if not path.is_file():   # (a folder or a pipe there was 'file not found')
+        what = ("a folder, not a file" if path.is_dir() else
+                "not a regular file (a CSV file is expected)" if path.exists() else
+                "file not found")
+        raise DataError(what, path)
     try:
         data = path.read_bytes()
     except OSError as exc:

@@ -122,7 +122,8 @@ def tree_rss(pid: int | None = None) -> float | None:
     pid = os.getpid() if pid is None else pid
     if not os.path.exists(f"/proc/{pid}/statm"):
         return None
-    total, todo, seen = 0.0, [pid], set()
+    from .descendants import watchdog_pid
+    total, todo, seen = 0.0, [pid], {watchdog_pid()}    # the watchdog is not the work
     while todo:
         p = todo.pop()
         if p in seen:

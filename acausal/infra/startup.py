@@ -11,7 +11,7 @@ interrupts as Ctrl-C does (KeyboardInterrupt: the command's one-line
 (:func:`acausal.infra.executor.exit_soon`). Commands that save work install
 their own handlers over these while they run. A signal the process was
 started ignoring (``nohup``: SIGHUP) stays ignored. No process the command
-started outlives it (:mod:`acausal.infra.descendants`).
+started outlives it, even when it is SIGKILLed (:mod:`acausal.infra.descendants`).
 """
 import os
 import signal
@@ -62,7 +62,11 @@ def guard() -> None:
     import atexit
     from . import descendants
     descendants.adopt()
-    atexit.register(descendants.end)   # registered first: runs last
+    descendants.watch()    # before any thread: it forks
+    if hasattr(os, "register_at_fork"):
+        os.register_at_fork(after_in_child=_child_defaults)
+    atexit.register(_ignore_stop_signals)   # registered first: runs last
+    atexit.register(descendants.end)       # ... after this one
     defaults = {"SIGINT": signal.default_int_handler}
     _STATE["starting"] = True
     for name in STOP_SIGNALS:
@@ -76,3 +80,61 @@ def guard() -> None:
 def started() -> None:
     """The imports are over: from now on a signal interrupts the command."""
     _STATE["starting"] = False
+
+
+def finishing() -> None:
+    """The command's work is over (its results written or its error said):
+    from now on a stop signal is one line and changes nothing; the process
+    ends as it was ending, its descendants ended
+    (:mod:`acausal.infra.descendants`). A SIGTERM then raised a
+    KeyboardInterrupt inside an atexit function (a traceback); one landing
+    after the interpreter had put back the default handlers killed it with
+    no word (exit 143, seen in ``fmu``): the last atexit function has the
+    stop signals ignored from then on (:func:`_ignore_stop_signals`)."""
+    for name in STOP_SIGNALS:
+        sig = getattr(signal, name, None)
+        if sig is not None and signal.getsignal(sig) is _handler:
+            signal.signal(sig, _late)
+
+
+def _late(signum, frame):
+    name = signal.Signals(signum).name
+    try:
+        os.write(2, f"acausal: {name} while the command was ending, its work done: its "
+                    "results are kept\n".encode())
+    except OSError:
+        pass
+    try:
+        from .executor import exit_soon
+        exit_soon(130)    # whatever the end is waiting for, the process ends
+    except Exception:     # noqa: BLE001 - never a traceback at the command's end
+        pass
+
+
+def _child_defaults() -> None:
+    """A process forked by the command (a model file's multiprocessing pool)
+    does not inherit the command's stop handlers: they raised
+    KeyboardInterrupt in it, and ending such a process (the command's end,
+    its watchdog) printed its traceback on the command's stderr. It ends
+    as a plain process does; one that wants handlers sets its own (the
+    command's own pool workers do)."""
+    for name in STOP_SIGNALS:
+        sig = getattr(signal, name, None)
+        try:
+            if sig is not None and callable(signal.getsignal(sig)):
+                signal.signal(sig, signal.SIG_DFL)
+        except (OSError, ValueError):
+            pass
+
+
+def _ignore_stop_signals() -> None:
+    """The command's last act before the interpreter's own end: the stop
+    signals are ignored (for the whole process: blocking them in one thread
+    leaves them to the others, numpy's among them), instead of killing it
+    silently once Python has put back their default action (it leaves an
+    ignored signal ignored)."""
+    for name in STOP_SIGNALS:
+        try:
+            signal.signal(getattr(signal, name), signal.SIG_IGN)
+        except (OSError, ValueError, AttributeError):
+            pass

@@ -31,10 +31,49 @@ model.connect(model.k.flange_b, model.body.flange)
 """
 
 
+# a mass on a spring driven by a force F (a condition of the data folders), k.c
+# free: the model file of the batteries' data, calibrate and sweep cases
+DRIVEN_SPRING = """\
+from acausal import Experiment, Model
+from acausal.mechanics.translational import Fixed, Force, Mass, Spring
+
+model = Model()
+F = model.parameter("F", 1.0, "N", "drive force", min=0.0, max=100.0)
+model.wall = Fixed()
+model.body = Mass(m=0.1, s=0.0, v=0.0)
+model.k = Spring(c=40.0, s_rel0=0.0)
+model.drive = Force(f=F)
+model.connect(model.wall.flange, model.k.flange_a)
+model.connect(model.k.flange_b, model.body.flange, model.drive.flange)
+experiment = Experiment(t_end=0.1, rtol=1e-6, atol=1e-9, output_step=1e-3)
+measures = {"s_end": lambda res: res.final()["body.s"]}
+conditions = {"F": (0.1, 10.0, "N")}
+free_parameters = {"k.c": (10.0, 160.0)}
+"""
+
+
 def spring_file(tail):
     """The text of a spring model file ending with ``tail`` (its
     experiment and measures)."""
     return SPRING_IMPORTS + "\n" + SPRING_MODEL + tail
+
+
+def invoke(args):
+    """The command run in this process (click's CliRunner)."""
+    from click.testing import CliRunner
+
+    from acausal.cli import main
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+def one_error_line(r, code=2):
+    """The command ended with ``code`` and exactly one 'error:' line, no traceback."""
+    assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
+    assert "Traceback" not in r.output, r.output
+    assert r.exit_code == code, (r.exit_code, r.output)
+    errors = [ln for ln in r.stderr.splitlines() if "error:" in ln]
+    assert len(errors) == 1, r.stderr
+    return errors[0]
 
 
 def copy_model(name, folder):
@@ -77,7 +116,8 @@ def kill_tree_check(proc, sig, wait=10.0):
     descendants still alive ``wait`` seconds later (there should be none)
     and its stderr."""
     family = psutil.Process(proc.pid).children(recursive=True)
-    assert family, "the command started no worker process"
+    assert [p for p in family if p.name() != "acausal-watch"], \
+        "the command started no worker process"
     os.kill(proc.pid, sig)
     _, stderr = proc.communicate(timeout=60)
     _, alive = psutil.wait_procs(family, timeout=wait)

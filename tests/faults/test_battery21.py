@@ -30,31 +30,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from click.testing import CliRunner
-
-from acausal.cli import main
 
 from . import helpers as h
 
 ROOT = Path(__file__).resolve().parents[2]
 
-SPRING = """\
-from acausal import Experiment, Model
-from acausal.mechanics.translational import Fixed, Force, Mass, Spring
-
-model = Model()
-F = model.parameter("F", 1.0, "N", "drive force", min=0.0, max=100.0)
-model.wall = Fixed()
-model.body = Mass(m=0.1, s=0.0, v=0.0)
-model.k = Spring(c=40.0, s_rel0=0.0)
-model.drive = Force(f=F)
-model.connect(model.wall.flange, model.k.flange_a)
-model.connect(model.k.flange_b, model.body.flange, model.drive.flange)
-experiment = Experiment(t_end=0.1, rtol=1e-6, atol=1e-9, output_step=1e-3)
-measures = {"s_end": lambda res: res.final()["body.s"]}
-conditions = {"F": (0.1, 10.0, "N")}
-free_parameters = {"k.c": (10.0, 160.0)}
-"""
+SPRING = h.DRIVEN_SPRING
 
 
 def model_file(tmp_path, extra="", name="spring.py", base=SPRING):
@@ -63,18 +44,7 @@ def model_file(tmp_path, extra="", name="spring.py", base=SPRING):
     return path
 
 
-def invoke(args):
-    return CliRunner().invoke(main, [str(a) for a in args])
-
-
-def one_error_line(r, code=2):
-    """The command ended with ``code`` and exactly one 'error:' line, no traceback."""
-    assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
-    assert "Traceback" not in r.output, r.output
-    assert r.exit_code == code, (r.exit_code, r.output)
-    errors = [ln for ln in r.stderr.splitlines() if "error:" in ln]
-    assert len(errors) == 1, r.stderr
-    return errors[0]
+invoke, one_error_line = h.invoke, h.one_error_line
 
 
 # ---------------------------------------------------------------------------

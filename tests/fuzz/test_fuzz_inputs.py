@@ -28,7 +28,8 @@ EXAMPLES = ROOT / "models" / "examples"
 N_DATA, N_MODEL, N_SET = 750, 250, 300
 LIMIT_S = 3.0
 # errors about a whole file, which has no line to name
-FILE_LEVEL = ("file not found", "no header row", "trace of unknown experiment")
+FILE_LEVEL = ("file not found", "a folder, not a file", "not a regular file", "no header row",
+              "trace of unknown experiment")
 
 
 @pytest.fixture(scope="module")
