@@ -186,7 +186,8 @@ class _Group(click.Group):
 
 class _Number(click.ParamType):
     """A number option checked when it is parsed: ``kind`` "finite", "positive"
-    (finite > 0), "fraction" (0 < x < 1) or "count" (a whole number >= 1,
+    (finite > 0), "fraction" (0 < x < 1), "atol" and "rtol" (within
+    :data:`~acausal.modelfile.ATOL_RANGE`, ``RTOL_RANGE``) or "count" (a whole number >= 1,
     written 1000000, 1e6 or 1_000_000: the messages print counts as 1e6)."""
 
     def __init__(self, kind):
@@ -207,6 +208,9 @@ class _Number(click.ParamType):
             self.fail(f"{value!r} must be > 0", param, ctx)
         if self.kind == "fraction" and not 0 < x < 1:
             self.fail(f"{value!r} must be between 0 and 1", param, ctx)
+        if self.kind == "rtol" and not RTOL_RANGE[0] <= x <= RTOL_RANGE[1]:
+            self.fail(f"{value!r} is outside the accepted range {RTOL_RANGE[0]:g} to "
+                      f"{RTOL_RANGE[1]:g} (a relative tolerance)", param, ctx)
         if self.kind == "atol" and not ATOL_RANGE[0] <= x <= ATOL_RANGE[1]:
             self.fail(f"{value!r} is outside the accepted range {ATOL_RANGE[0]:g} to "
                       f"{ATOL_RANGE[1]:g} (SI units of the unknowns)", param, ctx)
@@ -219,9 +223,10 @@ class _Number(click.ParamType):
         return x
 
 
-from .modelfile import ATOL_RANGE  # noqa: E402  (--atol: what an absolute tolerance can mean)
-FINITE, POSITIVE, FRACTION, COUNT, ATOL = (_Number(k) for k in ("finite", "positive", "fraction",
-                                                                 "count", "atol"))
+# --atol, --rtol: what a tolerance can mean
+from .modelfile import ATOL_RANGE, RTOL_RANGE  # noqa: E402
+FINITE, POSITIVE, FRACTION, COUNT, ATOL, RTOL = (_Number(k) for k in (
+    "finite", "positive", "fraction", "count", "atol", "rtol"))
 
 
 def _size(ctx, param, value):
@@ -461,7 +466,7 @@ MAX_MEMORY_HELP = ("memory limit of the command (4GB, 512MB, ...; default $ACAUS
 @click.option("--out", type=click.Path(dir_okay=False), help="write all variables to CSV")
 @click.option("--plot", type=click.Path(dir_okay=False), help="write a figure (PNG, PDF...)")
 @click.option("--json", "as_json", is_flag=True, help="print one JSON object")
-@click.option("--rtol", type=FRACTION, help="relative tolerance (0 < rtol < 1)")
+@click.option("--rtol", type=RTOL, help="relative tolerance (1e-14 to 0.1)")
 @click.option("--atol", type=ATOL, help="absolute tolerance (1e-20 to 1e3, SI units)")
 @click.option("--max-rows", type=COUNT, default=None, metavar="N",
               help="most output rows to store (default 1e6): a larger grid is refused")

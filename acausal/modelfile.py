@@ -345,6 +345,12 @@ def _positive(value):
 # --atol and a model file's Experiment(atol=...) alike; the library's own calls
 # take any positive value)
 ATOL_RANGE = (1e-20, 1e3)
+# a relative tolerance can mean something between these: below 1e-14 no step's
+# local error test can pass in double precision (unit roundoff 2.2e-16, a few
+# digits of margin); above 0.1 a step may carry a tenth of its value as error
+# (rtol 0.9 ran silently, 8 % off at the end). The command line's --rtol and
+# Experiment(rtol=...) alike; the library's own calls take any value in (0, 1).
+RTOL_RANGE = (1e-14, 0.1)
 
 
 def _check_experiment(exp, path):
@@ -371,8 +377,11 @@ def _check_experiment(exp, path):
         bad = (f"atol = {atol!r} is outside {ATOL_RANGE[0]:g} to {ATOL_RANGE[1]:g} (SI units): "
                "above, every position, speed and force counts as zero; below, no solution "
                "gets closer than rtol makes it")
-    if bad is None and _positive(exp.rtol) and not _number(exp.rtol) < 1:
-        bad = f"rtol = {exp.rtol!r} must be below 1 (a relative tolerance)"
+    if bad is None and _positive(exp.rtol) and \
+            not RTOL_RANGE[0] <= _number(exp.rtol) <= RTOL_RANGE[1]:
+        bad = (f"rtol = {exp.rtol!r} is outside {RTOL_RANGE[0]:g} to {RTOL_RANGE[1]:g}: below, "
+               "no step's error test can pass in double precision; above, a step may carry "
+               "a tenth of its value as error")
     options = getattr(exp, "options", None)
     if bad is None and options:   # a field no run reads: the settings were silently ignored
         bad = (f"options = {options!r} is not read by any run: give the settings as "

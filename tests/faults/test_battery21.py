@@ -57,8 +57,10 @@ invoke, one_error_line = h.invoke, h.one_error_line
     ("raise SystemExit('bye')\n", "called sys.exit('bye')", 16),
     ("experiment.stop = 5\n", "experiment stop = 5 must be an acausal.Stop", 12),
     ("experiment = Experiment(t_end=0.1, stop='body.s')\n", "must be an acausal.Stop", 16),
-    ("experiment = Experiment(t_end=0.1, rtol=5.0)\n", "rtol = 5.0 must be below 1", 16),
-    ("experiment = Experiment(t_end=0.1, rtol=1)\n", "rtol = 1 must be below 1", 16)])
+    ("experiment = Experiment(t_end=0.1, rtol=5.0)\n", "rtol = 5.0 is outside 1e-14 to 0.1", 16),
+    ("experiment = Experiment(t_end=0.1, rtol=1)\n", "rtol = 1 is outside 1e-14 to 0.1", 16),
+    ("experiment = Experiment(t_end=0.1, rtol=0.9)\n", "rtol = 0.9 is outside", 16),
+    ("experiment = Experiment(t_end=0.1, rtol=1e-300)\n", "rtol = 1e-300 is outside", 16)])
 @pytest.mark.parametrize("command", ["check", "simulate", "variables"])
 def test_a_model_file_that_ends_the_command_or_binds_a_bad_experiment(tmp_path, extra, said,
                                                                       line, command):

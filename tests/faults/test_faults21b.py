@@ -288,6 +288,19 @@ def test_an_absurd_absolute_tolerance_is_refused(spring, value):
     assert "--atol" in line and "outside the accepted range 1e-20 to 1000" in line
 
 
+@pytest.mark.parametrize("value", ["0.9", "0.5", "1e-300", "1e-15"])
+def test_an_absurd_relative_tolerance_is_refused(spring, value):
+    """--rtol 0.9 ran silently (8 % off at the end), --rtol 1e-300 ran too."""
+    line = _one_line(_invoke(["simulate", spring, "--rtol", value]))
+    assert "--rtol" in line and "outside the accepted range 1e-14 to 0.1" in line
+
+
+def test_a_sensible_relative_tolerance_still_runs(spring):
+    for value in ("1e-3", "1e-12"):
+        r = _invoke(["simulate", spring, "--rtol", value])
+        assert r.exit_code == 0, r.output
+
+
 def test_a_sensible_absolute_tolerance_still_runs(spring):
     r = _invoke(["simulate", spring, "--atol", "1e-3"])
     assert r.exit_code == 0, r.stderr
