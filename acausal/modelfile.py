@@ -17,6 +17,7 @@ the current folder's ``models/`` and the bundled ``models/`` are on the path
 (:func:`model_path`).
 """
 import contextlib
+import io
 import math
 import os
 import re
@@ -153,7 +154,10 @@ def _command_state():
     command with a traceback), its signal handlers (one that ignored SIGINT
     made Ctrl-C do nothing), numpy's error handling, the recursion limit,
     the umask and no timer (the command sets none). What the file does
-    for itself while it is read is its own affair."""
+    for itself while it is read is its own affair. In the command, the file
+    reads an empty standard input: ``input()`` in a model file waited
+    forever for a harness's open pipe (a hang); it is now an EOFError
+    naming its line. (A library call keeps the caller's stdin.)"""
     import signal
 
     import numpy as np
@@ -168,6 +172,9 @@ def _command_state():
     depth = sys.getrecursionlimit()
     mask = os.umask(0o022)
     os.umask(mask)
+    from .infra.startup import is_command
+    if is_command():
+        sys.stdin = io.StringIO("")
     try:
         yield
     finally:
@@ -217,7 +224,10 @@ def _run(path):
     except Exception as exc:  # a bug in the script: say where
         line = _line(exc, path) or _bad_byte_line(path)
         hint = ""
-        if isinstance(exc, ModuleNotFoundError):
+        if isinstance(exc, EOFError):
+            hint = (" (a model file is read with no standard input: it cannot ask for "
+                    "input; give values as parameters and --set)")
+        elif isinstance(exc, ModuleNotFoundError):
             hint = (" (a model file's imports are searched in " + ", ".join(model_path(path))
                     + " and ACAUSAL_MODEL_PATH)")
         elif isinstance(exc, TypeError) and "convert expression to" in str(exc):

@@ -551,3 +551,27 @@ def test_a_sweep_plot_that_cannot_be_drawn_is_refused_before_the_sweep(tmp_path,
     else:
         assert "a line per value of one other, but this sweep also varies" in one_error_line(r)
         assert not (tmp_path / "s.csv").exists()
+
+
+def test_a_model_file_that_asks_for_input_is_one_line_not_a_hang(tmp_path):
+    """``input()`` in a model file waited forever on the harness's open
+    stdin (a hang); the command gives the file an empty one."""
+    path = tmp_path / "asks.py"
+    path.write_text(h.spring_file("answer = input('stiffness? ')\n"
+                                  "experiment = Experiment(t_end=0.1)\n"))
+    p = subprocess.Popen([sys.executable, "-m", "acausal.cli", "simulate", str(path)],
+                         env=dict(os.environ, PYTHONPATH=str(h.ROOT)), stdin=subprocess.PIPE,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        p.wait(timeout=60)      # stdin left open, as a harness or a terminal would
+    finally:
+        if p.poll() is None:
+            p.kill()
+    err = p.stderr.read()
+    p.stdin.close()
+    p.stdout.close()
+    p.stderr.close()
+    assert p.returncode == 2, (p.returncode, err)
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert len(lines) == 1 and "Traceback" not in err, err
+    assert f"{path}:" in lines[0] and "EOFError" in lines[0] and "no standard input" in lines[0]
