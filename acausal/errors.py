@@ -37,6 +37,25 @@ def _restore(cls, args, state):
     return err
 
 
+def _picklable(state):
+    """``state`` with each value that cannot be pickled replaced by None: a
+    SolverError's partial ``result`` holds its compiled model, whose
+    components may be classes of a model file (module ``__acausal_model__``),
+    which no other process can import. Raised in a process pool's worker,
+    such an error could not be sent back: the worker died and the pool with
+    it (a detection-power run lost its last 25 cases to one truth that IDA
+    could not integrate). The message and the location always travel."""
+    import pickle
+    out = {}
+    for key, value in state.items():
+        try:
+            pickle.dumps(value)
+        except Exception:   # noqa: BLE001 - any failure to pickle: leave it behind
+            value = None
+        out[key] = value
+    return out
+
+
 class AcausalError(Exception):
     """Base class of every error a user can cause.
 
@@ -55,7 +74,7 @@ class AcausalError(Exception):
         self.file, self.line, self.column, self.t = file, line, column, t
 
     def __reduce__(self):  # keep the payload when pickled (dask workers, ...)
-        return _restore, (type(self), self.args, dict(self.__dict__))
+        return _restore, (type(self), self.args, _picklable(self.__dict__))
 
     def location(self):
         """The location prefix of :meth:`__str__` (``''`` when none is known

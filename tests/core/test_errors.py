@@ -51,6 +51,43 @@ def test_errors_pickle_with_their_payload(err):
     assert back.__dict__ == err.__dict__
 
 
+class _FromAModelFile:
+    """As a class a model file defines: its module cannot be imported
+    elsewhere (model files run as ``__acausal_model__``)."""
+
+
+_FromAModelFile.__module__ = "__acausal_model__"
+_FromAModelFile.__qualname__ = "Armature"
+
+
+def _raise_with_a_partial_result():
+    raise SolverError("IDA failed at t = 5.4e-06 s in cam", t=5.4e-6, component="cam",
+                      result=_FromAModelFile())
+
+
+def test_an_error_whose_payload_cannot_be_pickled_still_travels():
+    """A SolverError's partial result holds the compiled model, whose
+    components may be a model file's classes: the error pickles with the
+    result left behind, its message and location kept."""
+    err = SolverError("IDA failed", t=5.4e-6, component="cam", result=_FromAModelFile())
+    with pytest.raises(pickle.PicklingError):
+        pickle.dumps(err.result)
+    back = pickle.loads(pickle.dumps(err))
+    assert str(back) == str(err) and back.t == 5.4e-6 and back.component == "cam"
+    assert back.result is None
+
+
+def test_such_an_error_raised_in_a_worker_does_not_break_the_pool():
+    """It killed the worker that tried to send it back, and the pool with it
+    (BrokenProcessPool for every task after it)."""
+    import concurrent.futures as cf
+    import multiprocessing as mp
+    with cf.ProcessPoolExecutor(1, mp_context=mp.get_context("fork")) as pool:
+        with pytest.raises(SolverError, match="IDA failed at t"):
+            pool.submit(_raise_with_a_partial_result).result(timeout=60)
+        assert pool.submit(abs, -3).result(timeout=60) == 3
+
+
 def test_unknown_name_is_still_a_key_error():
     assert issubclass(UnknownNameError, KeyError)
 
