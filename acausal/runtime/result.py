@@ -20,6 +20,11 @@ class Rows(NamedTuple):
 
 
 BLOCK_ROWS = 200_000    # rows of one block of a large result's CSV or scan
+# observed variables read one by one from a result before the whole matrix is
+# computed instead: a fit reads one or two (each alone is 10x cheaper than
+# all of them), a comparison against a reference reads every one (the whole
+# matrix once is cheaper than a generated expression and a check per name)
+ALONE = 4
 
 
 class Result:
@@ -136,6 +141,8 @@ class Result:
         """Observed variable ``k`` alone (:func:`.observe.observed_column`),
         or from the whole matrix when it cannot be vectorised."""
         col = self._columns.get(k)
+        if col is None and len(self._columns) >= ALONE:
+            return self._observed()[:, k]      # many names read: the whole matrix, once
         if col is None:
             col = observed_column(self.model, k, self.p, self.t, self.y, self.yp,
                                   self.d)

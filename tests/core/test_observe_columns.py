@@ -3,6 +3,8 @@ expression alone, vectorised over each mode (runtime/observe.observed_column):
 the same values as every variable computed row by row by the per-row
 callback, in every mode of a hybrid run, and the per-row values when the
 vectorised expression disagrees with them (the guard)."""
+import weakref
+
 import numpy as np
 import pytest
 
@@ -31,6 +33,7 @@ def test_each_observed_variable_alone_is_its_per_row_value(path):
     assert len(observed) > 10
     worst = 0.0
     for k, name in observed:
+        res._columns.clear()     # each read alone (past ALONE names: the whole matrix)
         col = res[name]
         assert col.shape == res.t.shape
         worst = max(worst, float(_ulps(rowwise[:, k], col).max()))
@@ -54,7 +57,10 @@ def test_a_column_that_disagrees_falls_back_to_the_per_row_values(monkeypatch):
             fn(t, y, yp, p, d, o)
             o += 1.0          # what a wrong array printer would give
         return off
-    observe._COLUMNS.pop(cm, None)
+    # this test's own tables: the wrong function must not stay with the
+    # (cached, shared) compiled model for the tests after it
+    monkeypatch.setattr(observe, "_COLUMNS", weakref.WeakKeyDictionary())
+    monkeypatch.setattr(observe, "_ROWS", weakref.WeakKeyDictionary())
     monkeypatch.setattr(observe, "generate_observe_rows", wrong)
     expect = observe.per_row(cm, res.p, res.t, res.y, res.yp, res.d)[:, k]
     got = res[name]
