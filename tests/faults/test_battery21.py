@@ -118,6 +118,7 @@ def run_cli(args, timeout=120):
     return p, time.monotonic() - t0
 
 
+@pytest.mark.slow   # 3-10 s: out of the default tier's 5-minute budget
 def test_max_wall_bounds_a_model_file_that_never_returns(tmp_path):
     """A model file that slept (a loop, a blocking call) ignored --max-wall:
     the run's own wall limit starts only with the run."""
@@ -263,6 +264,7 @@ def test_trace_samples_outside_the_run_are_said(tmp_path):
 # ---------------------------------------------------------------------------
 
 
+@pytest.mark.slow   # 3-10 s: out of the default tier's 5-minute budget
 def test_workers_killed_under_a_queue_of_cancelled_tasks_print_no_thread_traceback():
     """A sweep of 200,000 points whose process group got SIGTERM (``timeout``
     sends it to the group): the workers died first, and the pool's manager
@@ -390,6 +392,7 @@ def test_a_result_is_written_by_blocks_exactly(tmp_path, monkeypatch):
     assert res.final()["w"] != res.final()["w"] and res.final()["body.s"] == res["body.s"][-1]
 
 
+@pytest.mark.slow   # 3-10 s: out of the default tier's 5-minute budget
 def test_max_wall_bounds_a_measure_that_never_returns(tmp_path):
     """A measure that slept (the model file's code, run after the run)
     ignored --max-wall 5: a hang. The rows are written first; the measures

@@ -216,6 +216,7 @@ def test_a_semicolon_spec_is_read_or_one_line(spring, tmp_path, text, expect):
 
 # -- os._exit in a model file -------------------------------------------------------------------
 
+@pytest.mark.slow   # 3-10 s: out of the default tier's 5-minute budget
 def test_os_exit_while_a_model_file_is_read_is_one_line(tmp_path):
     """``os._exit(7)`` in a model file ended the command with exit 7 and no
     word; a measure's ended it after the run with the results unsaid."""

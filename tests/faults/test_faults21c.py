@@ -246,6 +246,7 @@ experiment = Experiment(t_end=0.1)
 """)
 
 
+@pytest.mark.slow   # 3-10 s: out of the default tier's 5-minute budget
 def test_a_sigterm_while_the_command_ends_is_one_line_and_keeps_the_result(tmp_path):
     """A SIGTERM while the command was ending (here: in a model file's
     atexit function) raised KeyboardInterrupt inside it, a traceback; one

@@ -91,6 +91,7 @@ def test_an_interrupted_simulation_writes_its_partial_result(tmp_path, sig, step
     np.testing.assert_allclose(s, 0.2 * np.cos(5.0 * t), atol=1e-3)
 
 
+@pytest.mark.slow   # 3-10 s: out of the default tier's 5-minute budget
 def test_ctrl_c_on_a_sweep_leaves_no_worker_and_no_traceback(tmp_path):
     """The terminal sends Ctrl-C to the whole process group: the workers
     ignore it, the command stops them and says how to resume."""
@@ -181,6 +182,7 @@ def test_a_memory_watchdog_stops_the_command_with_its_reason():
     assert "stopped: the test used" in r.stdout and "more than the limit 400 MB" in r.stdout
 
 
+@pytest.mark.slow   # 3-10 s: out of the default tier's 5-minute budget
 def test_a_sweep_past_its_wall_limit_stops_keeping_its_points(tmp_path):
     model = h.copy_model("osc_sweep_model.py", tmp_path / "model")
     out = tmp_path / "sweep.csv"
@@ -480,6 +482,7 @@ def test_calibrate_fits_a_long_trace_thinned(tmp_path):
     assert abs(fitted - c) / c < 1e-3
 
 
+@pytest.mark.slow   # 3-10 s: out of the default tier's 5-minute budget
 def test_a_sized_write_moves_the_exit_deadline_later():
     """exit_no_sooner: an interrupted run's rows, sized in advance, are
     written within a deadline moved later (5.4 M rows took about the whole

@@ -194,6 +194,7 @@ def test_measure_without_its_event_is_missing_and_the_rest_is_kept(tmp_path):
 # -- solver failure: JSON and plot --------------------------------------------------------
 
 
+@pytest.mark.slow   # 3-10 s: out of the default tier's 5-minute budget
 def test_solver_failure_json_has_error_and_partial_result(tmp_path):
     model = write(tmp_path, "blowup.py", BLOWUP)
     r = run_cli(["simulate", model, "--json"])
