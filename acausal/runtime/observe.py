@@ -74,22 +74,19 @@ def observed_column(cm, k, p, t, y, yp, d):
     col = _column_function(cm, k)
     if col is None:
         return None
-    out = np.empty((1, len(t)))
-    pv = [float(v) for v in p]
-    with np.errstate(all="ignore"):
-        for key, rows in _modes(d):
-            o = out[:, rows] if isinstance(rows, slice) else np.empty((1, len(rows)))
-            col.fn(t[rows], np.ascontiguousarray(y[rows].T), np.ascontiguousarray(yp[rows].T),
-                   pv, list(key), o)
-            if key not in col.checked:
-                i = (rows.start or 0) if isinstance(rows, slice) else rows[0]
-                ref = per_row(cm, p, t[i:i + 1], y[i:i + 1], yp[i:i + 1], d[i:i + 1])[0, k]
-                if not _agrees(o[:, 0], np.array([ref])):
-                    _COLUMNS[cm][k] = None
-                    return None
-                col.checked.add(key)
-            if not isinstance(rows, slice):
-                out[:, rows] = o
+
+    def agrees(key, i, first):
+        if key in col.checked:
+            return True
+        ok = _agrees(first, per_row(cm, p, t[i:i + 1], y[i:i + 1], yp[i:i + 1],
+                                    d[i:i + 1])[0, k:k + 1])
+        if ok:
+            col.checked.add(key)
+        return ok
+    out = _by_mode(col.fn, 1, (p, t, y, yp, d), agrees)
+    if out is None:
+        _COLUMNS[cm][k] = None
+        return None
     return out[0]
 
 
@@ -133,22 +130,33 @@ def observed_rows(cm, p, t, y, yp, d):
     fn = _function(cm) if len(t) >= VECTOR_ROWS else None
     if fn is None:
         return per_row(cm, p, t, y, yp, d)
-    out = np.empty((len(cm.var_names), len(t)))
+    out = _by_mode(fn, len(cm.var_names), (p, t, y, yp, d), lambda key, i, first: _agrees(
+        first, per_row(cm, p, t[i:i + 1], y[i:i + 1], yp[i:i + 1], d[i:i + 1])[0]))
+    if out is None:
+        _ROWS[cm] = None   # a function the array code got wrong: never again
+        return per_row(cm, p, t, y, yp, d)
+    return out.T
+
+
+def _by_mode(fn, n, rows_of, agrees):
+    """(n x rows) of the vectorised ``fn`` (:func:`generate_observe_rows`)
+    over all rows of each mode at once; ``rows_of`` = (p, t, y, yp, d);
+    None as soon as ``agrees(mode, its first row's index, that row's
+    values)`` is False (the guard against a wrong array function)."""
+    p, t, y, yp, d = rows_of
+    out = np.empty((n, len(t)))
     pv = [float(v) for v in p]
     with np.errstate(all="ignore"):
         for key, rows in _modes(d):
-            o = out[:, rows] if isinstance(rows, slice) else np.empty((len(out), len(rows)))
+            o = out[:, rows] if isinstance(rows, slice) else np.empty((n, len(rows)))
             fn(t[rows], np.ascontiguousarray(y[rows].T), np.ascontiguousarray(yp[rows].T),
                pv, list(key), o)
-            k = rows.start if isinstance(rows, slice) else rows[0]
-            k = k or 0
-            if not _agrees(o[:, 0], per_row(cm, p, t[k:k + 1], y[k:k + 1], yp[k:k + 1],
-                                            d[k:k + 1])[0]):
-                _ROWS[cm] = None   # a function the array code got wrong: never again
-                return per_row(cm, p, t, y, yp, d)
+            i = (rows.start or 0) if isinstance(rows, slice) else rows[0]
+            if not agrees(key, i, o[:, 0]):
+                return None
             if not isinstance(rows, slice):
                 out[:, rows] = o
-    return out.T
+    return out
 
 
 def _agrees(a, b):
