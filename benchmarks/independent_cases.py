@@ -13,7 +13,8 @@ Columns: case, truth (the hidden laws as scaled), effect (noise-free RMS
 change of the data, floors), seed, verdict, named cause and location,
 parameter error % (each named cause's magnitude against the truth's),
 held-out error after (floors), ok (issue 24's acceptance: judge.py),
-wall (s) and simulations.
+wall (s) and simulations (the fits' and the located term's: the
+diagnosis's own count, ``timing.n_sim``, leaves out the located stage).
 """
 import argparse
 import json
@@ -87,7 +88,8 @@ def run_one(case, effect, seed, workers=2, keep=None):
                 heldout_after=out["gain"]["after"]["heldout"],
                 wall_s=wall, cpu_s_main=time.process_time() - cpu0,
                 cpu_s_children=_children_cpu(ch0),
-                n_sim=timing.get("n_sim"), weak=det.get("weak_evidence"),
+                n_sim=(timing.get("n_sim") or 0) + (timing.get("located_n_sim") or 0),
+                located_n_sim=timing.get("located_n_sim"), weak=det.get("weak_evidence"),
                 sticks=sum(1 for ev in events.values() for e in ev if e[1] == "stick"),
                 ranking=out.get("ranking", [])[:3])
 

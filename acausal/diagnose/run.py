@@ -228,6 +228,8 @@ def _timing(s: State, clock: Clock, t_fit: float, t_cv: float) -> dict:
     """``candidates.json``'s timing: the fit stage's and the later stages'
     wall times, candidates, simulations, the total and each timed stage's."""
     extra = dict(clock.times)
+    if s.location is not None and s.location.n_sim:
+        extra["located_n_sim"] = s.location.n_sim    # the located term's (not in n_sim)
     if s.pair_screen_n_sim is not None:
         extra["pair_screen_n_sim"] = s.pair_screen_n_sim
         ps = s.pair_search
