@@ -93,6 +93,18 @@ REFINE_WITHIN = 1.25  # nodes fitted in full: linearised held-out RMS within thi
 REFINE_MAX = 3        # ... of the best node's, at most this many
 RECHOOSE = 3          # the best node's setting chosen again at its fitted point at most
                       # this many times (_rechoose)
+LOCATED_EVALS = 6   # a located fit's budget, in evaluations of every experiment per
+                 # parameter and window (FitSettings.evals_per_param; the first window a
+                 # third): deterministic, where the wall-time budget the other fits share
+                 # (chain.BUDGET_MIN_S, 60 s) stopped every refit of the cam detent case
+                 # (85-100 weights, 60-180 ms an evaluation at the fitted weights) at a
+                 # point that depended on the machine's load: the same data gave the
+                 # follower's term 13.9, 14.7 and 31.1 floors held-out in three runs
+LOCATED_JACOBIAN = "secant"  # Broyden updates between difference Jacobians (a fresh one
+                 # at the optimum for the intervals and leave-one-out): on that case the
+                 # first located fit took 846 simulations against 1770, the same verdict
+GUARD = 10.0     # the wall-time budget of a located fit, in multiples of the other fits'
+                 # (chain._budget): a guard against a pathological run only
 FLOOR_REACH = 1.1     # the best term "reaches the floor" when its held-out RMS is at most
                  # this many floors (the nulls' held-out spread is 0.99-1.01 on the rig
                  # and stop rig, docs/diagnosis.md; a penalised term of tens of effective
@@ -178,6 +190,16 @@ def needed(dec, rk) -> bool:
     """Run the stage when a discrepancy is found and no cause is named or
     the best fit still leaves misfit beyond the instrument."""
     return dec.discrepancy and (rk.named is None or dec.c_hat > st.OVERDISPERSION)
+
+
+def located_tasks(problem, cal, cands) -> list:
+    """The fit tasks of the generic term's candidates: ``problem``'s fits
+    with the located settings (``LOCATED_EVALS`` evaluations per parameter,
+    the ``LOCATED_JACOBIAN``) and the wall-time budget a guard only."""
+    s = dataclasses.replace(problem.settings, evals_per_param=LOCATED_EVALS,
+                            jacobian=LOCATED_JACOBIAN)
+    return [dataclasses.replace(t, budget_s=None if t.budget_s is None else GUARD * t.budget_s)
+            for t in fit_tasks(dataclasses.replace(problem, settings=s), cal, cands)]
 
 
 def _params(graph, loc, n_x, n_v):
@@ -636,7 +658,7 @@ def locate(ctx, problem, cal, dec, rk) -> Location:
     # the term is linear in its weights: refined from the linearised step
     # (with the free parameters' step) only, through the growing windows
     cands = [chosen_candidate(nd, graph, n) for nd in fitted]
-    tasks = [_free_step(t, nd) for t, nd in zip(fit_tasks(problem.one_start(), cal, cands),
+    tasks = [_free_step(t, nd) for t, nd in zip(located_tasks(problem.one_start(), cal, cands),
                                                 fitted)]
     results = ctx.run(fit_candidate, tasks, "locating")
     terms, fits = [], {}
@@ -758,7 +780,7 @@ def _rechoose(ctx, problem, cal, node: _Node, r, graph, c_hat) -> _Again:
         k_f = c.Jf.shape[1]
         step = np.concatenate([ch.step[:k_f] + offset, ch.step[k_f:]])
         new = dataclasses.replace(node, cols=c, choice=dataclasses.replace(ch, step=step))
-        task = _free_step(fit_tasks(problem.one_start(), cal,
+        task = _free_step(located_tasks(problem.one_start(), cal,
                                     [chosen_candidate(new, graph, n)])[0], new)
         got = ctx.run(fit_candidate, [task], "locating again")[0]
         n_sim += got.fit.n_sim if got.fit is not None else 0
@@ -802,7 +824,7 @@ def _beside(ctx, problem, cal, dec, rows, node, graph):
     fails is left out."""
     n = cal.fit.n
     cands = [chosen_candidate(node, graph, n, beside=r) for r in rows]
-    tasks = [_free_step(t, node) for t in fit_tasks(problem.from_fit(), cal, cands)]
+    tasks = [_free_step(t, node) for t in located_tasks(problem.from_fit(), cal, cands)]
     out = []
     for row, r in zip(rows, ctx.run(fit_candidate, tasks, "locating beside a cause")):
         if r.ok:
