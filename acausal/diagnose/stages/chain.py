@@ -728,13 +728,16 @@ def _scored(r, cv: CrossValidation):
         heldout_dir=directional_heldout(r.fit, res, pen))
 
 
-def rank(ds, cal: NominalFit, dec: Decision, cv: CrossValidation, unfitted=()) -> Ranking:
+def rank(ds, cal: NominalFit, dec: Decision, cv: CrossValidation, unfitted=(),
+         same: vd.SameCause | None = None) -> Ranking:
     """Stage 6: exact held-out errors in, classes, and the verdict
     (:mod:`.verdict`): a cause is named only when its held-out error is
     within :func:`.stats.heldout_threshold` ("not explained by the
     library" otherwise, never "weak") and no weak-evidence rule objects; it
     is never named while a rival candidate is untested, or screened as
-    plausible and left unfitted (``unfitted``: :class:`.screen.Unfitted`)."""
+    plausible and left unfitted (``unfitted``: :class:`.screen.Unfitted`), nor
+    while its class holds another cause that explains the held-out data
+    (``same``: which candidates name the same cause, :func:`.verdict.class_rivals`)."""
     rows = tuple(_scored(r, cv) for r in dec.rows)
     held0 = cv.heldout(NOMINAL.key, cal.nominal.loo)
     if dec.discrepancy:
@@ -756,6 +759,9 @@ def rank(ds, cal: NominalFit, dec: Decision, cv: CrossValidation, unfitted=()) -
             heldout_nominal=held0, heldout_best=b.heldout_rmse, ci_rel=None,
             c_hat=dec.c_hat, coarse=_coarse(ds, cal.fit), heldout_threshold=threshold.rms))]
         reasons += vd.determination_reasons(b)
+        rivals = vd.class_rivals(rows, classes[0], 0, same or vd.SameCause(),
+                                 lambda r: _explains(r, cal.fit.n, len(ds.experiments)))
+        reasons += vd.rival_reasons(rows, rivals, 0)
         reasons += [vd.Reason("untested_rival", t) for t in _untested_reasons(untested, b)]
         reasons += [vd.Reason("unfitted_rival", t) for t in _unfitted_reasons(unfitted)]
         reasons += [vd.Reason("pair_not_earned", t) for t in _pair_reasons(b, rows, cal.fit.n, len(ds.experiments))]

@@ -227,9 +227,9 @@ def prefer_simplest(rk, index: FamilyIndex):
     data: Arnold, "Uninformative parameters and model selection using
     Akaike's Information Criterion", J. Wildlife Management 74 (2010)
     1175-1178; Burnham and Anderson 2002, sec. 2.6). The simpler member
-    must predict the held-out data no worse, and when a cause is named it
-    must itself explain the held-out data (within the verdict's
-    threshold). A pair is compared with the pairs at the same sites whose
+    must predict the held-out data no worse, and when a cause is named, or
+    the best row explains the held-out data, it must itself explain them
+    (within the verdict's threshold). A pair is compared with the pairs at the same sites whose
     members are of the same families (the best pair's simpler mates are
     fitted for this: :func:`.pairsearch.simpler_tasks`). Rows and classes
     are unchanged."""
@@ -252,7 +252,12 @@ def prefer_simplest(rk, index: FamilyIndex):
                 and r.candidate.hypothesis not in index.refines
         if r.k > best.k:
             return False
-        if rk.cause is not None and threshold is not None and not explains(r, threshold):
+        if threshold is not None and (rk.cause is not None or explains(best, threshold)) \
+                and not explains(r, threshold):
+            # the simpler member stands for the richer one only when it explains
+            # the held-out data as the richer one does, named or not (a weak
+            # verdict had moved the gain's row from Stribeck friction, which
+            # explains them, to Coulomb friction 23 AICc units worse, which does not)
             return False
         return near or not earns_extras(rk, rk.after, i)
 
