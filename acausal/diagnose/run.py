@@ -39,7 +39,7 @@ from .stages.nextexp import next_experiment
 from .stages.resume import FitStore
 from .stages.state import State
 from .stages.tasks import fit_candidate
-from .stages.verdict import SameCause
+from .stages.verdict import SameCause, same_laws
 
 __all__ = ["diagnose", "run_stages", "DiagnosisError", "DiagnosisOptions"]
 
@@ -126,7 +126,8 @@ def cross_validated(ctx: Context, s: State) -> State:
 
 def ranked(ctx: Context, s: State) -> State:
     """The ranking and the verdict (:func:`.stages.chain.rank`)."""
-    same = SameCause(family_index(s.problem.library), s.kinematics)
+    same = SameCause(family_index(s.problem.library), s.kinematics,
+                     same_laws(s.problem.library))
     return dataclasses.replace(s, ranking=stages.rank(s.dataset, s.calibration, s.decision,
                                                       s.cv, s.members.unfitted
                                                       + s.pair_search.unfitted, same))

@@ -84,6 +84,23 @@ def test_a_smooth_law_and_a_null_get_the_least_complex_term():
     assert ch0.heldout == pytest.approx(1.0, abs=0.05)
 
 
+def test_a_setting_scored_alone_matches_its_score_in_the_search():
+    """``linear_heldout`` (the re-choice's score of the current setting at
+    its fitted point) is the score ``choose`` gives the same setting: every
+    row of the search table, recomputed alone, agrees to rounding; and on
+    the six-cycle law a 9-knot setting is not tied with the chosen one (the
+    re-choice would refit), while the chosen one is tied with itself."""
+    P, A = 2.0 / 6, 3.0
+    cols, _ = _columns(lambda x: A * np.sin(2 * np.pi * x / P), seed=2)
+    n = cols.r0.size
+    ch = L.choose(cols, RANGES, n)
+    for row in ch.table[::7]:
+        assert L.linear_heldout(cols, RANGES, n, row[:4]) == pytest.approx(row[4], rel=1e-9)
+    assert L.linear_heldout(cols, RANGES, n, ch.setting) <= ch.heldout * (1 + L.tie_of(n))
+    nine = min((r for r in ch.table if r[0] == 9), key=lambda r: r[4])
+    assert L.linear_heldout(cols, RANGES, n, nine[:4]) > ch.heldout * (1 + L.tie_of(n))
+
+
 def test_band_is_the_fit_covariance():
     """Unpenalised, the band is the least-squares standard error of the
     spline's value: compared with the spread of refits over 300 noise

@@ -508,13 +508,31 @@ def _choose(cols, ranges, n, ladder_x, ladder_v, grid):
             su = setups[n_x, n_v] = _setup(cols, ranges, n_x, n_v, nf_x, nf_v)
             table += _search(su, n, n_x, n_v, grid)
     best = min(r[4] for r in table)
-    tie = max(CV_TIE, 1.0 / np.sqrt(2.0 * n))      # one standard error of an RMS
+    tie = tie_of(n)
     pick = min((r for r in table if r[4] <= best * (1 + tie)),
                key=lambda r: (r[0] + r[1], r[5], -r[2], -r[3]))
     n_x, n_v, lam_x, lam_v = pick[:4]
     su = setups[n_x, n_v]
     held, edf, train, step = _score(su, n, lam_x, lam_v)
     return Choice(n_x, n_v, lam_x, lam_v, held, train, edf, step, su.pins, tuple(table))
+
+
+def tie_of(n) -> float:
+    """The relative margin within which two linearised held-out RMS errors
+    on ``n`` values are tied: one standard error of an RMS of unit-variance
+    values, 1/sqrt(2n), at least ``CV_TIE``."""
+    return max(CV_TIE, 1.0 / np.sqrt(2.0 * n))
+
+
+def linear_heldout(cols: Columns, ranges, n, setting) -> float:
+    """The linearised leave-one-experiment-out RMS of one ``setting`` (n_x,
+    n_v, smoothing x, smoothing v) from ``cols`` (the finest splines of the
+    ladders), as :func:`choose` scores it."""
+    from ...infra.blas import single_threaded
+    n_x, n_v, lam_x, lam_v = setting
+    with single_threaded(cols.Jg.shape[1]):
+        su = _setup(cols, ranges, n_x, n_v, gen.X_LADDER[-1], gen.V_LADDER[-1])
+        return _score(su, n, lam_x, lam_v)[0]
 
 
 # -- the fits --------------------------------------------------------------------------
@@ -642,6 +660,7 @@ def locate(ctx, problem, cal, dec, rk) -> Location:
     col_tasks = fit_tasks(problem, cal, [nd.cand for nd in nodes])
     failed = {}
     n_sim = 0
+    phases = {}
     for nd, c in zip(nodes, ctx.run(columns, col_tasks, "locating: columns",
                                     checkpoint=False)):
         n_sim += c.n_sim
@@ -660,6 +679,7 @@ def locate(ctx, problem, cal, dec, rk) -> Location:
     cands = [chosen_candidate(nd, graph, n) for nd in fitted]
     tasks = [_free_step(t, nd) for t, nd in zip(located_tasks(problem.one_start(), cal, cands),
                                                 fitted)]
+    phases["columns"] = n_sim
     results = ctx.run(fit_candidate, tasks, "locating")
     terms, fits = [], {}
     for r, nd in zip(results, fitted):
@@ -669,12 +689,14 @@ def locate(ctx, problem, cal, dec, rk) -> Location:
             fits[nd.cand.location] = r
         else:
             failed[nd.cand.location] = r.error or (r.fit.message if r.fit else "failed")
+    phases["fits"] = n_sim - phases["columns"]
     rechosen = {}
     if terms:
         top = min(terms, key=lambda t: (t.heldout_rmse, t.aicc))
         nd = next(x for x in fitted if x.cand.location == top.node)
         again = _rechoose(ctx, problem, cal, nd, fits[top.node], graph, dec.c_hat)
         n_sim += again.n_sim
+        phases["rechoose"] = again.n_sim
         rechosen[top.node] = again.summary
         if again.term is not None:
             terms[terms.index(top)] = again.term
@@ -689,12 +711,13 @@ def locate(ctx, problem, cal, dec, rk) -> Location:
         nd.cand.location: dict(n_x=nd.choice.n_x, n_v=nd.choice.n_v, smooth_x=nd.choice.lam_x,
                                 smooth_v=nd.choice.lam_v, heldout_linear=nd.choice.heldout,
                                 edf=nd.choice.edf)
-        for nd in nodes if nd.choice is not None}, rechosen=rechosen)
+        for nd in nodes if nd.choice is not None}, rechosen=rechosen, n_sim=phases)
     beside = beside_rows(rk) if terms else []
     if beside:
         best = next(nd for nd in nodes if nd.cand.location == terms[0].node)
         got = _beside(ctx, problem, cal, dec, beside, best, graph)
         n_sim += sum(m for _, _, m in got)
+        phases["beside"] = sum(m for _, _, m in got)
         out.n_sim = n_sim
         if got:
             row, t, _ = min(got, key=lambda x: (x[1].heldout_rmse, x[1].aicc))
@@ -761,12 +784,15 @@ def _rechoose(ctx, problem, cal, node: _Node, r, graph, c_hat) -> _Again:
     fitted point whose residuals are near the noise the linearised ranking
     holds (there the same settings score 1.90 and 1.05). Each new choice is
     fitted in full from its step (growing windows); the lowest exact
-    held-out error of all the fits is kept. Stops when a choice repeats."""
+    held-out error of all the fits is kept. Stops when a choice repeats, or
+    when the current setting, scored at its own fitted point, is tied with
+    the new choice (within one standard error of an RMS: :func:`tie_of`),
+    so that the refit would only trade it for an equivalent setting."""
     n = cal.fit.n
     best = float(heldout_rms(r.loo))
     tried = {node.choice.setting: best}
     best_node = best_t = error = None
-    cur_node, cur_r, n_sim = node, r, 0
+    cur_node, cur_r, n_sim, sims, stopped = node, r, 0, {}, None
     for _ in range(RECHOOSE):
         c, offset = _at_fit(ctx, problem, cal, cur_node, cur_r)
         n_sim += c.n_sim
@@ -777,13 +803,24 @@ def _rechoose(ctx, problem, cal, node: _Node, r, graph, c_hat) -> _Again:
         key = ch.setting
         if key in tried:
             break
+        # the current setting scored at its own fitted point: tied with the
+        # new choice, a refit would trade it for an equivalent one (the
+        # coarsest of the ties) at the cost of a full located fit
+        now = linear_heldout(c, node.ranges, n, cur_node.choice.setting)
+        if now <= ch.heldout * (1 + tie_of(n)):
+            stopped = dict(setting=list(key), heldout_linear=float(ch.heldout),
+                           current_linear=float(now))
+            break
         k_f = c.Jf.shape[1]
         step = np.concatenate([ch.step[:k_f] + offset, ch.step[k_f:]])
         new = dataclasses.replace(node, cols=c, choice=dataclasses.replace(ch, step=step))
-        task = _free_step(located_tasks(problem.one_start(), cal,
-                                    [chosen_candidate(new, graph, n)])[0], new)
+        # on the whole record only: the step starts beside a whole-record fit,
+        # where a first window could only lead away (Problem.from_fit)
+        task = _free_step(located_tasks(problem.from_fit(), cal,
+                                        [chosen_candidate(new, graph, n)])[0], new)
         got = ctx.run(fit_candidate, [task], "locating again")[0]
         n_sim += got.fit.n_sim if got.fit is not None else 0
+        sims[key] = c.n_sim + (got.fit.n_sim if got.fit is not None else 0)
         if not got.ok:
             tried[key] = None
             error = got.error or "the fit failed"
@@ -793,10 +830,12 @@ def _rechoose(ctx, problem, cal, node: _Node, r, graph, c_hat) -> _Again:
         cur_node, cur_r = new, got
         if t.heldout_rmse < best:
             best, best_node, best_t = float(t.heldout_rmse), new, t
-    summary = dict(tried=[dict(n_x=k[0], n_v=k[1], smooth_x=k[2], smooth_v=k[3], heldout=h)
-                          for k, h in tried.items()])
+    summary = dict(tried=[dict(n_x=k[0], n_v=k[1], smooth_x=k[2], smooth_v=k[3], heldout=h,
+                               n_sim=sims.get(k, 0)) for k, h in tried.items()])
     if error is not None:
         summary["error"] = error
+    if stopped is not None:
+        summary["stopped_tied"] = stopped
     return _Again(best_t, n_sim, summary, best_node)
 
 

@@ -29,6 +29,7 @@ and the standard laws instead (:func:`law_notes`).
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -206,6 +207,19 @@ def determination_reasons(row) -> list:
     return out
 
 
+def same_laws(lib=None) -> dict:
+    """hypothesis id -> its ``same_law`` table (:class:`SameCause`): the laws
+    a family member becomes at a standard value of a shape parameter, as
+    the library's hypotheses declare them (none for a library without)."""
+    from ..library.loader import load_library
+    try:
+        hyps = load_library(lib).HYPOTHESES
+    except Exception:  # noqa: BLE001 - a stub library: no declared laws
+        return {}
+    return {hid: dict(getattr(h, "same_law", None) or {}) for hid, h in hyps.items()
+            if getattr(h, "same_law", None)}
+
+
 def _standard(hid, short, lib=None):
     from ..library.loader import load_library
     try:
@@ -268,18 +282,35 @@ class SameCause:
 
     families: object = None
     kinematics: object = None
+    same_law: dict = dataclasses.field(default_factory=dict)
+    # hypothesis id -> {shape parameter's short name: {standard value: the
+    # hypothesis whose law it is there}} (power drag at n = 1 is viscous
+    # damping): a member whose shape parameter's 95 % interval holds such a
+    # value names that law's cause too
 
-    def sites(self, hid, loc) -> set:
-        fam = self.families.family(hid) if self.families is not None else hid
+    def _family(self, hid):
+        return self.families.family(hid) if self.families is not None else hid
+
+    def causes(self, row, h, loc, names) -> set:
+        """The (family, site) pairs member ``h`` at ``loc`` of ``row`` names:
+        its family, and the family of each law its shape parameters' 95 %
+        intervals reach (``same_law``), at ``loc`` and its tied sites."""
+        fams = {self._family(h)}
+        for short, laws in self.same_law.get(h, {}).items():
+            name = next((n for n in names if n.partition(".")[2] == short), None)
+            lo, hi = row.fit.ci95.get(name, (math.nan, math.nan)) if name else (math.nan,) * 2
+            fams |= {self._family(other) for value, other in laws.items()
+                     if math.isfinite(lo) and math.isfinite(hi) and lo <= value <= hi}
         tied = self.kinematics.tied(loc) if self.kinematics is not None else []
-        return {(fam, loc)} | {(fam, other) for other, _, _ in tied}
+        return {(f, s) for f in fams for s in [loc] + [o for o, _, _ in tied]}
 
     def covers(self, a, b) -> bool:
-        """Does candidate ``a`` name every cause of ``b`` (a pair holding
-        ``b``'s cause, or ``b``'s cause at a tied site or by another member
-        of its family)?"""
-        mine = [self.sites(h, loc) for h, loc, _ in a.members()]
-        return all(any((self.sites(h, loc) & s) for s in mine) for h, loc, _ in b.members())
+        """Does row ``a`` name every cause of row ``b`` (a pair holding
+        ``b``'s cause, or ``b``'s cause at a tied site, by another member of
+        its family, or by a law that becomes it at a standard shape)?"""
+        mine = [self.causes(a, h, loc, ns) for h, loc, ns in a.candidate.members()]
+        return all(any(self.causes(b, h, loc, ns) & s for s in mine)
+                   for h, loc, ns in b.candidate.members())
 
 
 def class_rivals(rows, cls, best, same: SameCause, explaining) -> list:
@@ -295,9 +326,9 @@ def class_rivals(rows, cls, best, same: SameCause, explaining) -> list:
     the follower (1.3 AICc units better in training, held-out 5.8 against
     5.0 floors, both explaining them beyond their parameters' spread) was in
     its class; the truth was friction + drag at the cam."""
-    b = rows[best].candidate
+    b = rows[best]
     return [i for i in cls if i != best and explaining(rows[i])
-            and not same.covers(rows[i].candidate, b) and not same.covers(b, rows[i].candidate)]
+            and not same.covers(rows[i], b) and not same.covers(b, rows[i])]
 
 
 def rival_reasons(rows, rivals, best, shown=3) -> list:

@@ -1,0 +1,89 @@
+"""Rivals in the best candidate's class (verdict.class_rivals, issue 24: no
+name the data cannot decide). A row of the class that names another cause
+and explains the held-out data makes the verdict weak; the same cause at a
+kinematically tied site, by another member of its family, or by a law
+that becomes it at a standard shape (power drag with n = 1 is viscous
+damping) is no rival, nor is a pair that only adds a cause to the best.
+Rows here are built by hand (no fit): what is checked is the rule."""
+import dataclasses
+from types import SimpleNamespace
+
+from acausal.diagnose.library.loader import family_index
+from acausal.diagnose.problem import Candidate, Param
+from acausal.diagnose.stages import verdict as vd
+from acausal.diagnose.stages.kinematics import Kinematics, Tie
+
+FAM = family_index(None)
+LAWS = vd.same_laws(None)
+
+
+def _row(hyps, locs, ci=None, aicc=100.0, heldout=1.0):
+    """A ranking row of ``hyps`` at ``locs`` (lists: one, or two for a pair)
+    with one parameter per member, or ``ci`` ({short name: interval}) for
+    the named parameters of a single member."""
+    prefixes = [f"h{i}" for i in range(len(hyps))]
+    params, ci95, values = [], {}, {}
+    for p, h in zip(prefixes, hyps):
+        names = list(ci) if ci and len(hyps) == 1 else ["a"]
+        for short in names:
+            name = f"{p}.{short}"
+            params.append(Param(name, 0.0, -10.0, 10.0, 1.0, 0.0))
+            lo, hi = (ci or {}).get(short, (0.5, 1.5))
+            ci95[name], values[name] = (lo, hi), (lo + hi) / 2
+    cand = Candidate("+".join(hyps), "+".join(locs), tuple(params))
+    return SimpleNamespace(candidate=cand, fit=SimpleNamespace(ci95=ci95, values=values),
+                           aicc=aicc, heldout_rmse=heldout)
+
+
+def _rivals(rows, same):
+    return vd.class_rivals(rows, list(range(len(rows))), 0, same, lambda r: r.heldout_rmse < 2)
+
+
+def test_another_cause_in_the_class_is_a_rival_and_gives_its_numbers():
+    best = _row(["coulomb_friction"], ["mass"], heldout=1.01)
+    load = _row(["constant_load"], ["mass"], aicc=101.5, heldout=1.02)
+    rows = [best, load]
+    got = _rivals(rows, vd.SameCause(FAM, None, LAWS))
+    assert got == [1]
+    (r,) = vd.rival_reasons(rows, got, 0)
+    assert r.code == "rival_tied"
+    assert "constant_load at mass" in r.text and "+1.5" in r.text and "1.02" in r.text
+
+
+def test_a_rival_that_leaves_the_held_out_data_unexplained_is_none():
+    rows = [_row(["coulomb_friction"], ["mass"]), _row(["constant_load"], ["mass"], heldout=5.0)]
+    assert _rivals(rows, vd.SameCause(FAM, None, LAWS)) == []
+
+
+def test_same_family_tied_site_and_added_cause_are_not_rivals():
+    best = _row(["stribeck_friction"], ["cam"])
+    same = [_row(["coulomb_friction"], ["cam"]),               # family member, same site
+            _row(["coulomb_friction"], ["shaft"]),             # tied site
+            _row(["stribeck_friction", "hardening_spring"], ["cam", "spring"]),  # adds a cause
+            _row(["coulomb_friction", "quadratic_damping"], ["shaft", "cam"])]   # both
+    kin = Kinematics(ties=(Tie("cam", "shaft", 2.0, 0.01),))
+    assert _rivals([best] + same, vd.SameCause(FAM, kin, LAWS)) == []
+    # untied, the other site is another cause (alone, or in a pair without
+    # the best's friction at the cam)
+    got = _rivals([best] + same, vd.SameCause(FAM, Kinematics(), LAWS))
+    assert got == [2, 4]
+
+
+def test_a_single_member_of_a_best_pair_is_left_to_the_pair_rule():
+    best = _row(["coulomb_friction", "quadratic_damping"], ["cam", "cam"])
+    assert _rivals([best, _row(["coulomb_friction"], ["cam"])],
+                   vd.SameCause(FAM, None, LAWS)) == []
+
+
+def test_power_drag_at_a_viscous_exponent_is_viscous_damping():
+    """Power drag whose exponent's interval holds n = 1 names the viscous
+    damping of the friction family; at n = 2 +- 0.05 it does not (there it
+    is quadratic drag: another cause than viscous damping)."""
+    best = _row(["viscous_damping"], ["follower"])
+    viscous = _row(["power_drag"], ["follower"], ci={"c": (1.0, 2.0), "n": (0.98, 1.07)})
+    quadratic = _row(["power_drag"], ["follower"], ci={"c": (1.0, 2.0), "n": (1.95, 2.05)})
+    same = vd.SameCause(FAM, None, LAWS)
+    assert _rivals([best, viscous], same) == []
+    assert _rivals([best, quadratic], same) == [1]
+    # without the library's declared laws, the exponent does not count
+    assert _rivals([best, viscous], dataclasses.replace(same, same_law={})) == [1]
