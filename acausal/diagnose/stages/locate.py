@@ -557,9 +557,10 @@ def _graph(problem):
 
 def chosen_candidate(node: _Node, graph, n, beside=None):
     """The node's candidate at its chosen resolution, smoothing and pins,
-    its weights starting at the Gauss-Newton step; ``beside`` = a ranking
-    row of a single named cause: that cause's parameters first (starting
-    at its fit), hypothesis ``h+generic_force`` at ``site+node``."""
+    its weights starting at the node's step (the Gauss-Newton step, or where
+    its fit landed); ``beside`` = a ranking row of a single cause: that
+    cause's parameters first (starting at their neutral values), hypothesis
+    ``h+generic_force`` at ``site+node``."""
     ch = node.choice
     base = _params(graph, node.cand.location, ch.n_x, ch.n_v)
     k_f = node.cols.Jf.shape[1]
@@ -569,8 +570,13 @@ def chosen_candidate(node: _Node, graph, n, beside=None):
     P = np.vstack([penalty(ch.n_x, ch.n_v, ch.lam_x * n, ch.lam_v * n), ch.pins])
     if beside is None:
         return Candidate(GENERIC.id, node.cand.location, params, P, node.cand.fixed)
-    own = tuple(dataclasses.replace(q, start=float(beside.fit.values[q.name]))
-                for q in beside.candidate.params)
+    # the cause starts neutral: the term (landed where its fit alone ended,
+    # :func:`landed`) already carries the whole discrepancy, and the cause at
+    # its own fit absorbed part of it too, so the two added overshoot (cam
+    # detent: a hardening spring's k3 = -5e5, fitted alone, put the start at
+    # S = 5e8 against 6e3 with k3 = 0; every start then lost to the neutral
+    # one, and the fit beside ended at 33 floors held-out, the term alone 5)
+    own = tuple(dataclasses.replace(q, start=float(q.prior)) for q in beside.candidate.params)
     return Candidate(f"{beside.candidate.hypothesis}+{GENERIC.id}",
                      f"{beside.candidate.location}+{node.cand.location}", own + params, P,
                      node.cand.fixed)
@@ -583,6 +589,20 @@ def _free_step(task: FitTask, node: _Node) -> FitTask:
     seed = tuple(float(np.clip(q.start + d[i] * (abs(q.scale) or 1.0), q.low, q.high))
                  for i, q in enumerate(task.free))
     return dataclasses.replace(task, seed_free=seed)
+
+
+def landed(problem, cal, node: _Node, r) -> _Node:
+    """The node with its step set to where the fit ``r`` of its candidate
+    landed (the free parameters' offsets from their calibrated values and
+    the term's weights, per unit of scale), so that a fit started from it
+    (:func:`chosen_candidate`, :func:`_free_step`) starts at that fit and
+    not at the linearised step the fit began from."""
+    free = fit_tasks(problem, cal, [node.cand])[0].free
+    d = [(r.fit.values[q.name] - q.start) / (abs(q.scale) or 1.0) for q in free]
+    w = [r.fit.values[q.name] / q.scale for q in r.candidate.params
+         if q.name.startswith(GENERIC.prefix + ".")]
+    return dataclasses.replace(node, choice=dataclasses.replace(
+        node.choice, step=np.array(d + w, float)))
 
 
 def weights_cov(f, pen, S, n, edf):
@@ -687,13 +707,14 @@ def locate(ctx, problem, cal, dec, rk) -> Location:
         if r.ok:
             terms.append(_term(r, n, dec.c_hat, nd))
             fits[nd.cand.location] = r
+            nodes[nodes.index(nd)] = landed(problem, cal, nd, r)
         else:
             failed[nd.cand.location] = r.error or (r.fit.message if r.fit else "failed")
     phases["fits"] = n_sim - phases["columns"]
     rechosen = {}
     if terms:
         top = min(terms, key=lambda t: (t.heldout_rmse, t.aicc))
-        nd = next(x for x in fitted if x.cand.location == top.node)
+        nd = next(x for x in nodes if x.cand.location == top.node)
         again = _rechoose(ctx, problem, cal, nd, fits[top.node], graph, dec.c_hat)
         n_sim += again.n_sim
         phases["rechoose"] = again.n_sim
@@ -776,7 +797,7 @@ def _at_fit(ctx, problem, cal, node: _Node, r):
 
 def _rechoose(ctx, problem, cal, node: _Node, r, graph, c_hat) -> _Again:
     """The best node's resolution and smoothing chosen again at its fitted
-    point, up to ``RECHOOSE`` times, each time at the last fit's point. The
+    point, up to ``RECHOOSE`` times, each time at the best fit so far. The
     first choice linearises at the calibrated model, where a strong
     out-of-library force is far from zero, and can rank the settings wrongly: on the torsion rig's threshold law
     (51 floors) it predicted 1.54 floors held-out for 9 x 9 knots, which
@@ -784,10 +805,14 @@ def _rechoose(ctx, problem, cal, node: _Node, r, graph, c_hat) -> _Again:
     fitted point whose residuals are near the noise the linearised ranking
     holds (there the same settings score 1.90 and 1.05). Each new choice is
     fitted in full from its step (growing windows); the lowest exact
-    held-out error of all the fits is kept. Stops when a choice repeats, or
-    when the current setting, scored at its own fitted point, is tied with
-    the new choice (within one standard error of an RMS: :func:`tie_of`),
-    so that the refit would only trade it for an equivalent setting."""
+    held-out error of all the fits is kept. Each choice is made at the best
+    fit so far; it stops when a choice repeats, when the new choice's fit
+    does not beat the best (choosing again at the same point would repeat
+    it), or when the current setting, scored at its own fitted point, is
+    tied with the new choice (within one standard error of an RMS:
+    :func:`tie_of`), so that the refit would only trade it for an
+    equivalent setting. The node returned starts at its best fit
+    (:func:`landed`), where the term beside a cause starts."""
     n = cal.fit.n
     best = float(heldout_rms(r.loo))
     tried = {node.choice.setting: best}
@@ -827,9 +852,13 @@ def _rechoose(ctx, problem, cal, node: _Node, r, graph, c_hat) -> _Again:
             break
         t = _term(got, n, c_hat, new)
         tried[key] = float(t.heldout_rmse)
-        cur_node, cur_r = new, got
-        if t.heldout_rmse < best:
-            best, best_node, best_t = float(t.heldout_rmse), new, t
+        if not t.heldout_rmse < best:
+            # chosen at the best point so far, it did not beat it: choosing
+            # again there would pick it again
+            break
+        best, best_t = float(t.heldout_rmse), t
+        best_node = cur_node = landed(problem, cal, new, got)
+        cur_r = got
     summary = dict(tried=[dict(n_x=k[0], n_v=k[1], smooth_x=k[2], smooth_v=k[3], heldout=h,
                                n_sim=sims.get(k, 0)) for k, h in tried.items()])
     if error is not None:
