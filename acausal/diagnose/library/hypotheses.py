@@ -783,10 +783,11 @@ class PowerDrag(QuadraticDamping):
            "n = 2 is quadratic drag, n = 1 viscous), v_ref the body's typical speed")
     explanation = ("A drag growing with a power of the speed between linear (laminar, "
                    "viscous) and quadratic or steeper (turbulent, orifice flow).")
-    standard_shapes = {"n": (1.0, 2.0)}
     # the laws it becomes at a standard exponent: at n = 1 it is viscous damping
-    # (of the friction family), at n = 2 quadratic drag (its own family's head)
+    # (of the friction family), at n = 2 quadratic drag (its own family's head);
+    # those exponents are its standard shapes
     same_law = {"n": {1.0: "viscous_damping", 2.0: "quadratic_damping"}}
+    standard_shapes = {short: tuple(laws) for short, laws in same_law.items()}
 
     def params(self, graph, location):
         return super().params(graph, location) + [self._spec(

@@ -207,25 +207,25 @@ def determination_reasons(row) -> list:
     return out
 
 
+def _hypotheses(lib=None) -> dict:
+    """The library's hypotheses by id ({} for a stub library without the table)."""
+    from ..library.loader import load_library
+    try:
+        return load_library(lib).HYPOTHESES
+    except Exception:  # noqa: BLE001 - a stub library without the table: nothing declared
+        return {}
+
+
 def same_laws(lib=None) -> dict:
     """hypothesis id -> its ``same_law`` table (:class:`SameCause`): the laws
     a family member becomes at a standard value of a shape parameter, as
     the library's hypotheses declare them (none for a library without)."""
-    from ..library.loader import load_library
-    try:
-        hyps = load_library(lib).HYPOTHESES
-    except Exception:  # noqa: BLE001 - a stub library: no declared laws
-        return {}
-    return {hid: dict(getattr(h, "same_law", None) or {}) for hid, h in hyps.items()
+    return {hid: dict(h.same_law) for hid, h in _hypotheses(lib).items()
             if getattr(h, "same_law", None)}
 
 
 def _standard(hid, short, lib=None):
-    from ..library.loader import load_library
-    try:
-        hyp = load_library(lib).HYPOTHESES.get(hid)
-    except Exception:  # noqa: BLE001 - a stub library without the table: no standard laws
-        hyp = None
+    hyp = _hypotheses(lib).get(hid)
     declared = getattr(hyp, "standard_shapes", None) if hyp is not None else None
     table = declared if declared is not None else STANDARD_SHAPES.get(hid, {})
     return tuple(table.get(short, ()))
