@@ -737,8 +737,8 @@ def locate(ctx, problem, cal, dec, rk) -> Location:
     if beside:
         best = next(nd for nd in nodes if nd.cand.location == terms[0].node)
         got = _beside(ctx, problem, cal, dec, beside, best, graph)
-        n_sim += sum(m for _, _, m in got)
         phases["beside"] = sum(m for _, _, m in got)
+        n_sim += phases["beside"]
         out.n_sim = n_sim
         if got:
             row, t, _ = min(got, key=lambda x: (x[1].heldout_rmse, x[1].aicc))
@@ -843,8 +843,9 @@ def _rechoose(ctx, problem, cal, node: _Node, r, graph, c_hat) -> _Again:
         task = _free_step(located_tasks(problem.from_fit(), cal,
                                         [chosen_candidate(new, graph, n)])[0], new)
         got = ctx.run(fit_candidate, [task], "locating again")[0]
-        n_sim += got.fit.n_sim if got.fit is not None else 0
-        sims[key] = c.n_sim + (got.fit.n_sim if got.fit is not None else 0)
+        used = got.fit.n_sim if got.fit is not None else 0
+        n_sim += used
+        sims[key] = c.n_sim + used
         if not got.ok:
             tried[key] = None
             error = got.error or "the fit failed"
