@@ -94,6 +94,8 @@ def test_tied_causes_give_a_weak_verdict_with_the_tie_as_its_reason(slider):
     assert {best, other} <= {out["ranking"][0]["cause"]} | {
         e["cause"] for e in out["equivalent_causes"]}
     assert out["gain"]["after"]["heldout"] <= v["heldout_threshold"]["rms"]
+    # a friction and a load share no cause: nothing is named in part
+    assert v["partial"] is None
 
 
 def test_json_has_the_issue_11_keys_filled(slider_reversing):

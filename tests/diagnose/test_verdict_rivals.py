@@ -87,3 +87,72 @@ def test_power_drag_at_a_viscous_exponent_is_viscous_damping():
     assert _rivals([best, quadratic], same) == [1]
     # without the library's declared laws, the exponent does not count
     assert _rivals([best, viscous], dataclasses.replace(same, same_law={})) == [1]
+
+
+# -- what every tied candidate holds (verdict.partial) ---------------------------------------
+def _weak(rows, rivals):
+    reasons = tuple(vd.rival_reasons(rows, rivals, 0))
+    return vd.Verdict("weak", reasons, None, rows[0].heldout_rmse)
+
+
+def test_a_cause_every_tied_pair_holds_is_named_in_part_with_its_spread():
+    """Coulomb friction at the cam in every tied pair, the drag at the cam
+    or at the follower (cam friction + drag at 30 floors): the friction is
+    named with its site and values, the drag's sites are left undecided."""
+    best = _row(["coulomb_friction", "quadratic_damping"], ["cam", "cam"])
+    other = _row(["coulomb_friction", "quadratic_damping"], ["cam", "follower"], aicc=101.0)
+    other.fit.values["h0.a"] = 1.2                       # the friction's value in the rival
+    stick = _row(["stick_slip_friction", "quadratic_damping"], ["cam", "follower"], aicc=101.5)
+    rows = [best, other, stick]
+    same = vd.SameCause(FAM, Kinematics(), LAWS)
+    rivals = _rivals(rows, same)
+    assert rivals == [1, 2]
+    v = vd.with_partial(_weak(rows, rivals), rows, rivals, same)
+    c, drag = v.partial.shared
+    assert (c.family, c.member, c.location, c.sites) == ("friction", "coulomb_friction", "cam",
+                                                         ("cam",))
+    assert c.site_decided and c.values == {"h0.a": 1.0} and c.spread == {"h0.a": (1.0, 1.2)}
+    # the drag is in every tied pair too, at the cam or the follower
+    assert drag.member == "quadratic_damping" and drag.sites == ("cam", "follower")
+    assert not drag.site_decided and v.partial.undecided == ()
+    assert "coulomb_friction (friction family) at cam:" in v.partial.sentence()
+    assert "at cam or follower (its site is undecided)" in v.partial.sentence()
+    # a tied pair without the drag leaves it undecided, the friction shared
+    spring = _row(["coulomb_friction", "hardening_spring"], ["cam", "spring"], aicc=101.8)
+    rows = rows + [spring]
+    v = vd.with_partial(_weak(rows, [1, 2, 3]), rows, [1, 2, 3], same)
+    assert [x.member for x in v.partial.shared] == ["coulomb_friction"]
+    assert v.partial.undecided == ("quadratic_damping at cam", "quadratic_damping at follower",
+                                   "hardening_spring at spring")
+    assert v.kind == "weak"                  # the whole answer is still undecided
+
+
+def test_a_shared_family_at_untied_sites_leaves_the_site_undecided():
+    best = _row(["stribeck_friction"], ["cam"])
+    rival = _row(["stribeck_friction", "constant_load"], ["follower", "follower"], aicc=100.5)
+    rows = [best, rival]
+    same = vd.SameCause(FAM, Kinematics(), LAWS)
+    v = vd.with_partial(_weak(rows, _rivals(rows, same)), rows, [1], same)
+    (c,) = v.partial.shared
+    assert c.sites == ("cam", "follower") and not c.site_decided
+    assert v.partial.undecided == (vd.NOTHING_ELSE, "constant_load at follower")
+    # a site tied to the cam's decides it
+    tied = vd.SameCause(FAM, Kinematics(ties=(Tie("cam", "follower", 2.0, 0.01),)), LAWS)
+    rival2 = _row(["stribeck_friction", "constant_load"], ["follower", "cam"], aicc=100.5)
+    rows2 = [best, rival2]
+    v2 = vd.with_partial(_weak(rows2, [1]), rows2, [1], tied)
+    assert v2.partial.shared[0].site_decided
+
+
+def test_no_shared_cause_or_another_objection_gives_no_partial_name():
+    best = _row(["coulomb_friction"], ["mass"])
+    load = _row(["constant_load"], ["mass"], aicc=101.0)
+    rows = [best, load]
+    same = vd.SameCause(FAM, None, LAWS)
+    assert vd.with_partial(_weak(rows, [1]), rows, [1], same).partial is None
+    drag = _row(["coulomb_friction", "quadratic_damping"], ["mass", "mass"])
+    spring = _row(["coulomb_friction", "hardening_spring"], ["mass", "spring"], aicc=101.0)
+    rows = [drag, spring]
+    v = _weak(rows, [1])
+    v = dataclasses.replace(v, reasons=v.reasons + (vd.Reason("not_strong", "weak effect"),))
+    assert vd.with_partial(v, rows, [1], same).partial is None

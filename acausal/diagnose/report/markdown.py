@@ -343,6 +343,12 @@ def verdict(d, s) -> str:
         reasons = "; ".join(r["text"] for r in v["reasons"]) or "no candidate could be fitted"
         txt = (f"**Discrepancy, but the evidence is weak: no cause is named** (the data "
                f"cannot decide: {', '.join(kinds)}). {reasons}.")
+        if v.get("partial"):
+            txt = (f"**Discrepancy; named in part** (the data cannot decide the rest: "
+                   f"{', '.join(kinds)}): {d.verdict.partial.sentence()}."
+                   + (" The next experiment below splits them."
+                      if (s.get("next_experiment") or {}).get("computed") else "")
+                   + f" {reasons[0].upper()}{reasons[1:]}.")
         if best is not None:
             txt += (f" The best candidate, {best.candidate.label}, explains the held-out "
                     f"data ({held}).")
@@ -490,6 +496,8 @@ def _class_lines(d):
     if v.kind == "named" and v.caveats:
         L.append("- **named, on this ground**:")
         L += [f"  - {r.text} [`{r.code}`]" for r in v.caveats]
+    if v.kind == "weak" and v.partial is not None:
+        L.append("- **named in part**: " + v.partial.sentence())
     if v.kind == "weak" and v.reasons:
         L.append("- **evidence is weak** (the data cannot decide):")
         L += [f"  - {r.text} [`{r.code}`]" for r in v.reasons]

@@ -236,8 +236,11 @@ def verdict(d: Diagnosis) -> dict:
     on noise alone, with its derivation), ``heldout_rmse`` (of the best
     candidate), ``candidates`` (:func:`candidates`; with a discrepancy),
     ``laws`` (shape parameters away from the standard laws or at a bound:
-    a mixture of laws?) and ``undetermined`` (the named cause's parameters
-    whose intervals reach their neutral values, flagged)."""
+    a mixture of laws?), ``undetermined`` (the named cause's parameters
+    whose intervals reach their neutral values, flagged) and ``partial``
+    (a weak verdict whose only objection is a tie with other causes: the
+    causes every tied candidate holds, with their values and sites, and the
+    undecided rest, :class:`.stages.verdict.Partial`; else null)."""
     v = d.verdict
     named = d.ranking.named
     return clean(dict(
@@ -247,6 +250,7 @@ def verdict(d: Diagnosis) -> dict:
         candidates=candidates(d) if d.decision.discrepancy else [],
         laws=[x.to_dict() for x in v.laws],
         caveats=[dict(code=r.code, text=r.text) for r in getattr(v, "caveats", ())],
+        partial=None if getattr(v, "partial", None) is None else v.partial.to_dict(),
         undetermined=[] if named is None else [c.to_dict() for c in vd.undetermined(named)]))
 
 

@@ -750,7 +750,7 @@ def rank(ds, cal: NominalFit, dec: Decision, cv: CrossValidation, unfitted=(),
     untested = tuple(r for r in rows if not r.starts.tested and r.candidate.key not in acted)
     best = 0 if rows else None
     threshold = vd.threshold_of(cal.fit.n, rows[0] if rows else None, len(ds.experiments))
-    reasons = []
+    reasons, rivals = [], []
     if dec.discrepancy and rows:
         b = rows[0]
         reasons = [vd.Reason(code, text) for code, text in st.weak_reasons(st.Evidence(
@@ -759,14 +759,16 @@ def rank(ds, cal: NominalFit, dec: Decision, cv: CrossValidation, unfitted=(),
             heldout_nominal=held0, heldout_best=b.heldout_rmse, ci_rel=None,
             c_hat=dec.c_hat, coarse=_coarse(ds, cal.fit), heldout_threshold=threshold.rms))]
         reasons += vd.determination_reasons(b)
-        rivals = vd.class_rivals(rows, classes[0], 0, same or vd.SameCause(),
+        same = same or vd.SameCause()
+        rivals = vd.class_rivals(rows, classes[0], 0, same,
                                  lambda r: _explains(r, cal.fit.n, len(ds.experiments)))
         reasons += vd.rival_reasons(rows, rivals, 0)
         reasons += [vd.Reason("untested_rival", t) for t in _untested_reasons(untested, b)]
         reasons += [vd.Reason("unfitted_rival", t) for t in _unfitted_reasons(unfitted)]
         reasons += [vd.Reason("pair_not_earned", t) for t in _pair_reasons(b, rows, cal.fit.n, len(ds.experiments))]
         reasons += [vd.Reason("at_bound", t) for t in _bound_reasons(b)]
-    verdict = vd.judge(dec.discrepancy, rows, threshold, reasons)
+    verdict = vd.with_partial(vd.judge(dec.discrepancy, rows, threshold, reasons), rows,
+                              rivals, same)
     cause = best if verdict.kind == "named" else None
     after = best if dec.discrepancy else None
     return Ranking(rows, classes, cause, after, runner, verdict.weak, untested, held0, vectors,

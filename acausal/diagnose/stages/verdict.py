@@ -138,6 +138,7 @@ class Verdict:
     heldout: float | None = None
     laws: tuple = ()                          # LawNote
     caveats: tuple = ()                       # Reason: what a name rests on (rescue_note)
+    partial: Partial | None = None            # weak by a tie alone: what every tied row holds
 
     @property
     def weak(self) -> list:
@@ -346,6 +347,119 @@ def rival_reasons(rows, rivals, best, shown=3) -> list:
     return out
 
 
+# -- what every tied candidate shares -------------------------------------------------------
+@dataclass(frozen=True)
+class SharedCause:
+    """A cause that the best candidate and every rival tied with it hold
+    (:func:`partial`): its ``family`` (cause class), the best candidate's
+    law (``member``) and site (``location``) with its fitted parameters
+    (``values``), ``sites``: every site a tied candidate puts it at (one
+    site, or kinematically tied ones: the site is decided too), and
+    ``spread``: parameter -> (lowest, highest) value over the tied
+    candidates that hold the same law at the same site."""
+
+    family: str
+    member: str
+    location: str
+    sites: tuple
+    values: dict
+    spread: dict
+
+    @property
+    def site_decided(self) -> bool:
+        return len(self.sites) == 1
+
+    def to_dict(self):
+        return dict(family=self.family, cause=self.member, location=self.location,
+                    sites=list(self.sites), site_decided=self.site_decided,
+                    values={k: _num(v) for k, v in self.values.items()},
+                    spread={k: [_num(a), _num(b)] for k, (a, b) in self.spread.items()})
+
+    def sentence(self):
+        vals = ", ".join(
+            f"{k} = {v:.4g}" + (f" ({self.spread[k][0]:.4g} to {self.spread[k][1]:.4g} "
+                                f"over the tied candidates)" if k in self.spread
+                                and self.spread[k][0] != self.spread[k][1] else "")
+            for k, v in self.values.items())
+        where = (f"at {self.location}" if self.site_decided else
+                 f"at {' or '.join(self.sites)} (its site is undecided)")
+        return f"{self.member} ({self.family} family) {where}: {vals}"
+
+
+@dataclass(frozen=True)
+class Partial:
+    """What a weak verdict can still name when its only objection is a tie
+    with rivals that name other causes (``rival_tied``): the causes every
+    tied candidate holds (``shared``: :class:`SharedCause`), and the rest,
+    which the data leave undecided (``undecided``: each tied candidate's
+    other causes, "law at site"); ``tied``: the candidates' labels, best
+    first. The next experiment (:mod:`.nextexp`) splits them."""
+
+    shared: tuple
+    undecided: tuple
+    tied: tuple
+
+    def to_dict(self):
+        return dict(shared=[c.to_dict() for c in self.shared], undecided=list(self.undecided),
+                    tied=list(self.tied))
+
+    def sentence(self):
+        head = "; ".join(c.sentence() for c in self.shared)
+        rest = (f"; undecided between the tied candidates: {', '.join(self.undecided)}"
+                if self.undecided else "")
+        return (f"every one of the {len(self.tied)} tied candidates holds {head}{rest}")
+
+
+NOTHING_ELSE = "no other cause"   # a tied row that holds the shared causes alone
+
+
+def partial(rows, tied, same: SameCause):
+    """The :class:`Partial` name of the tied rows (indices into ``rows``,
+    the best first: the best and its :func:`class_rivals`), or None when
+    they share no cause. A member of the best row is shared when every tied
+    row has a member of its family (:meth:`SameCause.causes`: a law that
+    becomes the family's at a standard shape counts); its site is decided
+    when every one puts it at the best's site or a site tied to it (cam
+    friction + drag at 30 floors: Coulomb friction at the cam in every
+    tied pair, the drag at the cam or at the follower)."""
+    if len(tied) < 2:
+        return None
+    best, others = rows[tied[0]], [rows[i] for i in tied[1:]]
+    shared, families = [], set()
+    for h, loc, names in best.candidate.members():
+        fam = same._family(h)
+        home = {s for f, s in same.causes(best, h, loc, names) if f == fam}
+        sites, at_home = [loc], True
+        for r in others:
+            hits = [(mh, ml, mn) for mh, ml, mn in r.candidate.members()
+                    if any(f == fam for f, _ in same.causes(r, mh, ml, mn))]
+            if not hits:
+                break
+            sites += [ml for _, ml, _ in hits]
+            at_home &= any(ml in home for _, ml, _ in hits)
+        else:
+            values = {n: best.fit.values[n] for n in names if n in best.fit.values}
+            spread = {}
+            for n in values:
+                got = [r.fit.values[n] for r in [best] + others if n in r.fit.values
+                       and any(mh == h and ml == loc for mh, ml, _ in r.candidate.members())]
+                spread[n] = (min(got), max(got))
+            shared.append(SharedCause(fam, h, loc, (loc,) if at_home else
+                                      tuple(dict.fromkeys(sites)), values, spread))
+            families.add(fam)
+    if not shared:
+        return None
+    undecided = []
+    for r in [best] + others:
+        rest = [f"{mh} at {ml}" for mh, ml, mn in r.candidate.members()
+                if not any(f in families for f, _ in same.causes(r, mh, ml, mn))]
+        undecided += rest or [NOTHING_ELSE]
+    if undecided == [NOTHING_ELSE] * len(undecided):
+        undecided = []
+    return Partial(tuple(shared), tuple(dict.fromkeys(undecided)),
+                   tuple(r.candidate.label for r in [best] + others))
+
+
 # -- the verdict ----------------------------------------------------------------------------
 def threshold_of(n, row, experiments) -> st.HeldoutThreshold:
     """The held-out threshold for ``row`` (its k fitted parameters) on ``n``
@@ -438,3 +552,13 @@ def judge(discrepancy, rows, threshold, weak_reasons) -> Verdict:
     caveats = (rescue_note(best, threshold),) if rescued(best, threshold) else ()
     return Verdict("weak" if out else "named", tuple(out), threshold, best.heldout_rmse,
                    notes, caveats)
+
+
+def with_partial(v: Verdict, rows, rivals, same: SameCause) -> Verdict:
+    """``v`` with its :class:`Partial` name when it is weak by the tie with
+    ``rivals`` (:func:`class_rivals` of ``rows[0]``) alone: every other
+    rule passed, so what every tied row holds is named, and the rest is
+    left undecided."""
+    if v.kind != "weak" or not rivals or any(r.code != "rival_tied" for r in v.reasons):
+        return v
+    return dataclasses.replace(v, partial=partial(rows, [0] + list(rivals), same))
