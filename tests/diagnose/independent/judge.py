@@ -14,7 +14,13 @@ def verdict(out):
     named = " + ".join(f"{c['cause']} @ {c['location']}" for c in out.get("causes") or [])
     if un.get("value"):
         return f"not explained @ {un.get('node')}" + (f"; named {named}" if named else "")
-    return f"named {named}" if named else "weak (no cause named)"
+    if named:
+        return f"named {named}"
+    part = (out.get("verdict") or {}).get("partial")
+    if part:
+        return "weak; named in part " + " + ".join(
+            f"{c['cause']} @ {'|'.join(c['sites'])}" for c in part["shared"])
+    return "weak (no cause named)"
 
 
 def _sites(cause):
