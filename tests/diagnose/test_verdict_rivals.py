@@ -156,3 +156,19 @@ def test_no_shared_cause_or_another_objection_gives_no_partial_name():
     v = _weak(rows, [1])
     v = dataclasses.replace(v, reasons=v.reasons + (vd.Reason("not_strong", "weak effect"),))
     assert vd.with_partial(v, rows, [1], same).partial is None
+
+
+def test_the_next_experiments_rivals_are_distinct_causes():
+    """The next experiment takes one row per set of (family, site): the
+    family variants of the best pair are one rival, so the drag at the
+    follower and a friction at the follower get the places."""
+    from acausal.diagnose.stages.nextexp import class_rows
+    rows = [_row(["coulomb_friction", "quadratic_damping"], ["cam", "cam"]),
+            _row(["stick_slip_friction", "quadratic_damping"], ["cam", "cam"]),
+            _row(["quadratic_damping", "stribeck_friction"], ["cam", "cam"]),   # order
+            _row(["coulomb_friction", "quadratic_damping"], ["cam", "follower"]),
+            _row(["stribeck_friction", "hardening_spring"], ["follower", "spring"]),
+            _row(["stribeck_friction"], ["cam"])]
+    rk = SimpleNamespace(best=rows[0], classes=[list(range(len(rows)))], after=0, rows=rows)
+    got = class_rows(SimpleNamespace(discrepancy=True), rk, FAM)
+    assert [r.candidate.label for r in got] == [rows[i].candidate.label for i in (0, 3, 4, 5)]

@@ -53,18 +53,23 @@ class NextStep:
 
 
 def class_rows(dec, rk, index=None) -> list:
-    """The rows of the best candidate's class, best first, one per cause
-    class (family) and site: members of one family are nested (Coulomb
+    """The rows of the best candidate's class, best first, one per set of
+    cause classes (families) and sites (a pair: its two members' families
+    and sites, in any order): members of one family are nested (Coulomb
     friction is Stribeck friction without its static excess), so at their
-    fits they predict alike everywhere and would leave nothing to split; at
-    most MAX_RIVALS."""
+    fits they predict alike everywhere and would leave nothing to split
+    (Coulomb + drag at the cam and stick-slip + drag at the cam are one
+    rival; until 2026-11-28 a pair was keyed by its hypothesis ids, so such
+    variants filled the four places and the drag at the follower was never
+    a rival); at most MAX_RIVALS."""
     if not dec.discrepancy or rk.best is None or not rk.classes:
         return []
     first = next((c for c in rk.classes if rk.after in c), rk.classes[0])
     out, seen = [], set()
+    fam = index.family if index is not None else (lambda h: h)
     for i in [rk.after] + sorted(i for i in first if i != rk.after):
         c = rk.rows[i].candidate
-        key = (index.family(c.hypothesis) if index is not None else c.hypothesis, c.location)
+        key = frozenset((fam(h), loc) for h, loc, _ in c.members())
         if key not in seen:
             seen.add(key)
             out.append(rk.rows[i])
