@@ -133,24 +133,47 @@ class _Score:
 
 
 def score(predictions: Mapping[str, Mapping[str, np.ndarray] | None],
-          signals: Sequence[Signal]) -> _Score:
-    """The Hunter-Reiner score of one experiment from each rival's predicted
-    signals: for each signal the smallest pairwise D (sum of squared
-    differences over floor^2), and the signal where it is largest."""
+          signals: Sequence[Signal],
+          variances: Mapping[str, Mapping[str, np.ndarray]] | None = None) -> _Score:
+    """The score of one experiment from each rival's predicted signals: for
+    each signal the smallest pairwise D, and the signal where it is
+    largest. D is Hunter-Reiner's sum of squared differences over floor^2;
+    with ``variances`` (rival -> {signal: the variance of its prediction
+    from its parameters' uncertainty, per sample}) each sample's squared
+    difference is over floor^2 + both rivals' variances (Box and Hill 1967;
+    Buzzi-Ferraris and Forzatti, Chem. Eng. Sci. 38 (1983)): an experiment
+    whose outcome a rival predicts only loosely (a cam started just at the
+    energy that carries it over its top: one standard deviation of a
+    parameter decides whether it goes over) separates nothing."""
     names = list(predictions)
     if len(names) < 2:
         raise UsageError("experiment design needs at least two rival models")
     if any(p is None for p in predictions.values()):
         return _Score(-math.inf, None, {}, {})
+    var = variances or {}
     best = _Score(-math.inf, None, {}, {})
     for sig in signals:
         ys = {n: np.asarray(predictions[n][sig.name], float) for n in names}
-        pair = {f"{a} | {b}": float(np.sum(((ys[a] - ys[b]) / sig.floor) ** 2))
-                for a, b in combinations(names, 2)}
+        vs = {n: np.asarray((var.get(n) or {}).get(sig.name, 0.0), float) for n in names}
+        pair = {f"{a} | {b}": float(np.sum(((ys[a] - ys[b]) / np.sqrt(
+                    sig.floor ** 2 + vs[a] + vs[b])) ** 2)) for a, b in combinations(names, 2)}
         d2 = min(pair.values())
         if np.isfinite(d2) and d2 > best.d2:
             best = _Score(d2, sig.name, pair, ys)
     return best
+
+
+def predicted(rivals: Mapping[str, Rival], conditions, signals) -> _Score:
+    """:func:`score` of every rival at ``conditions``, with the variance of
+    each prediction for the rivals that give one (a ``spread(conditions,
+    prediction)`` method, as :class:`ModelRival` with its parameters'
+    covariance)."""
+    pred = {n: r(conditions) for n, r in rivals.items()}
+    var = {}
+    for n, r in rivals.items():
+        if pred[n] is not None and callable(getattr(r, "spread", None)):
+            var[n] = r.spread(conditions, pred[n])
+    return score(pred, signals, var)
 
 
 class _Evaluator:
@@ -172,7 +195,7 @@ class _Evaluator:
         if key not in self.cache:
             self.n += 1
             cond = self.values(np.array(key))
-            self.cache[key] = score({n: r(cond) for n, r in self.rivals.items()}, self.signals)
+            self.cache[key] = predicted(self.rivals, cond, self.signals)
         return self.cache[key]
 
     def loss(self, unit) -> float:
@@ -229,8 +252,7 @@ def design_experiment(rivals: Mapping[str, Rival], conditions: Sequence[Conditio
                            "predicted by every rival model")
     base = None
     if reference is not None:
-        ref = score({n: r({**ev.fixed, **reference}) for n, r in ev.rivals.items()},
-                    ev.signals)
+        ref = predicted(ev.rivals, {**ev.fixed, **reference}, ev.signals)
         base = math.sqrt(max(ref.d2, 0.0)) if np.isfinite(ref.d2) else None
     return _result(ev, best_key, best, base, min_separation, times)
 
@@ -301,21 +323,76 @@ class ModelRival:
     AcausalError) predicts nothing (None)."""
 
     def __init__(self, model, params: Mapping[str, float], signals: Sequence[str],
-                 times: np.ndarray, options: Mapping | None = None):
+                 times: np.ndarray, options: Mapping | None = None, steps=()):
         self.mf, self.cm = model if isinstance(model, tuple) else compile_file(model)
         self.params, self.signals = dict(params), list(signals)
         self.times = np.asarray(times, float)
         self.options = dict(options or {})
+        self.steps = [dict(s) for s in steps]
+
+    def spread(self, conditions: Mapping[str, float], prediction) -> dict | None:
+        """{signal: variance per sample} of the prediction at ``conditions``
+        from the parameters' uncertainty: the sum over ``steps`` (one
+        standard deviation along each principal direction of the
+        parameters' covariance: {name: change}; :func:`covariance_steps`)
+        of the squared change of the prediction, a one-sided sigma-point
+        estimate that stays finite where the prediction is not linear in
+        the parameters. A step whose simulation fails is retried at a
+        quarter, its change scaled back by 4 (linear); None without steps."""
+        if not self.steps:
+            return None
+        out = {s: np.zeros_like(np.asarray(prediction[s], float)) for s in self.signals}
+        for step in self.steps:
+            for frac in (1.0, 0.25):
+                moved = {k: self.params[k] + frac * dv for k, dv in step.items()}
+                y = self._run(conditions, {**self.params, **moved})
+                if y is not None:
+                    break
+            if y is None:
+                continue
+            for s in self.signals:
+                out[s] += ((np.asarray(y[s], float) - np.asarray(prediction[s], float))
+                           / frac) ** 2
+        return out
 
     def __call__(self, conditions: Mapping[str, float]):
+        return self._run(conditions, self.params)
+
+    def _run(self, conditions, params):
         opts = self.mf.experiment.run_options()
         opts.update(self.options)
         opts["t_end"] = max(float(opts.get("t_end") or 0.0), float(self.times[-1]))
         try:
-            res = self.cm.simulate(params={**self.params, **conditions}, **opts)
+            res = self.cm.simulate(params={**params, **conditions}, **opts)
             measures = [s for s in self.signals if s in self.mf.measures]
             scalars = evaluate_measures(self.mf, res) if measures else {}
             return {s: np.atleast_1d(scalars[s]) if s in scalars
                     else np.interp(self.times, res.t, res[s]) for s in self.signals}
         except AcausalError:
             return None
+
+
+def covariance_steps(names, values, jacobian, cost, max_steps=None) -> list:
+    """One standard deviation along each principal direction of a
+    least-squares fit's parameter covariance, as {name: change}: the
+    covariance is (J'J)^-1 scaled by max(1, cost/(n-k)), J the weighted
+    residuals' Jacobian (n x k) in parameter units, computed per relative
+    change of each parameter (``values``). Directions the data do not
+    determine (eigenvalue below 1e-12 of the largest) are left out: the
+    fit bounds nothing along them. With ``max_steps``, only that many of
+    the least determined directions are kept (they spread a prediction
+    most)."""
+    J = np.asarray(jacobian, float)
+    n, k = J.shape
+    if k == 0 or n <= k:
+        return []
+    v = np.array([values[nm] for nm in names], float)
+    sc = np.where(v != 0, np.abs(v), 1.0)
+    Js = J * sc
+    w, V = np.linalg.eigh(Js.T @ Js)
+    s2 = max(cost / (n - k), 1.0)
+    keep = [j for j in np.argsort(w) if w[j] > 1e-12 * w.max()]
+    if max_steps is not None:
+        keep = keep[:max_steps]
+    return [{nm: float(V[i, j] * math.sqrt(s2 / w[j]) * sc[i])
+             for i, nm in enumerate(names)} for j in keep]

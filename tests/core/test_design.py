@@ -230,3 +230,62 @@ def test_blind_next_experiment_splits_coulomb_friction_from_a_constant_load(tmp_
           f"(baseline {nxt.baseline:.2f}, {nxt.n_evaluations} experiments evaluated); "
           f"chi2/n after: coulomb {refits['coulomb'][1]:.3f}, load {refits['load'][1]:.1f}; "
           f"{time.perf_counter() - t0:.1f} s")
+
+
+# -- the rivals' own uncertainty (Box-Hill / Buzzi-Ferraris weighting) -------------------
+class _Loose:
+    """The line rival whose prediction spreads as (s a^3)^2 per sample: its
+    parameters determine it ever less as the condition a grows."""
+
+    def __init__(self, s):
+        self.s = s
+
+    def __call__(self, c):
+        return _line(c)
+
+    def spread(self, c, prediction):
+        return {"y": np.full(T.size, (self.s * c["a"] ** 3) ** 2)}
+
+
+def test_a_loosely_predicted_experiment_is_weighed_down_to_the_closed_form_optimum():
+    # D(a) = a^2 sum((T - T^2)^2) / (f^2 + s^2 a^6): largest at a^6 = f^2 / (2 s^2);
+    # unweighted it would be the bound a = 2
+    f, a_star = 0.01, 1.3
+    s = f / np.sqrt(2.0 * a_star ** 6)
+    nxt = design_experiment({"line": _Loose(s), "parabola": _parabola},
+                            [Condition("a", 0.1, 2.0), Condition("b", 0.0, 1.0)],
+                            [Signal("y", f)], search=Search(seed=1))
+    assert nxt.conditions["a"] == pytest.approx(a_star, rel=2e-3)
+    d2 = a_star ** 2 * np.sum((T - T ** 2) ** 2) / (f ** 2 + s ** 2 * a_star ** 6)
+    assert nxt.separation == pytest.approx(np.sqrt(d2), rel=1e-5)
+
+
+def test_covariance_steps_rebuild_the_least_squares_covariance():
+    from acausal.studies.design import covariance_steps
+    rng = np.random.default_rng(3)
+    J = rng.normal(size=(40, 3)) * [1.0, 30.0, 0.01]         # badly scaled columns
+    values = {"a": 2.0, "b": -0.5, "c": 300.0}
+    for cost in (20.0, 74.0):                                # s2 below 1, then 2
+        steps = covariance_steps(list(values), values, J, cost)
+        got = sum(np.outer(list(st.values()), list(st.values())) for st in steps)
+        want = np.linalg.inv(J.T @ J) * max(cost / 37.0, 1.0)
+        np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12 * np.abs(want).max())
+    # a direction the data do not determine is left out
+    J0 = np.column_stack([J[:, 0], J[:, 0], J[:, 2]])
+    assert len(covariance_steps(list(values), values, J0, 20.0)) == 2
+
+
+def test_a_model_rivals_spread_is_its_sensitivity_times_the_step(tmp_path):
+    """A mass on a spring (c = 80 N/m) pushed by a constant load F, started at
+    rest at s0: s(t) = F/c + (s0 - F/c) cos(w t), linear in F, so the spread
+    of a step dF is exactly (dF (1 - cos w t) / c)^2."""
+    f = tmp_path / "load.py"
+    f.write_text(_SLIDER.format(law=_LOAD, conditions=_RANGES))
+    rival = ModelRival(str(f), {"F": 1.0}, ["mass.s"], TIMES, steps=[{"F": 0.3}])
+    cond = {"s0": 0.05, "v0": 0.0}
+    y = rival(cond)
+    var = rival.spread(cond, y)["mass.s"]
+    w = np.sqrt(80.0 / 1.0)
+    np.testing.assert_allclose(np.sqrt(var), 0.3 * (1.0 - np.cos(w * TIMES)) / 80.0,
+                               rtol=1e-5, atol=1e-9)
+    assert ModelRival(str(f), {"F": 1.0}, ["mass.s"], TIMES).spread(cond, y) is None

@@ -88,20 +88,25 @@ def _signals(ds, ref):
 
 
 def rivals(problem, rows, ref, signals):
-    """label -> :class:`acausal.design.ModelRival` of each row's fitted model."""
-    from ...studies.design import ModelRival
+    """label -> :class:`acausal.design.ModelRival` of each row's fitted
+    model, with one step per principal direction of its parameters'
+    covariance (:func:`acausal.studies.design.covariance_steps`): the
+    design weighs each rival's predictions by how well its fit determines
+    them."""
+    from ...studies.design import ModelRival, covariance_steps
     from .tasks import model_of
     times = ref.trace.time if ref.trace is not None else np.array([0.0])
     opts = dict(backend=problem.settings.integrator)     # the fits' integrator
-    return {r.candidate.label: ModelRival(model_of(problem, r.candidate), r.fit.values,
-                                          [s.name for s in signals], times, opts)
-            for r in rows}
+    return {r.candidate.label: ModelRival(
+        model_of(problem, r.candidate), r.fit.values, [s.name for s in signals], times, opts,
+        steps=covariance_steps(r.fit.names, r.fit.values, r.fit.jacobian, r.fit.cost))
+        for r in rows}
 
 
 def _fixed_only(rv, signals, ref, times):
     """The class at the reference experiment alone (no condition declared)."""
-    from ...studies.design import NextExperiment, score
-    sc = score({n: r(dict(ref.conditions)) for n, r in rv.items()}, signals)
+    from ...studies.design import NextExperiment, predicted
+    sc = predicted(rv, dict(ref.conditions), signals)
     sep = math.sqrt(max(sc.d2, 0.0)) if np.isfinite(sc.d2) else float("nan")
     pair = min(sc.pairwise, key=sc.pairwise.get) if sc.pairwise else " | "
     n = max(np.asarray(next(iter(sc.predictions.values()), [0.0])).size, 1)
