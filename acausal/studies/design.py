@@ -82,7 +82,9 @@ class NextExperiment:
     :func:`design_experiment`; None if not given); ``decisive``: the
     separation reaches ``min_separation`` of :func:`design_experiment`, else
     ``message`` says that no experiment in the declared ranges splits them;
-    ``times``: the sample times of the predictions, when given."""
+    ``times``: the sample times of the predictions, when given; ``spread``:
+    the largest rival's prediction spread from its parameters' uncertainty
+    there (RMS, floors; 0 for rivals without it)."""
 
     conditions: dict
     signal: str
@@ -96,6 +98,7 @@ class NextExperiment:
     decisive: bool = True
     message: str = ""
     times: np.ndarray | None = None
+    spread: float = 0.0     # the largest rival's prediction spread there (RMS, floors)
 
     def to_dict(self) -> dict:
         """JSON-ready (the diagnosis's ``next_experiment`` key)."""
@@ -108,6 +111,7 @@ class NextExperiment:
                     n_evaluations=self.n_evaluations,
                     baseline_floors=None if self.baseline is None else float(self.baseline),
                     decisive=self.decisive, message=self.message,
+                    spread_floors=float(self.spread),
                     times=None if self.times is None else np.asarray(self.times).tolist())
 
 
@@ -130,11 +134,14 @@ class _Score:
     signal: str | None
     pairwise: dict
     predictions: dict
+    spread: float = 0.0        # the largest rival spread on ``signal`` (RMS, floors)
+    merit: float = -math.inf   # d2, weighed down where the spread passes MAX_SPREAD
 
 
 def score(predictions: Mapping[str, Mapping[str, np.ndarray] | None],
           signals: Sequence[Signal],
-          variances: Mapping[str, Mapping[str, np.ndarray]] | None = None) -> _Score:
+          variances: Mapping[str, Mapping[str, np.ndarray]] | None = None,
+          max_spread: float = math.inf) -> _Score:
     """The score of one experiment from each rival's predicted signals: for
     each signal the smallest pairwise D, and the signal where it is
     largest. D is Hunter-Reiner's sum of squared differences over floor^2;
@@ -144,7 +151,16 @@ def score(predictions: Mapping[str, Mapping[str, np.ndarray] | None],
     Buzzi-Ferraris and Forzatti, Chem. Eng. Sci. 38 (1983)): an experiment
     whose outcome a rival predicts only loosely (a cam started just at the
     energy that carries it over its top: one standard deviation of a
-    parameter decides whether it goes over) separates nothing."""
+    parameter decides whether it goes over) separates nothing.
+
+    ``max_spread`` [floors]: where a rival's spread (RMS over the samples)
+    exceeds it, the experiment's merit is D (max_spread / spread)^2. The
+    criterion is a linearisation: it assumes each rival's prediction is
+    linear in its parameters within their uncertainty, and a fit that must
+    move its parameters by more than their spread to follow the new run
+    travels a landscape the linearisation does not see (the cam at w0 =
+    24.76: 3.5 floors of spread, and with that run added a wrong pair was
+    fitted best; at w0 = 25.0, 0.95 floors, the true pair was)."""
     names = list(predictions)
     if len(names) < 2:
         raise UsageError("experiment design needs at least two rival models")
@@ -158,12 +174,19 @@ def score(predictions: Mapping[str, Mapping[str, np.ndarray] | None],
         pair = {f"{a} | {b}": float(np.sum(((ys[a] - ys[b]) / np.sqrt(
                     sig.floor ** 2 + vs[a] + vs[b])) ** 2)) for a, b in combinations(names, 2)}
         d2 = min(pair.values())
-        if np.isfinite(d2) and d2 > best.d2:
-            best = _Score(d2, sig.name, pair, ys)
+        spread = max(float(np.sqrt(np.mean(v))) / sig.floor if v.size else 0.0
+                     for v in vs.values())
+        merit = d2 * min(1.0, (max_spread / spread) ** 2) if spread > 0 else d2
+        if np.isfinite(merit) and merit > best.merit:
+            best = _Score(d2, sig.name, pair, ys, spread, merit)
     return best
 
 
-def predicted(rivals: Mapping[str, Rival], conditions, signals) -> _Score:
+MAX_SPREAD = 1.0     # floors: a rival's prediction spread beyond which an experiment is weighed down
+
+
+def predicted(rivals: Mapping[str, Rival], conditions, signals,
+              max_spread: float = MAX_SPREAD) -> _Score:
     """:func:`score` of every rival at ``conditions``, with the variance of
     each prediction for the rivals that give one (a ``spread(conditions,
     prediction)`` method, as :class:`ModelRival` with its parameters'
@@ -173,7 +196,7 @@ def predicted(rivals: Mapping[str, Rival], conditions, signals) -> _Score:
     for n, r in rivals.items():
         if pred[n] is not None and callable(getattr(r, "spread", None)):
             var[n] = r.spread(conditions, pred[n])
-    return score(pred, signals, var)
+    return score(pred, signals, var, max_spread)
 
 
 class _Evaluator:
@@ -201,7 +224,7 @@ class _Evaluator:
     def loss(self, unit) -> float:
         """-log(1 + min D): smooth enough for Powell, finite where a rival fails."""
         s = self(unit)
-        return -math.log1p(s.d2) if np.isfinite(s.d2) else 1e3
+        return -math.log1p(s.merit) if np.isfinite(s.merit) else 1e3
 
 
 @dataclass(frozen=True)
@@ -245,7 +268,7 @@ def design_experiment(rivals: Mapping[str, Rival], conditions: Sequence[Conditio
             continue
         optimize.minimize(ev.loss, start, method="Powell", bounds=[(0.0, 1.0)] * len(conds),
                           options=dict(maxfev=search.max_refine_evals, xtol=1e-3, ftol=1e-4))
-    best_key = max(ev.cache, key=lambda k: ev.cache[k].d2)
+    best_key = max(ev.cache, key=lambda k: ev.cache[k].merit)
     best = ev.cache[best_key]
     if best.signal is None:
         raise AcausalError("experiment design: no experiment in the declared ranges could be "
@@ -272,7 +295,7 @@ def _result(ev: _Evaluator, key, best: _Score, base, min_separation, times) -> N
                           tuple(pair.split(" | ")),
                           {k: math.sqrt(v) for k, v in best.pairwise.items()},
                           best.predictions, ev.n, base, decisive, message,
-                          None if times is None else np.asarray(times, float))
+                          None if times is None else np.asarray(times, float), best.spread)
 
 
 def plot_next_experiment(nxt: NextExperiment, path=None, title=None):

@@ -289,3 +289,34 @@ def test_a_model_rivals_spread_is_its_sensitivity_times_the_step(tmp_path):
     np.testing.assert_allclose(np.sqrt(var), 0.3 * (1.0 - np.cos(w * TIMES)) / 80.0,
                                rtol=1e-5, atol=1e-9)
     assert ModelRival(str(f), {"F": 1.0}, ["mass.s"], TIMES).spread(cond, y) is None
+
+
+class _Spreading:
+    """y = a^4 T, spread (s a^3)^2 per sample: its difference from y = 0
+    grows faster than its spread, so unweighed the design runs to the bound."""
+
+    def __init__(self, s):
+        self.s = s
+
+    def __call__(self, c):
+        return {"y": c["a"] ** 4 * T}
+
+    def spread(self, c, prediction):
+        return {"y": np.full(T.size, (self.s * c["a"] ** 3) ** 2)}
+
+
+def test_an_experiment_beyond_the_spread_limit_is_weighed_down():
+    # merit = D min(1, (f / (s a^3))^2), D = a^8 sum(T^2) / (f^2 + s^2 a^6): the
+    # spread reaches one floor at a = 1.2, beyond which the merit falls as a^-4
+    from acausal.studies.design import MAX_SPREAD
+    f = 0.01
+    s = f / 1.2 ** 3
+    nxt = design_experiment({"quartic": _Spreading(s), "zero": lambda c: {"y": 0.0 * T}},
+                            [Condition("a", 0.1, 2.0)], [Signal("y", f)],
+                            search=Search(seed=2))
+    a = np.linspace(0.1, 2.0, 190001)
+    d2 = a ** 8 * np.sum(T ** 2) / (f ** 2 + s ** 2 * a ** 6)
+    merit = d2 * np.minimum(1.0, (MAX_SPREAD * f / (s * a ** 3)) ** 2)
+    assert nxt.conditions["a"] == pytest.approx(a[np.argmax(merit)], rel=2e-3)
+    assert nxt.spread == pytest.approx(s * nxt.conditions["a"] ** 3 / f, rel=1e-9)
+    assert a[np.argmax(d2)] == pytest.approx(2.0)       # unweighed: the bound
