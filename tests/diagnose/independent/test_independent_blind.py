@@ -63,3 +63,44 @@ def test_independent_case(name):
         assert un["node"] or un["why"], f"not explained, no node and no reason: {un}"
         assert not un["node"] or un["node"] == un["nodes"][0]["node"]
     assert row["ok"], f"{row['why']}: got {row['verdict']}, errors {row['errors']} %"
+
+
+@pytest.mark.slow
+def test_the_next_experiment_run_names_both_causes(tmp_path):
+    """The loop a user runs: cam friction + quadratic drag at the cam, 30
+    floors, seed 0. The three runs cannot decide the drag's site (nor, by
+    two tied rows, the friction's): weak, with the friction named in part
+    and a next experiment computed. That experiment is then run on the
+    independent truth (its start speed; the first runs' noise unchanged)
+    and the diagnosis repeated on the four runs: both causes named within
+    10 % (2026-11-28: w0 = 24.34 rad/s, errors 1.1 % and 1.7 %; the plain
+    criterion's w0 = 24.65, where one standard deviation of the rivals'
+    parameters decides whether the cam goes over its top, left the run
+    unexplained, docs/next_experiment.md)."""
+    import types
+    import datawriter
+    import independent_cases as B
+    import judge as J
+    from acausal.diagnose.run import diagnose
+    case = C.CASES["cam_friction_drag"]
+    laws, _ = B.laws_of(case, EFFECT)
+    datawriter.write(tmp_path / "data", case.truth, laws, seed=0)
+    first = diagnose(case.model, tmp_path / "data", out_dir=tmp_path / "out", workers=2,
+                     progress=False, plots=False)
+    assert first["cause"] is None and first["verdict"]["kind"] == "weak"
+    part = first["verdict"]["partial"]
+    assert part and any(c["family"] == "friction" for c in part["shared"]), part
+    nxt = first["next_experiment"]
+    assert nxt["computed"] and nxt["decisive"] and nxt["spread_floors"] <= 1.0, nxt
+    t = case.truth
+    truth = types.SimpleNamespace(CONDITIONS=list(t.CONDITIONS) + [nxt["conditions"]],
+                                  SIGNALS=t.SIGNALS, NOISE=t.NOISE,
+                                  RESOLUTION=t.RESOLUTION, run=t.run)
+    datawriter.write(tmp_path / "data4", truth, laws, seed=0)
+    second = diagnose(case.model, tmp_path / "data4", out_dir=tmp_path / "out4", workers=2,
+                      progress=False, plots=False)
+    j = J.judge(case, laws, second, B.TIED)
+    print(f"NEXT cam_friction_drag: w0 = {nxt['conditions']}; {J.verdict(first)} -> "
+          f"{J.verdict(second)}; errors {j['errors']}")
+    assert not j["wrong"], j["wrong"]
+    assert j["ok"], f"{j['why']}: got {J.verdict(second)}, errors {j['errors']} %"
