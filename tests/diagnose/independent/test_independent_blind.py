@@ -29,11 +29,13 @@ EFFECT = 30.0
 # pass says so and its mark is removed. Each is an open acceptance item, not
 # an accepted behaviour.
 OPEN = {
-    "cam_friction_drag": "issue 24 open: on 18dd93e weak: the best is coulomb_friction + "
+    "cam_friction_drag": "issue 24 open: on e0856b0 weak: the best is coulomb_friction + "
                          "quadratic_damping at the cam (the truth), but the same friction with "
                          "the drag at the follower is 1-2 AICc units behind and explains the "
                          "held-out data too (rival_tied: the drag's site is not decided at 30 "
-                         "floors); on ac8c704 it was named with the drag c 11.2 % off",
+                         "floors on three runs); the friction is named in part (F +5.4 %), and "
+                         "the next experiment, run, names both (the test below); on ac8c704 it "
+                         "was named with the drag c 11.2 % off",
 }
 # gear_friction_cogging (Coulomb friction at the load + a cogging torque of the
 # motor) left OPEN on 2026-11-27: it passed on c28f4e3 (the slow tier) and on
