@@ -190,6 +190,7 @@ def fit(ctx: Context, problem: Problem, cal: NominalFit, cands) -> tuple:
 
 # -- stage 3b: pairs ------------------------------------------------------------------------
 PAIR_TOP = 4          # pairs among the best this many single candidates (tested, distinct)
+PAIR_OWN = 2          # own parameters of the simplest pair (two one-parameter laws)
 
 
 def pairs_needed(dec) -> bool:
@@ -198,12 +199,19 @@ def pairs_needed(dec) -> bool:
     or does not explain the held-out data (its linearised held-out error
     above :func:`.stats.heldout_threshold`: a free shape parameter can fit
     the training data of two laws and still miss the held-out experiment,
-    issue 24's power drag at n = 2.61, training 1.15 and held-out 2.69)."""
+    issue 24's power drag at n = 2.61, training 1.15 and held-out 2.69),
+    or has more parameters of its own than a pair of two one-parameter
+    laws (``PAIR_OWN``): such a pair could fit as well with fewer, and
+    only fitted can parsimony judge it (independent cam, Coulomb friction
+    + quadratic drag at the cam, four runs: Stribeck friction at the cam,
+    three parameters, reached the noise and no pair was searched)."""
     if not (dec.discrepancy and dec.rows):
         return False
     if dec.c_hat > st.OVERDISPERSION:
         return True
     best = dec.rows[0]
+    if "+" not in best.candidate.hypothesis and len(best.own) > PAIR_OWN:
+        return True
     return not vd.explains(best, vd.threshold_of(best.fit.n, best, max(len(best.loo), 1)))
 
 
