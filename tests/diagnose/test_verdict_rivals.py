@@ -115,7 +115,7 @@ def test_a_cause_every_tied_pair_holds_is_named_in_part_with_its_spread():
     # the drag is in every tied pair too, at the cam or the follower
     assert drag.member == "quadratic_damping" and drag.sites == ("cam", "follower")
     assert not drag.site_decided and v.partial.undecided == ()
-    assert "coulomb_friction (friction family) at cam:" in v.partial.sentence()
+    assert "a friction-family law (the best's: coulomb_friction) at cam:" in v.partial.sentence()
     assert "at cam or follower (its site is undecided)" in v.partial.sentence()
     # a tied pair without the drag leaves it undecided, the friction shared
     spring = _row(["coulomb_friction", "hardening_spring"], ["cam", "spring"], aicc=101.8)

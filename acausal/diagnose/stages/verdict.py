@@ -383,7 +383,7 @@ class SharedCause:
             for k, v in self.values.items())
         where = (f"at {self.location}" if self.site_decided else
                  f"at {' or '.join(self.sites)} (its site is undecided)")
-        return f"{self.member} ({self.family} family) {where}: {vals}"
+        return f"a {self.family}-family law (the best's: {self.member}) {where}: {vals}"
 
 
 @dataclass(frozen=True)
