@@ -252,14 +252,16 @@ def test_without_declared_conditions_the_separation_is_stated():
 
 
 @pytest.mark.slow
-def test_a_parameter_whose_wald_interval_crosses_its_bound_is_profiled(slider):
-    """The profile stage's traced path: with the load's lower bound moved
-    inside its Wald interval the cheap check fails, the profile is traced,
-    open at the bound below and closed above, where it agrees with the Wald
-    end (the model is nearly linear in F)."""
+def test_a_parameter_whose_wald_interval_crosses_its_bound_is_profiled(slider_reversing):
+    """The profile stage's traced path: with the named friction's lower
+    bound moved inside its Wald interval the cheap check fails, the profile
+    is traced, open at the bound below and closed above, where it agrees
+    with the Wald end (the model is nearly linear in F). (On the slider that
+    never reverses nothing is named since 2026-11-28, the tie being weak,
+    so the profile stage has no cause's parameter there.)"""
     import dataclasses
     from acausal.diagnose.stages.intervals import profile_parameter, profile_tasks
-    res, _ = slider
+    res, _ = slider_reversing
     label, tasks = profile_tasks(res.problem, res.calibration, res.ranking)
     i = next(k for k, t in enumerate(tasks) if t.params[t.index].name.startswith("hyp_"))
     task = tasks[i]
