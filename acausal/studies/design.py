@@ -43,6 +43,7 @@ from scipy.stats import qmc
 
 from ..errors import AcausalError, UsageError
 from ..modelfile import compile_file, evaluate_measures
+from .residuals import principal_directions
 
 Rival = Callable[[Mapping[str, float]], "Mapping[str, np.ndarray] | None"]
 
@@ -174,8 +175,7 @@ def score(predictions: Mapping[str, Mapping[str, np.ndarray] | None],
         pair = {f"{a} | {b}": float(np.sum(((ys[a] - ys[b]) / np.sqrt(
                     sig.floor ** 2 + vs[a] + vs[b])) ** 2)) for a, b in combinations(names, 2)}
         d2 = min(pair.values())
-        spread = max(float(np.sqrt(np.mean(v))) / sig.floor if v.size else 0.0
-                     for v in vs.values())
+        spread = max(float(np.sqrt(np.mean(v))) / sig.floor for v in vs.values())
         merit = d2 * min(1.0, (max_spread / spread) ** 2) if spread > 0 else d2
         if np.isfinite(merit) and merit > best.merit:
             best = _Score(d2, sig.name, pair, ys, spread, merit)
@@ -395,27 +395,21 @@ class ModelRival:
             return None
 
 
-def covariance_steps(names, values, jacobian, cost, max_steps=None) -> list:
+def covariance_steps(names, values, jacobian, cost) -> list:
     """One standard deviation along each principal direction of a
     least-squares fit's parameter covariance, as {name: change}: the
     covariance is (J'J)^-1 scaled by max(1, cost/(n-k)), J the weighted
     residuals' Jacobian (n x k) in parameter units, computed per relative
     change of each parameter (``values``). Directions the data do not
     determine (eigenvalue below 1e-12 of the largest) are left out: the
-    fit bounds nothing along them. With ``max_steps``, only that many of
-    the least determined directions are kept (they spread a prediction
-    most)."""
+    fit bounds nothing along them (:func:`.residuals.principal_directions`)."""
     J = np.asarray(jacobian, float)
     n, k = J.shape
     if k == 0 or n <= k:
         return []
     v = np.array([values[nm] for nm in names], float)
     sc = np.where(v != 0, np.abs(v), 1.0)
-    Js = J * sc
-    w, V = np.linalg.eigh(Js.T @ Js)
+    w, V, good = principal_directions(J * sc)
     s2 = max(cost / (n - k), 1.0)
-    keep = [j for j in np.argsort(w) if w[j] > 1e-12 * w.max()]
-    if max_steps is not None:
-        keep = keep[:max_steps]
     return [{nm: float(V[i, j] * math.sqrt(s2 / w[j]) * sc[i])
-             for i, nm in enumerate(names)} for j in keep]
+             for i, nm in enumerate(names)} for j in np.argsort(w) if good[j]]

@@ -38,6 +38,7 @@ import numpy as np
 from scipy import optimize, stats
 
 from .differences import ForwardDifferences
+from .residuals import principal_directions
 
 Residuals = Callable[[np.ndarray], np.ndarray]
 
@@ -225,8 +226,7 @@ def wald_halfwidths(residuals: Residuals, x_opt, *, log=False, scale=None, thres
         fd = ForwardDifferences(lambda u: residuals(c.to_x(u)), fd_step,
                                 np.full(c.x0.size, np.inf))
         jacobian = fd.jac(np.zeros(c.x0.size))
-    w, V = np.linalg.eigh(jacobian.T @ jacobian)
-    good = w > 1e-12 * max(w.max(initial=0.0), 1e-300)
+    w, V, good = principal_directions(jacobian)
     var = (V[:, good] ** 2 / w[good]).sum(axis=1)
     if np.any(~good):
         var[np.abs(V[:, ~good]).max(axis=1) > 1e-3] = np.inf

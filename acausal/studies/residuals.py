@@ -27,7 +27,7 @@ from ..errors import AcausalError, CalibrationError, ModelFileError
 from ..modelfile import compile_file
 
 __all__ = ["WeightedResiduals", "measure_derivative", "resolve", "sigma", "subset",
-           "weighted_jacobian", "weighted_residuals"]
+           "weighted_jacobian", "weighted_residuals", "principal_directions"]
 
 
 def resolve(model):
@@ -161,3 +161,16 @@ def weighted_jacobian(model, dataset: Dataset, params: dict, names, simulate,
                                                    res.sensitivity(var, n)) / s
                                          for n in names]))
     return np.asarray(vec, float), np.asarray(rows, float).reshape(len(vec), len(names))
+
+
+def principal_directions(jacobian):
+    """(w, V, good) of a least-squares Jacobian J (n x k): the eigenvalues
+    and eigenvectors of J'J, and which directions the data determine
+    (eigenvalue above 1e-12 of the largest). Over those, (J'J)^-1 is
+    V diag(1/w) V'; a direction outside them is one the data cannot see.
+    Shared by the Wald intervals (:func:`.profile.wald_halfwidths`), the
+    diagnosis's fits and the design's parameter steps."""
+    J = np.asarray(jacobian, float)
+    w, V = np.linalg.eigh(J.T @ J)
+    good = w > 1e-12 * max(w.max(initial=0.0), 1e-300)
+    return w, V, good

@@ -19,8 +19,8 @@ from scipy import optimize, stats
 
 from ...studies.calibrate import FD_STEP
 from ...studies.differences import ForwardDifferences
-from ...studies.residuals import WeightedResiduals, resolve, weighted_jacobian, \
-    weighted_residuals
+from ...studies.residuals import WeightedResiduals, principal_directions, resolve, \
+    weighted_jacobian, weighted_residuals
 from ...errors import AcausalError
 from ...modelfile import evaluate_measures
 
@@ -398,11 +398,9 @@ def confidence(f: Fit, level=0.95, positive=()) -> dict:
     live = norms > 1e-9 * max(norms.max(initial=0.0), 1e-300)
     cov = np.full((k, k), np.inf)
     if np.any(live):
-        JtJ = Js[:, live].T @ Js[:, live]
-        w, V = np.linalg.eigh(JtJ)
-        good = w > 1e-12 * w.max()
+        w, V, good = principal_directions(Js[:, live])
         inv = (V[:, good] / w[good]) @ V[:, good].T
-        sub = np.full(JtJ.shape, np.inf)
+        sub = np.full(inv.shape, np.inf)
         # a parameter that loads on an unidentifiable direction gets no interval
         blind = np.abs(V[:, ~good]).max(axis=1) > 1e-3 if np.any(~good) else \
             np.zeros(len(w), bool)
