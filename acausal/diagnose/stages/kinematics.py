@@ -153,11 +153,12 @@ def tie(va, vb, tol=KIN_TOL):
     na, nb = float(np.linalg.norm(va)), float(np.linalg.norm(vb))
     if na == 0.0 or nb == 0.0:
         return None
-    cos = float(va @ vb) / (na * nb)
-    spread = math.sqrt(max(0.0, 1.0 - cos * cos))
+    ratio = float(va @ vb) / na ** 2
+    # the sine of the angle between them, from the part of vb off va's line
+    # (sqrt(1 - cos^2) loses half the digits: 1.5e-8 for exactly proportional rates)
+    spread = float(np.linalg.norm(vb - ratio * va)) / nb
     if spread > tol:
         return None
-    ratio = float(va @ vb) / na ** 2
     varies = max(ratio_variation(va, vb, ratio), ratio_variation(vb, va, 1.0 / ratio))
     return (ratio, max(spread, varies)) if varies <= tol else None
 
