@@ -113,8 +113,9 @@ def tied_fitted(ctx: Context, s: State) -> State:
     if not cands:
         return s
     with ctx.clock.timing("tied_s"):
-        got = ctx.run(fit_candidate, stages.fit_tasks(s.problem, s.calibration, cands),
-                      "fitting at tied sites")
+        rows = {r.candidate.key: r for r in d.rows}
+        got = ctx.run(fit_candidate, [stages.with_floors(t, rows) for t in stages.fit_tasks(
+            s.problem, s.calibration, cands)], "fitting at tied sites")
     return decided(ctx, dataclasses.replace(s, fits=s.fits + tuple(got)))
 
 
@@ -214,17 +215,24 @@ def run_stages(model_path, data_folder, options: DiagnosisOptions | None = None,
               stages.candidates(problem, opts.hypotheses, opts.locations))
     with open_executor(opts.scheduler, opts.workers) as ex:
         ctx = Context(ex, opts.progress, collect, clock)
-        s = fitted(ctx, calibrated(ctx, s))
+        s = _timed(fitted, ctx, _timed(calibrated, ctx, s))
         t_fit = clock.elapsed()
         for stage in (decided, members_fitted, pairs_searched, tied_fitted, cross_validated,
                       ranked, shown,
                       located, profiled):
-            s = stage(ctx, s)
+            s = _timed(stage, ctx, s)
     ctx = Context(None, opts.progress, collect, clock)   # the stages below submit no task
-    s = designed(ctx, extended(ctx, s))
+    s = _timed(designed, ctx, _timed(extended, ctx, s))
     t_cv = clock.elapsed() - t_fit
-    s = viewed(ctx, s)
+    s = _timed(viewed, ctx, s)
     return diagnosis_of(s, _timing(s, clock, t_fit, t_cv))
+
+
+def _timed(stage, ctx: Context, s: State) -> State:
+    """``stage(ctx, s)``, its wall time recorded as ``stage_<name>_s`` (every
+    stage's share of a slow case, in ``candidates.json``'s timing)."""
+    with ctx.clock.timing(f"stage_{stage.__name__}_s"):
+        return stage(ctx, s)
 
 
 def _timing(s: State, clock: Clock, t_fit: float, t_cv: float) -> dict:

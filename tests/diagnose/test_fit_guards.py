@@ -116,3 +116,59 @@ def test_a_candidate_fitted_twice_keeps_its_lower_fit():
     other = CandidateFit(Candidate("g", "a", ()), _fit({"k.c": 1.0}, 800.0))
     assert _lowest_per_key([first, other, again]) == [again, other]
     assert _lowest_per_key([again, other, first]) == [again, other]
+
+
+def test_a_pair_fit_has_a_floor_at_each_member_alone():
+    """``chain.with_floors``: the free values and the member's own at its
+    single fit, the other member at its neutral value (pure data)."""
+    from acausal.diagnose.stages.chain import with_floors
+    problem = Problem("m.py", "", "lib", (Param("k.c", 50.0, 10.0, 100.0, 50.0, 50.0),),
+                      FitSettings())
+    a = _row("h", "a", {"k.c": 52.0, "hyp_h.k": 0.5})
+    b = _row("g", "b", {"k.c": 47.0, "hyp_g.k": -0.5})
+    cand = Candidate("h+g", "a+b", (Param("hyp_h.k", 0.4, -10.0, 10.0, 1.0, 0.0),
+                                     Param("hyp_g.k", -0.3, -10.0, 10.0, 1.0, 0.0)))
+    task = FitTask(problem, cand, problem.free)
+    got = with_floors(task, {r.candidate.key: r for r in (a, b)}).floors
+    assert got == ((52.0, 0.5, 0.0), (47.0, 0.0, -0.5))
+    # a member with no single fit has no floor; a single candidate has none
+    assert with_floors(task, {a.candidate.key: a}).floors == ((52.0, 0.5, 0.0),)
+    assert with_floors(FitTask(problem, a.candidate, problem.free), {}).floors == ()
+
+
+def test_a_fit_that_ends_above_a_floor_is_refined_from_it():
+    """``Refiner.lowest``: a multi-start's end above one of the floors (a
+    pair's member alone) is replaced by the refinement of the lowest floor
+    on the whole record; an end at or below every floor is kept (one
+    simulation per floor). On the simulated slider, rate 100."""
+    ds = _slider_data()
+    lo, hi, sc = np.array([50.0]), np.array([200.0]), np.array([50.0])
+    ref = Refiner(compile_file(SLIDER), ds, ["spring.c"], lo, hi, sc, (1.0,),
+                  FitSettings(max_nfev=30))
+    stuck = _fit({"spring.c": 180.0}, 1e7)
+    got, n_sim = ref.lowest(stuck, [np.array([150.0]), np.array([97.0])])
+    assert got is not stuck and n_sim > 2
+    assert got.cost < 1.0 and abs(got.values["spring.c"] - 100.0) < 0.1
+    good = _fit({"spring.c": 100.0}, 0.0)
+    kept, n_sim = ref.lowest(good, [np.array([150.0]), np.array([97.0])])
+    assert kept is good and n_sim == 2
+    assert ref.lowest(good, []) == (good, 0)
+
+
+def test_scored_starts_keep_the_penalty_rows_when_the_free_parameters_are_absorbed():
+    """``fitting.score_starts`` with ``absorb``: the data rows are moved by
+    the linearised re-calibration, the penalty's rows (after them) still
+    count (a leftover line had dropped them)."""
+    from acausal.diagnose.stages.fitting import score_starts
+
+    class _Obj:
+        names = ["k.c", "hyp.w"]
+
+        def __call__(self, x):       # 3 data rows on k.c, 1 penalty row on hyp.w
+            return np.array([x[0] - 1.0, x[0] - 1.0, x[0] - 1.0, 10.0 * x[1]])
+
+    J = np.ones((3, 1))              # the nominal's Jacobian of the data rows on k.c
+    (c, x), = score_starts(_Obj(), [np.array([3.0, 0.2])], np.array([-9.0, -9.0]),
+                           np.array([9.0, 9.0]), (["k.c"], J))
+    assert x[0] == pytest.approx(1.0)          # the data rows absorbed
+    assert c == pytest.approx(4.0)             # the penalty row's (10 * 0.2)^2

@@ -270,8 +270,7 @@ def score_starts(obj, starts, lo, hi, absorb=None):
             d = np.linalg.lstsq(a_jac, -r[:m], rcond=None)[0]
             moved = np.clip(x[a_idx] + d, lo[a_idx], hi[a_idx])
             rr = r[:m] + a_jac @ (moved - x[a_idx])
-            c = float(rr @ rr) + float(r[m:] @ r[m:])
-            c = float(rr @ rr)
+            c = float(rr @ rr) + float(r[m:] @ r[m:])   # a penalty's rows kept
             x = x.copy()
             x[a_idx] = moved
         out.append((c, x))

@@ -31,7 +31,6 @@ from scipy.stats import qmc
 from ...studies.calibrate import model_dataset
 from ...data import Dataset, MeasuredExperiment, Trace
 from ...data.thinning import MAX_TRACE_SAMPLES, MIN_TRACE_SAMPLES, thin_traces  # noqa: F401
-from ...errors import AcausalError
 from ...infra.executor import worker_cache
 from ...modelfile import compile_file
 from ...studies.residuals import subset
@@ -50,7 +49,10 @@ class FitTask:
     ``Param.prior``); ``absorb`` = (names, Jacobian) of the nominal fit;
     ``seed_free``: values of the free parameters (in ``free``'s order) that
     go with the candidate's seeded starts, one more start (a screened
-    member's Gauss-Newton step moves both)."""
+    member's Gauss-Newton step moves both); ``floors``: points (the free
+    values, then the extension's, in the fit's order) the fit must end no
+    higher than: a pair's members alone, each at its own fit with the other
+    member neutral (:meth:`Refiner.lowest` after the multi-start)."""
 
     problem: Problem
     candidate: Candidate
@@ -58,6 +60,7 @@ class FitTask:
     absorb: tuple | None = None
     budget_s: float | None = None
     seed_free: tuple | None = None   # free values that go with a seeded start (a step's)
+    floors: tuple = ()               # points the fit ends no higher than (a pair's members)
 
     @property
     def cost(self) -> float:
@@ -297,8 +300,14 @@ def _multistart(task: FitTask):
     refiner = Refiner(pair, ds, names, lo, hi, sc, _windows(ds, s), s, task.budget_s,
                       penalty_of(cand))
     fits = refiner.all([x for _, x in picked])
-    best, starts = _summary(fits, len(scored), cand.params, True, [x for _, x in picked])
-    best = dataclasses.replace(best, n_sim=obj.n_sim + sum(f.n_sim for f in fits))
+    best = min(fits, key=lambda f: f.cost)
+    low, used = refiner.lowest(best, [np.asarray(x, float) for x in task.floors])
+    refined = [x for _, x in picked]
+    if low is not best:           # a pair ended above one of its members alone
+        fits.append(low)
+        refined += [np.asarray(x, float) for x in task.floors]
+    best, starts = _summary(fits, len(scored) + len(task.floors), cand.params, True, refined)
+    best = dataclasses.replace(best, n_sim=obj.n_sim + used + sum(f.n_sim for f in fits))
     return best, starts
 
 
@@ -469,16 +478,23 @@ class Refiner:
         whole record reached the truth."""
         if len(self.windows) < 2 or not np.isfinite(end.cost):
             return end, 0
+        return self.lowest(end, [x0], 1e-3)
+
+    def lowest(self, end, points, rel=0.0):
+        """(fit, simulations): ``end``, or, when the lowest of ``points``
+        costs less on the whole record than ``end`` by more than
+        max(0.5, ``rel`` S) (a failed ``end`` costs infinity), the
+        refinement of that point on the whole record if it ends lower.
+        Each point is simulated once (:func:`.fitting.score_starts`)."""
+        if not len(points):
+            return end, 0
         obj = Objective(self.pair, self.ds, self.names, budget=Budget(self.budget_s),
                         penalty=self.penalty, backend=self.settings.integrator)
-        try:
-            r = obj(np.clip(np.asarray(x0, float), self.lo, self.hi))
-        except AcausalError:
+        scored = score_starts(obj, points, self.lo, self.hi)
+        total = end.cost + penalty_cost(end, self.penalty) if np.isfinite(end.cost) else np.inf
+        if not scored or (np.isfinite(total) and total <= scored[0][0] + max(0.5, rel * total)):
             return end, obj.n_sim
-        total = end.cost + penalty_cost(end, self.penalty)
-        if total <= float(r @ r) + max(0.5, 1e-3 * total):
-            return end, obj.n_sim
-        fit, _, used = self.window_fit(1.0, x0)
+        fit, _, used = self.window_fit(1.0, scored[0][1])
         better = fit.cost + penalty_cost(fit, self.penalty) < total
         return (fit if better else end), obj.n_sim + used
 
