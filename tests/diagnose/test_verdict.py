@@ -214,6 +214,23 @@ def test_a_nominal_near_the_floor_that_the_cause_brings_within_it_is_a_heldout_g
                  heldout_threshold=1.05) == ["no_heldout_gain"]
 
 
+def test_a_best_rescued_by_the_whitened_error_is_within_the_threshold_for_the_gain_too():
+    """The cam follower's friction + drag at 30 floors (numpy 2.4.6): the
+    best pair explains the held-out data by the whitened rescue (plain 30.8
+    floors, whitened 0.999), the nominal is at 9.96. The verdict must not say
+    both that it explains the held-out data and that their error does not
+    fall: on the rescue's ground it crossed into the threshold. Without the
+    rescue, or from a nominal already within the threshold, it did not."""
+    ev = dict(n=N, k=4, d_null=50.0, d_runner=None, ci_rel=None, c_hat=1.0, coarse=None)
+    codes = lambda **kw: [c for c, _ in st.weak_reasons(st.Evidence(**ev, **kw))]
+    assert codes(heldout_nominal=9.96, heldout_best=30.8, heldout_threshold=1.02,
+                 rescued=True) == []
+    assert codes(heldout_nominal=9.96, heldout_best=30.8,
+                 heldout_threshold=1.02) == ["no_heldout_gain"]
+    assert codes(heldout_nominal=1.01, heldout_best=30.8, heldout_threshold=1.02,
+                 rescued=True) == ["no_heldout_gain"]
+
+
 def test_the_pair_search_goes_on_when_the_best_single_misses_the_heldout_data():
     def dec(heldout, c_hat=1.2):
         r = _row("power_drag", "rotor", [("hyp_pd.c", 0.0, 0.0, 1.0)], {"hyp_pd.c": 0.3},

@@ -791,7 +791,8 @@ def rank(ds, cal: NominalFit, dec: Decision, cv: CrossValidation, unfitted=(),
             n=cal.fit.n, k=b.k, d_null=dec.a0 - b.aicc,
             d_runner=None if runner is None else rows[runner].aicc - b.aicc,
             heldout_nominal=held0, heldout_best=b.heldout_rmse, ci_rel=None,
-            c_hat=dec.c_hat, coarse=_coarse(ds, cal.fit), heldout_threshold=threshold.rms))]
+            c_hat=dec.c_hat, coarse=_coarse(ds, cal.fit), heldout_threshold=threshold.rms,
+            rescued=vd.rescued(b, threshold)))]
         reasons += vd.determination_reasons(b)
         same = same or vd.SameCause()
         rivals = vd.class_rivals(rows, classes[0], 0, same,

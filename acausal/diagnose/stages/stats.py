@@ -274,6 +274,7 @@ class Evidence:
     c_hat: float
     coarse: float | None
     heldout_threshold: float | None = None   # the most noise alone reaches (floors)
+    rescued: bool = False    # the best explains the held-out data by the whitened rescue
 
 
 def weak_evidence(ev: Evidence) -> list:
@@ -304,9 +305,13 @@ def weak_reasons(ev: Evidence) -> list:
                     f"AICc units behind (needs {RUNNER_UP:g})"))
     # the held-out error falls enough: by the factor, or from above what noise
     # alone reaches to within it (a nominal already near the floor, its free
-    # parameters absorbing part of the cause, cannot fall by the factor)
+    # parameters absorbing part of the cause, cannot fall by the factor); a
+    # best that explains the held-out data by the whitened rescue
+    # (:func:`.verdict.rescued`) is within it on the rescue's own ground, the
+    # one its name would stand on (else the verdict says both that it explains
+    # the held-out data and that their error does not fall)
     crossed = (ev.heldout_threshold is not None and heldout_nominal > ev.heldout_threshold
-               and heldout_best <= ev.heldout_threshold)
+               and (heldout_best <= ev.heldout_threshold or ev.rescued))
     if not (heldout_best < HELDOUT_GAIN * heldout_nominal or crossed):
         out.append(("no_heldout_gain", f"held-out error does not fall enough: "
                     f"{heldout_best:.3g} against {heldout_nominal:.3g} without extension "
