@@ -22,6 +22,7 @@ def test_forward_differences_absolute_step_and_reuse():
     np.testing.assert_allclose(J, [[1e-3, 0.0], [0.0, 3.0], [1.0, 0.0]], atol=1e-12)
 
 
+@pytest.mark.slow   # 4 s; the breaker's 110 V intervals also in test_breaker_calibration
 def test_breaker_110V_intervals_from_the_right_jacobian():
     """At 110 V the contact period fixes K to within the reading step: its
     sensitivity to log K is -0.4 x 0.3 ms = -4.3 floors, so the 95 % interval

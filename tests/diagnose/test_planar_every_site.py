@@ -34,8 +34,8 @@ def _candidates(path):
     return graph, [(h, loc) for h in ALL for loc in h.candidates(graph)]
 
 
-@pytest.mark.parametrize("path", [SLIDER_CRANK, PLANAR_BREAKER],
-                         ids=["slider_crank", "planar_breaker"])
+@pytest.mark.parametrize("path", [SLIDER_CRANK, pytest.param(PLANAR_BREAKER, marks=pytest.mark.slow)],
+                         ids=["slider_crank", "planar_breaker"])   # the breaker's 6 s: slow tier
 def test_every_candidate_applies_at_every_site(path):
     graph, cands = _candidates(path)
     joints = {s.path for s in graph.joints}
@@ -72,8 +72,8 @@ def test_a_planar_body_is_refused_in_one_line():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("path", [SLIDER_CRANK, PLANAR_BREAKER],
-                         ids=["slider_crank", "planar_breaker"])
+@pytest.mark.parametrize("path", [SLIDER_CRANK, pytest.param(PLANAR_BREAKER, marks=pytest.mark.slow)],
+                         ids=["slider_crank", "planar_breaker"])   # the breaker's 6 s: slow tier
 def test_every_candidate_compiles_at_every_site(path):
     _, cands = _candidates(path)
     failed = []

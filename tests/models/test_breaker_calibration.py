@@ -3,6 +3,8 @@ the report's own method (section 3) and output-error least squares."""
 import json
 import os
 
+import pytest
+
 from click.testing import CliRunner
 
 from acausal.studies import calibrate as cal
@@ -72,6 +74,7 @@ def test_calibrate_command_fits_110V_and_predicts_the_other_voltages():
     assert out["profile_ci95"] == {}
 
 
+@pytest.mark.slow   # 7 s; the 110 V command-line fit stays in the default tier
 def test_least_squares_over_all_voltages_is_consistent_with_the_instrument():
     ds = cal.model_dataset(MODEL, DATA)
     out = cal.least_squares(MODEL, ds, ["contact.K", "hook.bh"])
