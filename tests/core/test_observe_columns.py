@@ -15,22 +15,6 @@ from tests.faults import helpers as h
 ROOT = h.ROOT
 
 
-def _ulps(a, b):
-    """(same, gap): where ``a`` and ``b`` agree to the bit, and their gap in
-    ulps of each column's largest magnitude over the run. An absolute
-    measure: numpy's array math (SIMD pow, tanh, exp) is one ulp off libm's
-    on some values (numpy 2.4.6 on AVX-512: pow(x, 1.5) on 5 %, tanh on 27 %),
-    and a force summed from terms the size of the column's peak carries that
-    ulp into a small result (the breaker hook's acceleration: 71 of its own
-    ulps, 2 of the column's). A printer that writes a function wrong is off
-    by far more."""
-    same = (a == b) | (np.isnan(a) & np.isnan(b))
-    scale = np.max(np.abs(np.nan_to_num(np.where(same, a, np.fmax(np.abs(a), np.abs(b))))),
-                   axis=0)
-    gap = np.abs(a - b) / np.spacing(np.maximum(scale, np.finfo(float).tiny))
-    return same, np.where(same, 0.0, gap)
-
-
 @pytest.mark.parametrize("path", ["models/breaker_24kv.py", "models/examples/stick_slip.py"])
 def test_each_observed_variable_alone_is_its_per_row_value(path):
     res, _ = run_file(str(ROOT / path))
@@ -46,7 +30,7 @@ def test_each_observed_variable_alone_is_its_per_row_value(path):
         res._columns.clear()     # each read alone (past ALONE names: the whole matrix)
         col = res[name]
         assert col.shape == res.t.shape
-        worst = max(worst, float(_ulps(rowwise[:, k], col)[1].max()))
+        worst = max(worst, float(h.column_ulps(rowwise[:, k], col)[1].max()))
     # a primitive one ulp off (numpy's array pow or tanh against libm's, pow(w, 2)
     # against w*w), carried through a sum of a few terms: 2 measured (numpy 2.4.6)
     assert worst <= 4.0, worst

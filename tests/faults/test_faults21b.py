@@ -24,22 +24,6 @@ from . import helpers as h
 ROOT = h.ROOT
 
 
-def _ulps(a, b):
-    """(same, gap): where ``a`` and ``b`` agree to the bit, and their gap in
-    ulps of each column's largest magnitude over the run. An absolute
-    measure: numpy's array math (SIMD pow, tanh, exp) is one ulp off libm's
-    on some values (numpy 2.4.6 on AVX-512: pow(x, 1.5) on 5 %, tanh on 27 %),
-    and a force summed from terms the size of the column's peak carries that
-    ulp into a small result (the breaker hook's acceleration: 71 of its own
-    ulps, 2 of the column's). A printer that writes a function wrong is off
-    by far more."""
-    same = (a == b) | (np.isnan(a) & np.isnan(b))
-    scale = np.max(np.abs(np.nan_to_num(np.where(same, a, np.fmax(np.abs(a), np.abs(b))))),
-                   axis=0)
-    gap = np.abs(a - b) / np.spacing(np.maximum(scale, np.finfo(float).tiny))
-    return same, np.where(same, 0.0, gap)
-
-
 @pytest.mark.parametrize("path", ["models/breaker_24kv.py", "models/breaker_24kv_planar.py",
                                   "models/examples/stick_slip.py"])
 def test_the_vectorised_observe_gives_the_per_row_values(path, monkeypatch):
@@ -52,7 +36,7 @@ def test_the_vectorised_observe_gives_the_per_row_values(path, monkeypatch):
     monkeypatch.setattr(observe, "VECTOR_ROWS", 1)
     assert observe._function(cm) is not None   # it is vectorised, not the fallback
     arrays = observe.observed_rows(cm, res.p, *R)
-    same, ulps = _ulps(rowwise, arrays)
+    same, ulps = h.column_ulps(rowwise, arrays)
     # a primitive one ulp off (numpy's array pow or tanh against libm's; the
     # breakers' friction power w**2*bh: pow(w, 2) against w*w), carried through
     # a sum of a few terms: 2 ulps of the column measured (numpy 2.4.6)
@@ -91,7 +75,7 @@ def test_a_large_result_is_written_without_a_python_call_per_row(tmp_path, monke
     data = np.loadtxt(tmp_path / "big.csv", delimiter=",", skiprows=1, max_rows=len(res.t))
     ref = np.column_stack([res.t] + [res[name] for name in res.names])
     np.testing.assert_array_equal(data[:, 0], ref[:, 0])
-    _, ulps = _ulps(data, ref)
+    _, ulps = h.column_ulps(data, ref)
     assert ulps.max() <= 4.0, ulps.max()
 
 
