@@ -300,13 +300,14 @@ def _multistart(task: FitTask):
     refiner = Refiner(pair, ds, names, lo, hi, sc, _windows(ds, s), s, task.budget_s,
                       penalty_of(cand))
     fits = refiner.all([x for _, x in picked])
+    floors = [np.asarray(x, float) for x in task.floors]
     best = min(fits, key=lambda f: f.cost)
-    low, used = refiner.lowest(best, [np.asarray(x, float) for x in task.floors])
+    low, used = refiner.lowest(best, floors)
     refined = [x for _, x in picked]
     if low is not best:           # a pair ended above one of its members alone
         fits.append(low)
-        refined += [np.asarray(x, float) for x in task.floors]
-    best, starts = _summary(fits, len(scored) + len(task.floors), cand.params, True, refined)
+        refined += floors
+    best, starts = _summary(fits, len(scored) + len(floors), cand.params, True, refined)
     best = dataclasses.replace(best, n_sim=obj.n_sim + used + sum(f.n_sim for f in fits))
     return best, starts
 
