@@ -731,8 +731,9 @@ def _run_keeping_partial(cm, params, opts):
 
 @contextlib.contextmanager
 def _c_stdout_to_stderr():
-    """Send what C code prints to stdout (SUNDIALS writes its error lines
-    there) to stderr instead, so that stdout carries only the JSON."""
+    """Send what C code prints to stdout to stderr instead, so that stdout
+    carries only the JSON (SUNDIALS' error lines, printed from Python, are
+    caught by the backend and carried in the error's message)."""
     import ctypes
     import os
     sys.stdout.flush()

@@ -20,7 +20,19 @@ root. Creating an IDA object per segment costs more than a segment of a
 short contact, so one object serves a run and the log is cleared before
 each segment (:func:`_clear_event_log`); the public ``*_events`` fields then
 hold exactly the segment's roots.
+
+scikit-sundae's error handler ``print``s SUNDIALS' message (``[IDASolve,
+Error: -22] At t = ... mxstep steps taken``) to ``sys.stdout`` before
+``solve`` returns a failed status. That line is caught here
+(:func:`_caught_prints`) and carried in the segment's message, so that a
+failed run says it once, in its own error line, and the many fits of a
+diagnosis or a sweep whose trial points fail print nothing.
 """
+import contextlib
+import io
+import sys
+import threading
+
 import numpy as np
 from sksundae.ida import IDA
 
@@ -69,7 +81,12 @@ class SundaeSolver(SegmentSolver):
         _clear_event_log(self.roots, self.solved)
         self.solved = True
         cb.count[0] = 0
-        sol = self.ida.solve(tspan, y, yp)
+        with _caught_prints() as said:
+            sol = self.ida.solve(tspan, y, yp)
+        message = str(sol.message)
+        lines = [ln.strip() for ln in said.getvalue().splitlines() if ln.strip()]
+        if lines and int(sol.status) < 0:
+            message += " (SUNDIALS: " + "; ".join(dict.fromkeys(lines)) + ")"
         st, sy, syp = np.atleast_1d(sol.t), np.atleast_2d(sol.y), np.atleast_2d(sol.yp)
         if len(tspan) == 2 and not every_step and len(st) > 2:
             keep = np.r_[0, len(st) - 1]   # IDA reported every internal step
@@ -80,7 +97,7 @@ class SundaeSolver(SegmentSolver):
                                           sol.yp_events):
                 roots.append(Root(float(te), np.array(ye), np.array(ype),
                                   [i for i, s in enumerate(flags) if s != 0]))
-        return Segment(st, sy, syp, int(sol.status), str(sol.message), roots,
+        return Segment(st, sy, syp, int(sol.status), message, roots,
                        int(sol.nfev), int(sol.njev), int(cb.count[0]))
 
 
@@ -99,3 +116,57 @@ def _clear_event_log(roots, solved):
     for name in _EVENT_LOG:
         getattr(roots, name).clear()
     roots._i_cnt[:] = 0
+
+
+class _Routed(io.TextIOBase):
+    """``sys.stdout`` while a solve runs: what a thread inside
+    :func:`_caught_prints` writes goes to that thread's buffer, everything
+    else to the stream it replaced (Dask threads solving in one process
+    each catch their own lines; another thread's output is untouched)."""
+
+    def __init__(self, stream):
+        self.stream = stream
+        self.local = threading.local()
+
+    def write(self, text):
+        buf = getattr(self.local, "buf", None)
+        return (buf if buf is not None else self.stream).write(text)
+
+    def flush(self):
+        if getattr(self.local, "buf", None) is None:
+            self.stream.flush()
+
+    def __getattr__(self, name):          # encoding, isatty, fileno, ... of the stream
+        return getattr(self.stream, name)
+
+
+_ROUTE_LOCK = threading.Lock()
+_ROUTE = {"routed": None, "users": 0}
+
+
+@contextlib.contextmanager
+def _caught_prints():
+    """Python-level writes to ``sys.stdout`` by this thread go to the
+    returned buffer until the block ends. The router is installed by the
+    first thread in and removed by the last one out, unless someone replaced
+    ``sys.stdout`` meanwhile (then it is left to them)."""
+    buf = io.StringIO()
+    with _ROUTE_LOCK:
+        routed = _ROUTE["routed"]
+        if routed is None or sys.stdout is not routed:
+            routed = _Routed(sys.stdout)
+            sys.stdout = routed
+            _ROUTE.update(routed=routed, users=0)
+        _ROUTE["users"] += 1
+    routed.local.buf = buf
+    try:
+        yield buf
+    finally:
+        routed.local.buf = None
+        with _ROUTE_LOCK:
+            if _ROUTE["routed"] is routed:
+                _ROUTE["users"] -= 1
+                if _ROUTE["users"] <= 0:
+                    if sys.stdout is routed:
+                        sys.stdout = routed.stream
+                    _ROUTE.update(routed=None, users=0)
