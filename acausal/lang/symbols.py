@@ -34,6 +34,48 @@ def Eq(lhs, rhs=0, evaluate=False):
     return sp.Eq(lhs, rhs, evaluate=evaluate)
 
 
+class FastMax(sp.Max):
+    """``max(a, b, ...)`` as sympy's ``Max``, built without its symbolic
+    reduction of the arguments (``Max(0, u)`` tries to prove ``u >= 0`` and
+    to drop redundant arguments through sympy's assumptions: about 40 ms a
+    node for a hat ``max(0, 1 - |x - c|/h)`` over a body's position, paid
+    again each time an expression containing it is rebuilt: by
+    ``xreplace``, by the code generator's renaming, by unpickling a cached
+    compile). A 65 x 33-knot generic term at the cam follower took 11 s to
+    build, nearly all of it in ``Max``. With numbers for every argument it
+    is sympy's ``Max`` (a number); otherwise it stays as written. Printed,
+    differentiated and evaluated as ``Max`` (a subclass: the printers and
+    :func:`.fastdiff.diff` dispatch on it)."""
+
+    def __new__(cls, *args, **assumptions):
+        args = [sp.sympify(a) for a in args]
+        if all(a.is_number for a in args):
+            return sp.Max(*args)
+        assumptions["evaluate"] = False
+        return sp.Max.__new__(cls, *args, **assumptions)
+
+
+class FastAbs(sp.Abs):
+    """``|u|`` as sympy's ``Abs``, built without its evaluation (which asks
+    sympy's assumptions whether ``u`` is real, zero, of one sign: half of
+    the remaining build of that generic term, :class:`FastMax`). With a
+    number it is sympy's ``Abs``; otherwise it stays as written."""
+
+    def __new__(cls, arg, **assumptions):
+        arg = sp.sympify(arg)
+        if arg.is_number:
+            return sp.Abs(arg)
+        assumptions["evaluate"] = False
+        return sp.Abs.__new__(cls, arg, **assumptions)
+
+
+# sympy's code printers look ``Max`` and ``Abs`` up by the class's ``__name__``
+# (Python's ``known_functions``, numpy's, C's ``fmax``, ``fabs``); pickling
+# finds the classes by their ``__qualname__``, which stays FastMax, FastAbs
+FastMax.__name__ = "Max"
+FastAbs.__name__ = "Abs"
+
+
 def ordered(symbols):
     """Symbols sorted by name. Iterating a set of sympy symbols (``free_symbols``)
     follows their string hashes, which change with ``PYTHONHASHSEED``; every

@@ -24,6 +24,7 @@ import os
 import numpy as np
 import sympy as sp
 
+from ...lang.symbols import FastAbs, FastMax
 from ...runtime.model import compile_model
 from ...errors import ModelError
 from ...modelfile import load_model_file
@@ -221,7 +222,7 @@ class GenericForce(Hypothesis):
             h = (rng[hi] - rng[lo]) / (n - 1)
             for i in range(n):
                 w = self._par(hyp, vals, f"{c}{i}", dom.force_unit, f"spline weight {c}{i}")
-                f += w * sp.Max(0, 1 - sp.Abs(var - (rng[lo] + i * h)) / h)
+                f += w * FastMax(0, 1 - FastAbs(var - (rng[lo] + i * h)) / h)
         hyp.term = dom.source(f)
         model.connect(hyp.term.flange, body.flange)
 
