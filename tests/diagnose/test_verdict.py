@@ -269,3 +269,35 @@ def test_every_screened_rival_is_fitted_beyond_the_budget_briefly():
     assert len(slow) == 8
     assert [t.problem.settings.evals_per_param for t in slow] == [25] + [4] * 7
     assert all(t.problem.settings.windows == (1.0,) for t in slow[1:])
+
+
+def test_the_located_stage_runs_only_where_it_can_change_the_verdict():
+    """A weak verdict whose best library candidate explains the held-out
+    data (a tie of two causes, each within the threshold) cannot become
+    "not explained by the library": the located stage is not run and says
+    why with the numbers. It runs when nothing in the library explains the
+    held-out data, and beside a named cause that leaves misfit beyond the
+    instrument; never without a discrepancy."""
+    from acausal.diagnose.stages import locate
+    tied = [vd.Reason("rival_tied", "the runner-up is only 1.0 AICc units behind")]
+
+    def ranking(heldout, named=False, c_hat=1.2, discrepancy=True):
+        best = cvf(0.5, (0.4, 0.6), 0.2, (0.1, 0.3))
+        best = dataclasses.replace(best, heldout_rmse=heldout)
+        v = vd.judge(discrepancy, [best], T, [] if named else tied)
+        rk = NS(verdict=v, best=best, named=best if named else None)
+        return NS(discrepancy=discrepancy, c_hat=c_hat), rk
+
+    dec, rk = ranking(1.0)
+    assert rk.verdict.kind == "weak" and not locate.needed(dec, rk)
+    why = locate.library_explains(rk)
+    assert "explains the held-out data (1 floors" in why and f"{T.rms:.4g}" in why
+    dec, rk = ranking(T.rms * 1.5)                   # beyond the threshold: not explained
+    assert rk.verdict.kind == "not_explained" and locate.needed(dec, rk)
+    assert locate.library_explains(rk) is None
+    dec, rk = ranking(1.0, named=True, c_hat=3.0)    # named, misfit left: a second force?
+    assert rk.verdict.kind == "named" and locate.needed(dec, rk)
+    dec, rk = ranking(1.0, named=True)
+    assert not locate.needed(dec, rk)
+    dec, rk = ranking(T.rms * 1.5, discrepancy=False)
+    assert not locate.needed(dec, rk)
