@@ -118,7 +118,7 @@ def _clear_event_log(roots, solved):
     roots._i_cnt[:] = 0
 
 
-class _Routed(io.TextIOBase):
+class _Routed:
     """``sys.stdout`` while a solve runs: what a thread inside
     :func:`_caught_prints` writes goes to that thread's buffer, everything
     else to the stream it replaced (Dask threads solving in one process
@@ -136,7 +136,7 @@ class _Routed(io.TextIOBase):
         if getattr(self.local, "buf", None) is None:
             self.stream.flush()
 
-    def __getattr__(self, name):          # encoding, isatty, fileno, ... of the stream
+    def __getattr__(self, name):          # encoding, isatty, fileno, buffer, ... of the stream
         return getattr(self.stream, name)
 
 
