@@ -85,3 +85,14 @@ def test_a_run_that_succeeds_says_nothing_and_keeps_its_result(tmp_path, capfd):
                                                  backend="sundae")
     np.testing.assert_allclose(res["mass.s"][-1], np.cos(2.0), atol=1e-4)
     assert capfd.readouterr().out == ""
+
+
+def test_only_sundials_lines_are_kept_anything_else_is_passed_on(capsys):
+    """The residuals are generated code and print nothing, but a callback
+    that did would not be silenced: only SUNDIALS' lines are taken."""
+    text = ("\n[IDASolve, Error: -22] At t = 0.05, mxstep steps taken before reaching tout.\n\n"
+            "checking the law at 0.3\n[IDAHandleFailure, Error: -4] At t = 0.05 and h = 1e-15, "
+            "the corrector convergence failed repeatedly or with |h| = hmin.\n")
+    got = sundae._sundials_lines(text)
+    assert [g[:22] for g in got] == ["[IDASolve, Error: -22]", "[IDAHandleFailure, Err"]
+    assert capsys.readouterr().out.strip() == "checking the law at 0.3"

@@ -30,6 +30,7 @@ diagnosis or a sweep whose trial points fail print nothing.
 """
 import contextlib
 import io
+import re
 import sys
 import threading
 
@@ -84,7 +85,7 @@ class SundaeSolver(SegmentSolver):
         with _caught_prints() as said:
             sol = self.ida.solve(tspan, y, yp)
         message = str(sol.message)
-        lines = [ln.strip() for ln in said.getvalue().splitlines() if ln.strip()]
+        lines = _sundials_lines(said.getvalue())
         if lines and int(sol.status) < 0:
             message += " (SUNDIALS: " + "; ".join(dict.fromkeys(lines)) + ")"
         st, sy, syp = np.atleast_1d(sol.t), np.atleast_2d(sol.y), np.atleast_2d(sol.yp)
@@ -116,6 +117,22 @@ def _clear_event_log(roots, solved):
     for name in _EVENT_LOG:
         getattr(roots, name).clear()
     roots._i_cnt[:] = 0
+
+
+_SUNDIALS_LINE = re.compile(r"^\[\w+, Error: -?\d+\]")
+
+
+def _sundials_lines(text):
+    """SUNDIALS' lines in what a solve printed (``[IDASolve, Error: -22]
+    ...``); anything else (a model file's own ``print`` in a force law) is
+    written on to ``sys.stdout`` as it would have been."""
+    ours, other = [], []
+    for ln in text.splitlines(keepends=True):
+        (ours if _SUNDIALS_LINE.match(ln.strip()) else other).append(ln)
+    rest = "".join(other)
+    if rest.strip():
+        sys.stdout.write(rest)
+    return [ln.strip() for ln in ours]
 
 
 class _Routed:
