@@ -192,11 +192,15 @@ def needed(dec, rk) -> bool:
     named but the fit still leaves misfit beyond the instrument (is a second
     force left beside it?), or none is named and the library's best
     candidate does not explain the held-out data (:func:`library_explains`)."""
-    if not dec.discrepancy:
-        return False
-    if rk.named is not None:
-        return dec.c_hat > st.OVERDISPERSION
-    return library_explains(rk) is None
+    return skip_reason(dec, rk) is None
+
+
+def skip_reason(dec, rk) -> str | None:
+    """Why the stage is not run (:func:`needed`), or None when it runs."""
+    if not dec.discrepancy or rk.named is not None:
+        return None if dec.discrepancy and dec.c_hat > st.OVERDISPERSION else \
+            "not needed: no discrepancy, or a cause explains it"
+    return library_explains(rk)
 
 
 def library_explains(rk) -> str | None:
@@ -695,9 +699,9 @@ def _refined(nodes):
 def locate(ctx, problem, cal, dec, rk) -> Location:
     """Fit the generic term at every body node (module doc)."""
     import time
-    if not needed(dec, rk):
-        return Location(skipped=library_explains(rk) if dec.discrepancy and rk.named is None
-                        else "not needed: no discrepancy, or a cause explains it")
+    why = skip_reason(dec, rk)
+    if why is not None:
+        return Location(skipped=why)
     t0 = time.perf_counter()
     n = cal.fit.n
     fine = (gen.X_LADDER[-1], gen.V_LADDER[-1])
