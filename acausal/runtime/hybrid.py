@@ -658,7 +658,8 @@ class _Watch:
                 self.stopping = self._hard(count[0])
                 self._show(t)
                 if self.stopping:
-                    self._mute()   # IDA's message about the failure it is led into
+                    # IDA's message about the failure it is led into is caught
+                    # by the backend (backends.sundae), which prints nothing
                     r[:] = np.nan
                     return
             res(t, y, yp, r)
@@ -669,33 +670,6 @@ class _Watch:
                     fn(*args)
             return jac
         return cb._replace(res=checked, jac=jacobian(cb.jac), jac_csc=jacobian(cb.jac_csc))
-
-    def _mute(self):
-        """Send what C code prints (SUNDIALS writes its error lines to
-        stdout) to /dev/null until the call returns."""
-        self._saved_fds = []
-        try:
-            sys.stdout.flush()
-            sys.stderr.flush()
-            devnull = os.open(os.devnull, os.O_WRONLY)
-            for fd in (1, 2):
-                self._saved_fds.append((fd, os.dup(fd)))
-                os.dup2(devnull, fd)
-            os.close(devnull)
-        except (OSError, ValueError):
-            self._unmute()
-
-    def _unmute(self):
-        saved, self._saved_fds = getattr(self, "_saved_fds", []), []
-        if saved:
-            try:
-                import ctypes
-                ctypes.CDLL(None).fflush(None)   # C stdio buffers, into /dev/null
-            except (OSError, TypeError, AttributeError):
-                pass
-        for fd, copy in saved:
-            os.dup2(copy, fd)
-            os.close(copy)
 
     def _show(self, t):
         if self.bar is not None and t - self.run.t0 > self.bar.n:
@@ -743,7 +717,6 @@ class _Watch:
         try:
             return solver.solve(cb, d, float(tspan[0]), y, yp, tspan[1:], every_step)
         finally:
-            self._unmute()
             # no cycle solver -> watch -> run -> solver: the run's IDA handle
             # goes back to the backend's pool as soon as the run is dropped
             solver.guard = None
