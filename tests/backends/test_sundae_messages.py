@@ -12,16 +12,9 @@ import pytest
 
 from acausal import SolverError, compile_model
 from acausal.runtime.backends import sundae
+from tests.faults import helpers as h
 
-MODEL = """\
-from acausal import Experiment, Model
-from acausal.mechanics.translational import Force, Mass
-model = Model()
-model.mass = Mass(m=1.0, s=1.0, v=0.0)
-model.push = Force(f=lambda s: 1e3 * s**3)
-model.connect(model.push.flange, model.mass.flange)
-experiment = Experiment(t_end=1.0, output_step=1e-3)
-"""
+MODEL = h.CUBIC_BLOWUP
 
 
 def _fail(tmp_path):

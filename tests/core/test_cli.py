@@ -8,6 +8,7 @@ import pytest
 from click.testing import CliRunner
 
 from acausal.cli import main
+from tests.faults import helpers as h
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 EX = os.path.join(ROOT, "models", "examples")
@@ -126,15 +127,7 @@ def test_unconnected_flange_is_no_error(tmp_path):
 
 def test_solver_failure_exits_3_names_time_and_keeps_partial_results(tmp_path):
     # m s'' = 1e3 s^3 from s = 1: s blows up at a finite time (~0.056 s)
-    p = write(tmp_path, """\
-        from acausal import Experiment, Model
-        from acausal.mechanics.translational import Force, Mass
-        model = Model()
-        model.mass = Mass(m=1.0, s=1.0, v=0.0)
-        model.push = Force(f=lambda s: 1e3 * s**3)
-        model.connect(model.push.flange, model.mass.flange)
-        experiment = Experiment(t_end=1.0, output_step=1e-3)
-        """)
+    p = write(tmp_path, h.CUBIC_BLOWUP)
     out = tmp_path / "partial.csv"
     r = run("simulate", p, "--out", out)
     assert r.exit_code == 3, r.output

@@ -32,6 +32,18 @@ model.connect(model.k.flange_b, model.body.flange)
 """
 
 
+# m s'' = 1e3 s^3 from s = 1, at rest: s blows up at a finite time (about
+# 0.0586 s), where the solver fails: the model of the solver-failure tests
+CUBIC_BLOWUP = """\
+from acausal import Experiment, Model
+from acausal.mechanics.translational import Force, Mass
+model = Model()
+model.mass = Mass(m=1.0, s=1.0, v=0.0)
+model.push = Force(f=lambda s: 1e3 * s**3)
+model.connect(model.push.flange, model.mass.flange)
+experiment = Experiment(t_end=1.0, output_step=1e-3)
+"""
+
 # a mass on a spring driven by a force F (a condition of the data folders), k.c
 # free: the model file of the batteries' data, calibrate and sweep cases
 DRIVEN_SPRING = """\
