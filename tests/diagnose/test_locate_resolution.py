@@ -160,3 +160,44 @@ def test_term_beside_a_cause_builds_and_its_penalty_covers_only_the_weights():
     assert gen.members(cand) == (("coulomb_friction", "mass"), "mass", 9, 9)
     P, sc = penalty_of(cand)
     assert P.shape[1] == sc.size == 18 and np.all(sc == 0.25)
+
+
+def test_a_coarser_terms_linear_seed_is_the_finest_columns_seen_through_it():
+    """linear_seed on a model that is linear in everything (the residual is
+    y - H_fine w_fine - theta, so the finest spline's columns are exact):
+    for any free value and any coarser spline's weights, the seed's offset +
+    J x must give the residuals exactly, data rows and penalty rows (the
+    objective's P w / scale), whatever the scales of the weights and of the
+    free parameter, and the data rows it is judged on must be the residuals
+    at the point the columns were taken."""
+    from types import SimpleNamespace
+    from acausal.diagnose.problem import Candidate, Param
+    rng = np.random.default_rng(3)
+    s_w, s_f = 0.7, 0.3                      # the weights' and the free parameter's scales
+    nf_x, nf_v = gen.X_LADDER[-1], gen.V_LADDER[-1]
+    x = rng.uniform(-1, 1, 500)
+    v = rng.uniform(-2.5, 2.5, 500)
+    y = rng.normal(size=500)
+    Hx, Hv = gen.basis(RANGES, nf_x, nf_v, x, v)
+    H = np.hstack([Hx, Hv])
+
+    def residual(theta, w_fine):             # w_fine in the weights' own units
+        return y - H @ w_fine - theta
+
+    theta0, wf0 = 0.4, rng.normal(size=nf_x + nf_v)       # the columns' point (per scale)
+    cols = L.Columns(residual(theta0, wf0 * s_w), -H * s_w, -np.full((500, 1), s_f),
+                     ("E0",) * 500)
+    for n_x, n_v in ((9, 9), (17, 33), (nf_x, nf_v)):
+        P = gen.penalty(n_x, n_v, 3.0)
+        w = tuple(Param(f"gen.a{i}", 0.0, -9, 9, s_w, 0.0) for i in range(n_x)) + tuple(
+            Param(f"gen.b{j}", 0.0, -9, 9, s_w, 0.0) for j in range(n_v))
+        task = SimpleNamespace(free=(Param("k", theta0, -9, 9, s_f, theta0),),
+                               candidate=Candidate("generic_force", "mass", w, P))
+        seed = L.linear_seed(cols, task, [theta0], wf0, n_x, n_v)
+        assert np.array_equal(seed.r_ref, cols.r0)
+        T = L._transform(n_x, n_v, nf_x, nf_v)
+        for _ in range(3):
+            theta, wc = rng.normal(), rng.normal(size=n_x + n_v)   # wc in own units
+            want = np.concatenate([residual(theta, T @ wc), P @ (wc / s_w)])
+            got = seed.offset + seed.J @ np.concatenate([[theta], wc])
+            assert np.max(np.abs(got - want)) < 1e-10 * np.max(np.abs(want))

@@ -64,6 +64,7 @@ import numpy as np
 from . import stats as st
 from . import verdict as vd
 from .fitting import effective_k, heldout_rms, scaled_columns
+from ...studies.differences import LinearSeed
 from ..library import generic as gen
 from ..library.generic import GENERIC, N_V, N_X, SMOOTH, hats, penalty, shape
 from ..problem import Candidate, Param
@@ -328,36 +329,78 @@ def columns(task) -> Columns:
     """:class:`Columns` of ``task``'s candidate (worker side): forward
     differences, one simulation of every experiment per column. Never
     raises: a term that cannot be built or simulated gives ``error``."""
+    return column_part(ColumnPart(task, 0, 1))
+
+
+@dataclass(frozen=True)
+class ColumnPart:
+    """The ``part``-th of ``parts`` contiguous shares of ``task``'s columns
+    (the term's weights, then the free parameters): one task of a node's
+    columns split over idle workers (:func:`columns_of`)."""
+
+    task: FitTask
+    part: int
+    parts: int
+
+    def share(self):
+        """(the term's parameters, the free ones) of this share."""
+        every = list(self.task.candidate.params) + list(self.task.free)
+        lo, hi = (len(every) * self.part) // self.parts, (len(every) * (self.part + 1)) // self.parts
+        k = len(self.task.candidate.params)
+        return every[lo:min(hi, k)], every[max(lo, k):hi]
+
+    @property
+    def cost(self) -> float:
+        return float(sum(len(s) for s in self.share()) + 1)
+
+
+def column_part(part: ColumnPart) -> Columns:
+    """:class:`Columns` of one share of a node's columns (worker side): the
+    residuals at the base and the share's columns (``Jg`` and ``Jf`` hold
+    only the share's). Never raises (``error``)."""
     from .fitting import residuals_of
+    task = part.task
     p, cand = task.problem, task.candidate
+    mine_g, mine_f = part.share()
     base = {**{q.name: q.start for q in task.free}, **{q.name: q.start for q in cand.params}}
     try:
         ds, pair, b = dataset_of(p), model_of(p, cand), p.settings.integrator
         w0 = residuals_of(pair, ds, base, b)
         # no step backwards at an upper bound here (the term's weights start
         # at 0, far inside theirs); the residuals at the base are shared
-        r0, Jg = scaled_columns(pair, ds, base, cand.params, STEP, b, w0.vector, inside=False)
-        Jf = scaled_columns(pair, ds, base, task.free, STEP, b, r0, inside=False)[1]
+        r0, Jg = scaled_columns(pair, ds, base, mine_g, STEP, b, w0.vector, inside=False)
+        Jf = scaled_columns(pair, ds, base, mine_f, STEP, b, r0, inside=False)[1]
     except Exception as exc:  # noqa: BLE001 - reported with the node
         z = np.zeros(0)
         return Columns(z, np.zeros((0, 0)), np.zeros((0, 0)), (), 0,
                        f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}")
     n_exp = len(ds.experiments)
-    return Columns(r0, Jg, Jf, tuple(w0.groups),
-                   n_exp * (1 + len(cand.params) + len(task.free)))
+    return Columns(r0, Jg, Jf, tuple(w0.groups), n_exp * (1 + len(mine_g) + len(mine_f)))
 
 
-def pin_rows(task):
-    """Penalty rows pinning the generic term's degenerate directions (module
-    doc) at the calibrated free parameters and zero weights: the term's
-    and the free parameters' data Jacobians by forward differences, one
-    simulation of every experiment per column. Returns (rows, the term's
-    largest singular value); no rows when the term cannot be simulated."""
-    c = columns(task)
-    if c.error is not None:
-        return np.zeros((0, len(task.candidate.params))), 0.0
-    Q, s0 = degenerate_directions(c.Jg, c.Jf)
-    return PIN_WEIGHT * s0 * Q, s0
+def columns_of(ctx, tasks, desc) -> list:
+    """:func:`columns` of each task, on the workers. With fewer tasks than
+    workers (the re-choice's one node) each task's columns are split into
+    contiguous shares over the workers (:class:`ColumnPart`; each share
+    simulates the base once more) and joined again: the same columns, the
+    simulations run side by side instead of on one worker while the others
+    wait."""
+    workers = getattr(ctx.executor, "workers", None) or 1
+    k = max(1, workers // max(len(tasks), 1))
+    parts = [ColumnPart(t, i, k) for t in tasks for i in range(k)]
+    got = ctx.run(column_part, parts, desc, checkpoint=False)
+    out = []
+    for j in range(len(tasks)):
+        mine = got[j * k:(j + 1) * k]
+        bad = next((c for c in mine if c.error is not None), None)
+        n_sim = sum(c.n_sim for c in mine)
+        if bad is not None:
+            out.append(dataclasses.replace(bad, n_sim=n_sim))
+            continue
+        first = mine[0]
+        out.append(Columns(first.r0, np.hstack([c.Jg for c in mine]),
+                           np.hstack([c.Jf for c in mine]), first.groups, n_sim))
+    return out
 
 
 def at_rest_row(ranges, n_x=N_X, n_v=N_V):
@@ -416,6 +459,33 @@ def _transform(n_x, n_v, nf_x, nf_v):
     T[:nf_x, :n_x] = gen.refine_matrix(n_x, nf_x)
     T[nf_x:, n_x:] = gen.refine_matrix(n_v, nf_v)
     return T
+
+
+def linear_seed(c: Columns, task, theta, w_f, n_x, n_v) -> LinearSeed:
+    """The linear model of ``task``'s residuals (its free parameters, then
+    the term's ``n_x`` x ``n_v`` weights, in their own units; the penalty's
+    rows after the data's) from the finest spline's columns ``c`` taken at
+    the free parameters' values ``theta`` and the finest weights ``w_f``
+    (per unit of scale), ``c.r0`` the residuals there (not shifted): a
+    coarser spline is exactly a finer one (:func:`_transform`), so its
+    columns are the finer one's seen through it. A secant refinement of the
+    task uses it for its first Jacobian where it predicts the residuals
+    within the secant's trust (:class:`~acausal.studies.differences.SecantDifferences`):
+    one simulation of every experiment per parameter saved."""
+    nf_x, nf_v = gen.X_LADDER[-1], gen.V_LADDER[-1]
+    sc_f = np.array([abs(q.scale) or 1.0 for q in task.free])
+    theta = np.asarray(theta, float)
+    w_sc = np.array([abs(q.scale) or 1.0 for q in task.candidate.params])
+    Jw = (c.Jg @ _transform(n_x, n_v, nf_x, nf_v)) / w_sc[None, :]
+    J = np.hstack([c.Jf / sc_f[None, :], Jw])
+    offset = c.r0 - c.Jg @ np.asarray(w_f, float) - J[:, :sc_f.size] @ theta
+    pen = penalty_of(task.candidate)
+    if pen is not None:
+        P, psc = pen
+        Jp = np.zeros((P.shape[0], J.shape[1]))
+        Jp[:, J.shape[1] - P.shape[1]:] = P / psc[None, :]
+        J, offset = np.vstack([J, Jp]), np.concatenate([offset, np.zeros(P.shape[0])])
+    return LinearSeed(offset, J, np.asarray(c.r0, float))
 
 
 def _grams(X, r, groups):
@@ -714,8 +784,7 @@ def locate(ctx, problem, cal, dec, rk) -> Location:
     failed = {}
     n_sim = 0
     phases = {}
-    for nd, c in zip(nodes, ctx.run(columns, col_tasks, "locating: columns",
-                                    checkpoint=False)):
+    for nd, c in zip(nodes, columns_of(ctx, col_tasks, "locating: columns")):
         n_sim += c.n_sim
         if c.error is not None:
             failed[nd.cand.location] = c.error
@@ -732,6 +801,10 @@ def locate(ctx, problem, cal, dec, rk) -> Location:
     cands = [chosen_candidate(nd, graph, n) for nd in fitted]
     tasks = [_free_step(t, nd) for t, nd in zip(located_tasks(problem.one_start(), cal, cands),
                                                 fitted)]
+    # the whole record's first Jacobian from the columns at the calibrated point
+    tasks = [dataclasses.replace(t, jac_seed=linear_seed(
+        nd.cols, t, [q.start for q in t.free], np.zeros(nd.cols.Jg.shape[1]), nd.choice.n_x,
+        nd.choice.n_v)) for t, nd in zip(tasks, fitted)]
     phases["columns"] = n_sim
     results = ctx.run(fit_candidate, tasks, "locating")
     terms, fits = [], {}
@@ -802,13 +875,27 @@ class _Again:
     node: _Node | None = None     # the node at its new choice, when that won
 
 
-def _at_fit(ctx, problem, cal, node: _Node, r):
-    """(:class:`Columns` of the node's finest splines at the fit ``r``'s
-    point, the free parameters' offset there from their calibrated values,
-    per unit of scale). The columns' residuals
-    are shifted by the term's own part, r0 - Jg w, so that a resolution's
-    absolute weights enter the linear problem (a coarser spline need not
-    reproduce the fitted one)."""
+@dataclass
+class _AtFit:
+    """The finest splines' columns at a located fit's point (:func:`_at_fit`)."""
+
+    cols: Columns            # their residuals shifted by the term's own part, r0 - Jg w_f
+    r_fit: np.ndarray        # the residuals there (not shifted)
+    w_f: np.ndarray          # the fit's term as the finest spline's weights, per unit of scale
+    theta: np.ndarray        # the free parameters' values there
+    offset: np.ndarray       # ... their offsets from the calibrated values, per unit of scale
+
+    def seed(self, task, n_x, n_v) -> LinearSeed:
+        """:func:`linear_seed` of ``task`` (an ``n_x`` x ``n_v`` term) from these columns."""
+        return linear_seed(dataclasses.replace(self.cols, r0=self.r_fit), task, self.theta,
+                           self.w_f, n_x, n_v)
+
+
+def _at_fit(ctx, problem, cal, node: _Node, r) -> _AtFit:
+    """The node's finest splines' columns at the fit ``r``'s point. The
+    columns' residuals are shifted by the term's own part, r0 - Jg w, so
+    that a resolution's absolute weights enter the linear problem (a
+    coarser spline need not reproduce the fitted one)."""
     ch = node.choice
     nf_x, nf_v = gen.X_LADDER[-1], gen.V_LADDER[-1]
     coarse = [q for q in r.candidate.params if q.name.startswith(GENERIC.prefix + ".")]
@@ -821,11 +908,9 @@ def _at_fit(ctx, problem, cal, node: _Node, r):
     free = tuple(dataclasses.replace(q, start=float(r.fit.values[q.name])) for q in task.free)
     offset = np.array([(r.fit.values[q.name] - p.start) / (abs(p.scale) or 1.0)
                        for q, p in zip(free, task.free)])
-    c = ctx.run(columns, [dataclasses.replace(task, free=free)], "locating: columns at the fit",
-                checkpoint=False)[0]
-    if c.error is None:
-        c = dataclasses.replace(c, r0=c.r0 - c.Jg @ w_f)
-    return c, offset
+    c = columns_of(ctx, [dataclasses.replace(task, free=free)], "locating: columns at the fit")[0]
+    shifted = c if c.error is not None else dataclasses.replace(c, r0=c.r0 - c.Jg @ w_f)
+    return _AtFit(shifted, c.r0, w_f, np.array([q.start for q in free]), offset)
 
 
 def _rechoose(ctx, problem, cal, node: _Node, r, graph, c_hat) -> _Again:
@@ -851,7 +936,8 @@ def _rechoose(ctx, problem, cal, node: _Node, r, graph, c_hat) -> _Again:
     best_node = best_t = error = None
     cur_node, cur_r, n_sim, sims, stopped = node, r, 0, {}, None
     for _ in range(RECHOOSE):
-        c, offset = _at_fit(ctx, problem, cal, cur_node, cur_r)
+        at = _at_fit(ctx, problem, cal, cur_node, cur_r)
+        c, offset = at.cols, at.offset
         n_sim += c.n_sim
         if c.error is not None:
             error = c.error
@@ -875,6 +961,9 @@ def _rechoose(ctx, problem, cal, node: _Node, r, graph, c_hat) -> _Again:
         # where a first window could only lead away (Problem.from_fit)
         task = _free_step(located_tasks(problem.from_fit(), cal,
                                         [chosen_candidate(new, graph, n)])[0], new)
+        # its first Jacobian from these columns (they are exact at the fit's
+        # point; the secant's trust test judges them at the refit's start)
+        task = dataclasses.replace(task, jac_seed=at.seed(task, ch.n_x, ch.n_v))
         got = ctx.run(fit_candidate, [task], "locating again")[0]
         used = got.fit.n_sim if got.fit is not None else 0
         n_sim += used
