@@ -277,16 +277,12 @@ def score_starts(obj, starts, lo, hi, absorb=None):
     return sorted(out, key=lambda cx: cx[0])
 
 
-def refine(obj, x_start, lo, hi, sc, max_nfev, tol, seed=None):
+def refine(obj, x_start, lo, hi, sc, max_nfev, tol):
     """Trust-region least squares (scipy, bounded, on value/scale) from
     ``x_start`` with forward differences of a step FD_STEP of each scale,
     or with the Jacobian from forward sensitivities when ``obj.jacobian`` is
     "sensitivities" (:class:`acausal.calibrate.SensitivityJacobian`: the
-    differences answer where a sensitivity run fails), or with Broyden
-    updates between differences when it is "secant"
-    (:class:`~acausal.studies.differences.SecantDifferences`; ``seed``, a
-    :class:`~acausal.studies.differences.LinearSeed`, may stand for its
-    first differences).
+    differences answer where a sensitivity run fails).
     Returns (x, jacobian in parameter units, ok, message); when the budget
     runs out the best point seen is kept and the Jacobian taken there."""
     fd = ForwardDifferences(lambda z: obj(z * sc), FD_STEP, hi / sc)
@@ -297,7 +293,7 @@ def refine(obj, x_start, lo, hi, sc, max_nfev, tol, seed=None):
         jac = SensitivityJacobian(obj.jac_x, lambda z: z * sc, lambda z: sc, fd).jac
     elif kind == "secant":
         from ...studies.differences import SecantDifferences
-        secant = SecantDifferences(fd, seed=seed, sc=sc)
+        secant = SecantDifferences(fd)
         jac = secant.jac
     obj.best_cost, obj.best_x = np.inf, None
     try:
@@ -355,11 +351,11 @@ def fit(model, dataset, params, *, fixed=None, starts=None, absorb=None, budget=
                                        refinement.tol), lo)
 
 
-def refine_or_keep(obj, x, lo, hi, sc, max_nfev, tol, seed=None):
+def refine_or_keep(obj, x, lo, hi, sc, max_nfev, tol):
     """:func:`refine` when there is something to fit, else the start."""
     if not obj.names:
         return x, np.zeros((0, 0)), True, ""
-    return refine(obj, x, lo, hi, sc, max_nfev, tol, seed)
+    return refine(obj, x, lo, hi, sc, max_nfev, tol)
 
 
 def failed_fit(names, x0, obj, message):

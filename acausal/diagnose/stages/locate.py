@@ -64,7 +64,6 @@ import numpy as np
 from . import stats as st
 from . import verdict as vd
 from .fitting import effective_k, heldout_rms, scaled_columns
-from ...studies.differences import LinearSeed
 from ..library import generic as gen
 from ..library.generic import GENERIC, N_V, N_X, SMOOTH, hats, penalty, shape
 from ..problem import Candidate, Param
@@ -461,33 +460,6 @@ def _transform(n_x, n_v, nf_x, nf_v):
     return T
 
 
-def linear_seed(c: Columns, task, theta, w_f, n_x, n_v) -> LinearSeed:
-    """The linear model of ``task``'s residuals (its free parameters, then
-    the term's ``n_x`` x ``n_v`` weights, in their own units; the penalty's
-    rows after the data's) from the finest spline's columns ``c`` taken at
-    the free parameters' values ``theta`` and the finest weights ``w_f``
-    (per unit of scale), ``c.r0`` the residuals there (not shifted): a
-    coarser spline is exactly a finer one (:func:`_transform`), so its
-    columns are the finer one's seen through it. A secant refinement of the
-    task uses it for its first Jacobian where it predicts the residuals
-    within the secant's trust (:class:`~acausal.studies.differences.SecantDifferences`):
-    one simulation of every experiment per parameter saved."""
-    nf_x, nf_v = gen.X_LADDER[-1], gen.V_LADDER[-1]
-    sc_f = np.array([abs(q.scale) or 1.0 for q in task.free])
-    theta = np.asarray(theta, float)
-    w_sc = np.array([abs(q.scale) or 1.0 for q in task.candidate.params])
-    Jw = (c.Jg @ _transform(n_x, n_v, nf_x, nf_v)) / w_sc[None, :]
-    J = np.hstack([c.Jf / sc_f[None, :], Jw])
-    offset = c.r0 - c.Jg @ np.asarray(w_f, float) - J[:, :sc_f.size] @ theta
-    pen = penalty_of(task.candidate)
-    if pen is not None:
-        P, psc = pen
-        Jp = np.zeros((P.shape[0], J.shape[1]))
-        Jp[:, J.shape[1] - P.shape[1]:] = P / psc[None, :]
-        J, offset = np.vstack([J, Jp]), np.concatenate([offset, np.zeros(P.shape[0])])
-    return LinearSeed(offset, J, np.asarray(c.r0, float))
-
-
 def _grams(X, r, groups):
     """Per experiment: (X_g'X_g, X_g'r_g, r_g'r_g)."""
     g = np.asarray(groups)
@@ -801,10 +773,6 @@ def locate(ctx, problem, cal, dec, rk) -> Location:
     cands = [chosen_candidate(nd, graph, n) for nd in fitted]
     tasks = [_free_step(t, nd) for t, nd in zip(located_tasks(problem.one_start(), cal, cands),
                                                 fitted)]
-    # the whole record's first Jacobian from the columns at the calibrated point
-    tasks = [dataclasses.replace(t, jac_seed=linear_seed(
-        nd.cols, t, [q.start for q in t.free], np.zeros(nd.cols.Jg.shape[1]), nd.choice.n_x,
-        nd.choice.n_v)) for t, nd in zip(tasks, fitted)]
     phases["columns"] = n_sim
     results = ctx.run(fit_candidate, tasks, "locating")
     terms, fits = [], {}
@@ -875,27 +843,13 @@ class _Again:
     node: _Node | None = None     # the node at its new choice, when that won
 
 
-@dataclass
-class _AtFit:
-    """The finest splines' columns at a located fit's point (:func:`_at_fit`)."""
-
-    cols: Columns            # their residuals shifted by the term's own part, r0 - Jg w_f
-    r_fit: np.ndarray        # the residuals there (not shifted)
-    w_f: np.ndarray          # the fit's term as the finest spline's weights, per unit of scale
-    theta: np.ndarray        # the free parameters' values there
-    offset: np.ndarray       # ... their offsets from the calibrated values, per unit of scale
-
-    def seed(self, task, n_x, n_v) -> LinearSeed:
-        """:func:`linear_seed` of ``task`` (an ``n_x`` x ``n_v`` term) from these columns."""
-        return linear_seed(dataclasses.replace(self.cols, r0=self.r_fit), task, self.theta,
-                           self.w_f, n_x, n_v)
-
-
-def _at_fit(ctx, problem, cal, node: _Node, r) -> _AtFit:
-    """The node's finest splines' columns at the fit ``r``'s point. The
-    columns' residuals are shifted by the term's own part, r0 - Jg w, so
-    that a resolution's absolute weights enter the linear problem (a
-    coarser spline need not reproduce the fitted one)."""
+def _at_fit(ctx, problem, cal, node: _Node, r):
+    """(:class:`Columns` of the node's finest splines at the fit ``r``'s
+    point, the free parameters' offset there from their calibrated values,
+    per unit of scale). The columns' residuals
+    are shifted by the term's own part, r0 - Jg w, so that a resolution's
+    absolute weights enter the linear problem (a coarser spline need not
+    reproduce the fitted one)."""
     ch = node.choice
     nf_x, nf_v = gen.X_LADDER[-1], gen.V_LADDER[-1]
     coarse = [q for q in r.candidate.params if q.name.startswith(GENERIC.prefix + ".")]
@@ -909,8 +863,9 @@ def _at_fit(ctx, problem, cal, node: _Node, r) -> _AtFit:
     offset = np.array([(r.fit.values[q.name] - p.start) / (abs(p.scale) or 1.0)
                        for q, p in zip(free, task.free)])
     c = columns_of(ctx, [dataclasses.replace(task, free=free)], "locating: columns at the fit")[0]
-    shifted = c if c.error is not None else dataclasses.replace(c, r0=c.r0 - c.Jg @ w_f)
-    return _AtFit(shifted, c.r0, w_f, np.array([q.start for q in free]), offset)
+    if c.error is None:
+        c = dataclasses.replace(c, r0=c.r0 - c.Jg @ w_f)
+    return c, offset
 
 
 def _rechoose(ctx, problem, cal, node: _Node, r, graph, c_hat) -> _Again:
@@ -936,8 +891,7 @@ def _rechoose(ctx, problem, cal, node: _Node, r, graph, c_hat) -> _Again:
     best_node = best_t = error = None
     cur_node, cur_r, n_sim, sims, stopped = node, r, 0, {}, None
     for _ in range(RECHOOSE):
-        at = _at_fit(ctx, problem, cal, cur_node, cur_r)
-        c, offset = at.cols, at.offset
+        c, offset = _at_fit(ctx, problem, cal, cur_node, cur_r)
         n_sim += c.n_sim
         if c.error is not None:
             error = c.error
@@ -961,9 +915,6 @@ def _rechoose(ctx, problem, cal, node: _Node, r, graph, c_hat) -> _Again:
         # where a first window could only lead away (Problem.from_fit)
         task = _free_step(located_tasks(problem.from_fit(), cal,
                                         [chosen_candidate(new, graph, n)])[0], new)
-        # its first Jacobian from these columns (they are exact at the fit's
-        # point; the secant's trust test judges them at the refit's start)
-        task = dataclasses.replace(task, jac_seed=at.seed(task, ch.n_x, ch.n_v))
         got = ctx.run(fit_candidate, [task], "locating again")[0]
         used = got.fit.n_sim if got.fit is not None else 0
         n_sim += used

@@ -33,7 +33,6 @@ from ...data import Dataset, MeasuredExperiment, Trace
 from ...data.thinning import MAX_TRACE_SAMPLES, MIN_TRACE_SAMPLES, thin_traces  # noqa: F401
 from ...infra.executor import worker_cache
 from ...modelfile import compile_file
-from ...studies.differences import LinearSeed
 from ...studies.residuals import subset
 from .fitting import Budget, Fit, Objective, failed_fit, finish, linear_loo, penalty_cost, \
     refine_or_keep, residuals_of, score_starts
@@ -62,7 +61,6 @@ class FitTask:
     budget_s: float | None = None
     seed_free: tuple | None = None   # free values that go with a seeded start (a step's)
     floors: tuple = ()               # points the fit ends no higher than (a pair's members)
-    jac_seed: LinearSeed | None = None   # a first Jacobian on the whole record (secant)
 
     @property
     def cost(self) -> float:
@@ -300,7 +298,7 @@ def _multistart(task: FitTask):
         return failed_fit(names, pts[0][0], obj, "every starting point failed"), Starts()
     picked = _pick(scored, len(cand.params), sc, s.refine)
     refiner = Refiner(pair, ds, names, lo, hi, sc, _windows(ds, s), s, task.budget_s,
-                      penalty_of(cand), task.jac_seed)
+                      penalty_of(cand))
     fits = refiner.all([x for _, x in picked])
     floors = [np.asarray(x, float) for x in task.floors]
     best = min(fits, key=lambda f: f.cost)
@@ -419,7 +417,6 @@ class Refiner:
     settings: object
     budget_s: float | None = None
     penalty: object = None
-    seed: LinearSeed | None = None    # may stand for a first Jacobian on the whole record
 
     def window_fit(self, w, x, targets=()):
         """(fit on window ``w`` from ``x``, index of the ``targets`` fit it
@@ -434,8 +431,7 @@ class Refiner:
         obj.watch = self._watch(targets, tols) if targets else None
         try:
             fit = finish(obj, *refine_or_keep(obj, x, self.lo, self.hi, self.sc, s.max_nfev,
-                                              s.tol, self.seed if w >= 1.0 else None),
-                         self.lo)
+                                              s.tol), self.lo)
         except _Met as met:
             return None, met.index, obj.n_sim
         met = next((j for j, (t, tol) in enumerate(zip(targets, tols)) if same_point(
