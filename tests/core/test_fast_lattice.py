@@ -1,4 +1,4 @@
-"""FastMax and FastAbs (acausal.lang.symbols): sympy's Max and Abs built
+"""FastMax, FastMin and FastAbs (acausal.lang.symbols): sympy's Max and Abs built
 without the symbolic reduction of their arguments. They must print,
 differentiate, pickle and evaluate exactly as Max and Abs do, and a
 number-only call must give the number. Compared against sympy's own
@@ -12,7 +12,7 @@ from sympy.printing.c import C99CodePrinter
 from sympy.printing.pycode import PythonCodePrinter
 
 from acausal.lang.fastdiff import diff
-from acausal.lang.symbols import FastAbs, FastMax
+from acausal.lang.symbols import FastAbs, FastMax, FastMin
 
 x, c, h = sp.symbols("body.s x_lo h")
 
@@ -61,3 +61,27 @@ def test_a_pickled_term_comes_back_equal_and_of_its_class():
     assert back == terms
     assert {type(a) for b in back for a in sp.preorder_traversal(b)
             if isinstance(a, (sp.Max, sp.Abs))} == {FastMax, FastAbs}
+
+
+def clip(mx, mn, u):
+    return mn(mx(u, -1), 1)
+
+
+def test_fast_min_is_min():
+    """FastMin, as the loop's clipped cosine uses it: numbers evaluate, a
+    symbolic clip stays as written, and values, C and Python printing and
+    the derivative are sympy's Min's."""
+    assert FastMin(1, 3, 2) == 1 and isinstance(FastMin(1, 3), sp.Integer)
+    u = (x - c) / h
+    e, ref = clip(FastMax, FastMin, u), clip(sp.Max, sp.Min, u)
+    assert type(e) is FastMin and "fmin(" in C99CodePrinter().doprint(e)
+    assert "min(" in PythonCodePrinter().doprint(e)
+    f, g = sp.lambdify((x, c, h), e, "numpy"), sp.lambdify((x, c, h), ref, "numpy")
+    xs = np.linspace(-0.2, 0.8, 401)
+    np.testing.assert_array_equal(f(xs, 0.3, 0.05), g(xs, 0.3, 0.05))
+    for at in (0.2, 0.29, 0.31, 0.4):
+        vals = {x: at, c: 0.3, h: 0.05}
+        assert float(diff(e, x).xreplace(vals)) == pytest.approx(
+            float(diff(ref, x).xreplace(vals)), abs=1e-12)
+    back = pickle.loads(pickle.dumps(e))
+    assert back == e and type(back) is FastMin

@@ -67,6 +67,7 @@ import numpy as np
 import sympy as sp
 
 from ...lang import Model
+from ...lang.symbols import FastMax, FastMin
 from ...runtime.model import compile_model
 from ...errors import ModelError
 from ...modelfile import load_model_file
@@ -836,7 +837,7 @@ def _parallel_force(model, hyp, name, spring, d, force):
 
 
 def _clip(u, w):
-    return sp.Max(-w, sp.Min(w, u))
+    return FastMax(-w, FastMin(w, u))
 
 
 class BilinearSpring(HardeningSpring):

@@ -35,6 +35,7 @@ import math
 import sympy as sp
 
 from acausal.lang import Model, guess
+from acausal.lang.symbols import FastMax, FastMin
 from acausal.errors import ParameterError
 
 from .joints import Revolute
@@ -66,7 +67,9 @@ def fourbar_assembly(theta_a, mode=1, lib=math, **g):
         if abs(cos_l) > 1:
             return None
     else:
-        cos_l = sp.Min(sp.Max((d**2 + g["b"]**2 - g["c"]**2) / (2 * g["b"] * d), -1), 1)
+        # built as written (FastMax/FastMin): sympy's Min/Max reduce their
+        # arguments again at every xreplace of these start guesses
+        cos_l = FastMin(FastMax((d**2 + g["b"]**2 - g["c"]**2) / (2 * g["b"] * d), -1), 1)
     ub = lib.atan2(dy, dx) + mode * lib.acos(cos_l)            # rocker direction (world)
     cx, cy = g["b"] * lib.cos(ub), g["b"] * lib.sin(ub)         # C - B
     uc = lib.atan2(dy - cy, dx - cx)                            # coupler direction C -> D
