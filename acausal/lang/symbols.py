@@ -84,9 +84,9 @@ class FastMin(sp.Min):
         return sp.Min.__new__(cls, *args, **assumptions)
 
 
-# sympy's code printers look ``Max`` and ``Abs`` up by the class's ``__name__``
+# sympy's code printers look ``Max``, ``Min`` and ``Abs`` up by the class's ``__name__``
 # (Python's ``known_functions``, numpy's, C's ``fmax``, ``fabs``); pickling
-# finds the classes by their ``__qualname__``, which stays FastMax, FastAbs
+# finds the classes by their ``__qualname__``, which stays FastMax, FastAbs, FastMin
 FastMax.__name__ = "Max"
 FastAbs.__name__ = "Abs"
 FastMin.__name__ = "Min"
