@@ -152,11 +152,21 @@ def main(argv=None):
     labels = sorted({json.loads(l).get("label", "") for l in log.read_text().splitlines()})
     every = [json.loads(l) for l in log.read_text().splitlines()]
     with open(a.out, "w") as fh:
-        fh.write(HEADER)
+        # the header names the log the rows came from
+        fh.write(HEADER.replace("`docs/independent_cases.jsonl`", f"`{_shown(log)}`"))
         for lab in labels:
             fh.write(table([r for r in every if r.get("label", "") == lab],
                            f"\n### {lab or 'runs'}\n"))
     return 0
+
+
+def _shown(path):
+    """``path`` relative to the repository when inside it."""
+    p = Path(path).resolve()
+    try:
+        return str(p.relative_to(HERE.parent))
+    except ValueError:
+        return str(p)
 
 
 HEADER = """# Independent blind cases (issue 24, item 7)
