@@ -207,6 +207,14 @@ class PartialFrictionModes(Component):
         """Locked after the start (Unknown is locked only until initial_mode)."""
         return Rel(self.mode, STUCK) & Rel(self.startForward, 0) & Rel(self.startBackward, 0)
 
+    def _locked_now(self, state):
+        """:meth:`_locked_condition` at an event's ``state``, from the numbers
+        (the action runs at every event of every element: building the sympy
+        condition and substituting into it was half of a stick-slip pair
+        model's simulation time)."""
+        return bool(state[self.mode] == STUCK and state[self.startForward] == 0
+                    and state[self.startBackward] == 0)
+
     def _friction_elements(self):
         """Every friction element of the model this one belongs to, in the
         model's order."""
@@ -357,12 +365,12 @@ class PartialFrictionModes(Component):
         them (in the model's order) stays locked, and this one starts to
         slide in the direction of its share of the load (at once if the
         velocity allows, else waiting, as after a break-away)."""
-        if not _true(state, self._locked_condition()):
+        if not self._locked_now(state):
             return
         for other in self._friction_elements():
             if other is self:
                 return                            # none before this one holds the same motion
-            if _true(state, other._locked_condition()) and self._coupled(state, other):
+            if other._locked_now(state) and self._coupled(state, other):
                 share = _value(state, self.sa)
                 self._act_break(1 if share >= 0 else -1)(state)
                 return
