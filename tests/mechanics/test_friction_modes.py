@@ -495,3 +495,23 @@ def test_stops_without_room_are_one_clear_line():
     with pytest.raises(ParameterError, match=r"m: the stops leave no room") as exc:
         compile_model(model).simulate(t_end=0.1)
     assert "\n" not in str(exc.value)
+
+
+def test_the_locked_test_from_numbers_is_the_sympy_condition():
+    """The coupled-lock action reads "locked" from the event's numbers
+    (``_locked_now``, run at every event of every element); it must agree
+    with the mode machine's own sympy condition (``_locked_condition``) on
+    every discrete state, including the start's Unknown and a start in
+    progress."""
+    from acausal.mechanics.frictionmodes import (BACKWARD, FORWARD, FREE, STUCK, UNKNOWN,
+                                                 _true)
+    m = Model()
+    m.bf = rot.BearingFriction(tau_pos=[[0.0, 1.0]])
+    el = m.bf
+    for mode in (UNKNOWN, FREE, FORWARD, STUCK, BACKWARD):
+        for sf in (0, 1):
+            for sb in (0, 1):
+                state = {el.mode: float(mode), el.startForward: float(sf),
+                         el.startBackward: float(sb)}
+                assert el._locked_now(state) == _true(state, el._locked_condition()), \
+                    (mode, sf, sb)
