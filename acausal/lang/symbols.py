@@ -34,6 +34,19 @@ def Eq(lhs, rhs=0, evaluate=False):
     return sp.Eq(lhs, rhs, evaluate=evaluate)
 
 
+def _as_written(base):
+    """The ``__new__`` of a subclass of sympy's ``base`` (``Max``, ``Min``)
+    built as written: ``base`` itself (its number) when every argument is a
+    number, otherwise the subclass's node without ``base``'s evaluation."""
+    def __new__(cls, *args, **assumptions):
+        args = [sp.sympify(a) for a in args]
+        if all(a.is_number for a in args):
+            return base(*args)
+        assumptions["evaluate"] = False
+        return base.__new__(cls, *args, **assumptions)
+    return __new__
+
+
 class FastMax(sp.Max):
     """``max(a, b, ...)`` as sympy's ``Max``, built without its symbolic
     reduction of the arguments (``Max(0, u)`` tries to prove ``u >= 0`` and
@@ -47,12 +60,7 @@ class FastMax(sp.Max):
     differentiated and evaluated as ``Max`` (a subclass: the printers and
     :func:`.fastdiff.diff` dispatch on it)."""
 
-    def __new__(cls, *args, **assumptions):
-        args = [sp.sympify(a) for a in args]
-        if all(a.is_number for a in args):
-            return sp.Max(*args)
-        assumptions["evaluate"] = False
-        return sp.Max.__new__(cls, *args, **assumptions)
+    __new__ = _as_written(sp.Max)
 
 
 class FastAbs(sp.Abs):
@@ -76,12 +84,7 @@ class FastMin(sp.Min):
     in sympy's ``Max``/``Min`` reduction at every ``xreplace``. With numbers
     for every argument it is sympy's ``Min`` (a number)."""
 
-    def __new__(cls, *args, **assumptions):
-        args = [sp.sympify(a) for a in args]
-        if all(a.is_number for a in args):
-            return sp.Min(*args)
-        assumptions["evaluate"] = False
-        return sp.Min.__new__(cls, *args, **assumptions)
+    __new__ = _as_written(sp.Min)
 
 
 # sympy's code printers look ``Max``, ``Min`` and ``Abs`` up by the class's ``__name__``
