@@ -45,7 +45,7 @@ def task(tmp_path_factory):
 
 @pytest.mark.parametrize("workers", [2, 3, 5])
 def test_split_columns_are_the_columns_of_one_task(task, workers):
-    whole = L.columns(task)
+    whole = L.column_part(L.ColumnPart(task, 0, 1))
     assert whole.error is None and whole.Jg.shape[1] == 18 and whole.Jf.shape[1] == 2
     with open_executor("serial") as ex:
         ex.workers = workers                      # as a pool of that many would say
@@ -60,7 +60,7 @@ def test_two_tasks_on_two_workers_are_not_split(task):
     with open_executor("serial") as ex:
         ex.workers = 2
         got = L.columns_of(_Ctx(ex), [task, task], "test")
-    whole = L.columns(task)
+    whole = L.column_part(L.ColumnPart(task, 0, 1))
     assert all(g.n_sim == whole.n_sim and np.array_equal(g.Jg, whole.Jg) for g in got)
 
 

@@ -324,13 +324,6 @@ class Columns:
     error: str | None = None
 
 
-def columns(task) -> Columns:
-    """:class:`Columns` of ``task``'s candidate (worker side): forward
-    differences, one simulation of every experiment per column. Never
-    raises: a term that cannot be built or simulated gives ``error``."""
-    return column_part(ColumnPart(task, 0, 1))
-
-
 @dataclass(frozen=True)
 class ColumnPart:
     """The ``part``-th of ``parts`` contiguous shares of ``task``'s columns
@@ -354,9 +347,11 @@ class ColumnPart:
 
 
 def column_part(part: ColumnPart) -> Columns:
-    """:class:`Columns` of one share of a node's columns (worker side): the
+    """:class:`Columns` of one share of a node's columns (worker side):
+    forward differences, one simulation of every experiment per column, the
     residuals at the base and the share's columns (``Jg`` and ``Jf`` hold
-    only the share's). Never raises (``error``)."""
+    only the share's; ``ColumnPart(task, 0, 1)`` is all of them). Never
+    raises: a term that cannot be built or simulated gives ``error``."""
     from .fitting import residuals_of
     task = part.task
     p, cand = task.problem, task.candidate
@@ -378,9 +373,9 @@ def column_part(part: ColumnPart) -> Columns:
 
 
 def columns_of(ctx, tasks, desc) -> list:
-    """:func:`columns` of each task, on the workers. With fewer tasks than
-    workers (the re-choice's one node) each task's columns are split into
-    contiguous shares over the workers (:class:`ColumnPart`; each share
+    """:class:`Columns` of each task's candidate, on the workers. With fewer
+    tasks than workers (the re-choice's one node) each task's columns are
+    split into contiguous shares over the workers (:class:`ColumnPart`; each share
     simulates the base once more) and joined again: the same columns, the
     simulations run side by side instead of on one worker while the others
     wait."""
