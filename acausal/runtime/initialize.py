@@ -21,7 +21,7 @@ import sympy as sp
 from scipy.optimize import least_squares
 
 from . import linalg
-from .linalg import choose_guesses, event_matrix, jacobians, newton, solve_square
+from .linalg import SquareSolver, choose_guesses, event_matrix, jacobians, newton
 from ..infra.blas import single_threaded
 from ..compiler.codegen import Triplets
 from ..errors import InitializationError
@@ -451,12 +451,13 @@ def _reinitialize(cm, cb, t, y, yp):
     yp = np.array(yp, dtype=float)
     z = np.concatenate([y[ns:], yp[:ns]])
     converged, last = False, np.inf
+    solve = SquareSolver()
     for _ in range(50):
         cb.res(t, y, yp, r)
         if not r.any():
             break                     # exact: a further solve only adds round-off
         J, _ = event_matrix(cb, t, y, yp, ns)
-        dz = solve_square(J, -r)
+        dz = solve(J, -r)
         size = float(np.max(np.abs(dz))) if dz.size else 0.0
         if converged and not size < last:
             break                     # refined to the round-off floor
@@ -468,10 +469,10 @@ def _reinitialize(cm, cb, t, y, yp):
         # is an exact zero)
         converged = converged or bool(np.all(np.abs(dz) <= 1e-12 * (1 + np.abs(z))))
         last = size
-    return y, _algebraic_rates(cm, cb, t, y, yp)
+    return y, _algebraic_rates(cm, cb, t, y, yp, solve)
 
 
-def _algebraic_rates(cm, cb, t, y, yp):
+def _algebraic_rates(cm, cb, t, y, yp, solve):
     """Fill y' of the algebraic slots with their true rates.
 
     IDA keeps every component, algebraic ones too, in its BDF history and
@@ -480,7 +481,9 @@ def _algebraic_rates(cm, cb, t, y, yp):
     which fails the error test down to the minimum step at tight tolerances.
     Differentiating F(t, y, y') = 0 once along the solution gives
     ``[F_y(alg) F_y'(states)] [y'_alg; y''_states] = -(F_t + F_y(states) y'_states)``:
-    the same matrix as the re-initialisation. F_t by a central difference.
+    the same matrix as the re-initialisation (``solve``, the
+    re-initialisation's :class:`~acausal.runtime.linalg.SquareSolver`).
+    F_t by a central difference.
     """
     dae = cm.dae
     n, ns = len(dae.y), dae.n_states
@@ -495,7 +498,7 @@ def _algebraic_rates(cm, cb, t, y, yp):
     cb.res(t - dt, y, yp, rm)
     cb.count[:] = saved     # these are not solver step attempts
     rhs = -((rp - rm) / (2 * dt) + Jy_states @ yp[:ns])
-    sol = solve_square(J, rhs)
+    sol = solve(J, rhs)
     if np.all(np.isfinite(sol)):
         yp[ns:] = sol[:n - ns]
     return yp

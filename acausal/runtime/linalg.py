@@ -162,15 +162,48 @@ def event_matrix(cb, t, y, yp, ns):
 def solve_square(J, b):
     """``J x = b`` for a square dense or sparse ``J`` (LU); least squares
     when the LU finds it singular."""
-    if sps.issparse(J):
+    return SquareSolver()(J, b)
+
+
+class SquareSolver:
+    """``J x = b`` as :func:`solve_square`, for a run of matrices that
+    often repeat: the Newton iterations of one event's re-initialisation
+    and the algebraic rates after it. At a stuck friction element that
+    matrix is singular by structure, and the LU fails at every iteration
+    before least squares answers. A matrix equal to the last one whose LU
+    failed goes to least squares at once: its LU would fail again, so the
+    answer is the same, bit for bit, without the failed factorisation."""
+
+    def __init__(self):
+        self._singular = None
+
+    def __call__(self, J, b):
+        if self._singular is not None and _same_matrix(J, self._singular):
+            return _least_squares(J, b)
+        if sps.issparse(J):
+            try:
+                x = scipy.sparse.linalg.splu(J).solve(b)
+                if np.all(np.isfinite(x)):
+                    return x
+            except RuntimeError:      # "Factor is exactly singular"
+                pass
         try:
-            x = scipy.sparse.linalg.splu(J).solve(b)
-            if np.all(np.isfinite(x)):
-                return x
-        except RuntimeError:      # "Factor is exactly singular"
-            pass
-        J = J.toarray()
-    try:
-        return scipy.linalg.solve(J, b)
-    except (scipy.linalg.LinAlgError, ValueError):
-        return np.linalg.lstsq(J, b, rcond=None)[0]
+            return scipy.linalg.solve(J.toarray() if sps.issparse(J) else J, b)
+        except (scipy.linalg.LinAlgError, ValueError):
+            self._singular = J.copy()
+            return _least_squares(J, b)
+
+
+def _least_squares(J, b):
+    """The minimum-norm least-squares solution of ``J x = b`` (dense)."""
+    return np.linalg.lstsq(J.toarray() if sps.issparse(J) else J, b, rcond=None)[0]
+
+
+def _same_matrix(J, K):
+    """Whether ``J`` and ``K`` hold the same numbers in the same storage
+    kind (dense or sparse)."""
+    if J.shape != K.shape:
+        return False
+    if sps.issparse(J) or sps.issparse(K):
+        return sps.issparse(J) and sps.issparse(K) and (J != K).nnz == 0
+    return np.array_equal(J, K)

@@ -71,7 +71,7 @@ from ..compiler.codegen import Sparsity, generate, load, root_gradients
 from ..errors import ModelError, UsageError
 from ..infra import store
 from ..lang.fastdiff import diff
-from .linalg import solve_square
+from .linalg import SquareSolver
 
 # compiled model -> {names: SensitivityModel}: the runtime's cache of them
 _models = weakref.WeakKeyDictionary()
@@ -253,10 +253,11 @@ class SensitivityModel:
             J = J.toarray()
         J0 = J[np.ix_(rows[0], cols[0])]
         x = np.empty_like(b)
-        x0 = solve_square(J0, b[rows[0]])
+        solve = SquareSolver()
+        x0 = solve(J0, b[rows[0]])
         x[cols[0]] = x0
         c0 = J[:, cols[0]] @ x0
-        X = solve_square(J0, np.column_stack([b[r] - c0[r] for r in rows[1:]]))
+        X = solve(J0, np.column_stack([b[r] - c0[r] for r in rows[1:]]))
         for j, c in enumerate(cols[1:]):
             x[c] = X[:, j]
         return x
