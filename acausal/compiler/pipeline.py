@@ -39,23 +39,28 @@ def compile_artefact(model, cache=True):
     entry = compile_cache.load(key) if key is not None else None
     hit = entry is not None
     if entry is None:
-        entry, code = _compile(model, flat, stage_s, key)
+        # the code generator's resolver becomes the artefact's: what it
+        # resolved (every event condition) is not resolved again for the C code
+        entry, code, resolve = _compile(model, flat, stage_s, key)
         if key is not None:
             compile_cache.save(entry)
     else:
         make, fixjac = load_generated(entry.source)
         code = Generated(entry.source, make, fixjac, entry.sparsity)
+        resolve = None
     parameters = ParameterSpace.of(flat, entry.reduced.param_subs)
     disc_syms = [d.symbol for d in flat.discretes.values()]
+    if resolve is None:
+        resolve = Resolver.of(entry.reduced, entry.dae, parameters.symbols, disc_syms)
     return Artefact(model, flat, entry.reduced, entry.graph, entry.dae, parameters,
-                    StartPlan.of(flat, entry, parameters),
-                    Resolver.of(entry.reduced, entry.dae, parameters.symbols, disc_syms),
+                    StartPlan.of(flat, entry, parameters), resolve,
                     code, BuildInfo(stage_s, _time.perf_counter() - t0, hit))
 
 
 def _compile(model, flat, stage_s, key):
     """The compile stages after flattening: a
-    :class:`acausal.compiler.cache.Entry` and the generated code."""
+    :class:`acausal.compiler.cache.Entry`, the generated code and the
+    :class:`~acausal.compiler.artefact.Resolver` it used."""
     param_syms = ParameterSpace.of(flat, {}).symbols
     disc_syms = [d.symbol for d in flat.discretes.values()]
     clock = _Stages(stage_s)
@@ -86,7 +91,7 @@ def _compile(model, flat, stage_s, key):
     clock.lap("codegen")
     entry = compile_cache.Entry(key, red, g, root_starts, dae, gen.source, gen.sparsity,
                                 root_via, propagated)
-    return entry, gen
+    return entry, gen, resolve
 
 
 def _start_values(flat, root_starts, graph):
