@@ -84,14 +84,17 @@ def blind_folder(case, folder, marker):
 
 
 class StageCounter:
-    """Simulations and wall time per diagnosis stage (serial runs only:
-    every task then runs in this process)."""
+    """Simulations, model builds (flatten to generated code, not read from
+    the compile cache; the C library's ``cc`` is not in them) and wall time
+    per diagnosis stage (serial runs only: every task then runs in this
+    process)."""
 
     STAGES = {"stages": ("calibrate", "fit", "search_pairs", "cross_validate"),
               "run": ("fit_members", "locate", "intervals", "next_experiment")}
 
     def __init__(self):
         self.sims, self.wall, self.calls = Counter(), Counter(), Counter()
+        self.builds, self.build_s = Counter(), Counter()
         self.current = "load/other"
 
     def install(self):
@@ -105,6 +108,15 @@ class StageCounter:
             me.sims[me.current] += 1
             return inner(cm, *a, **k)
         comp.CompiledModel.simulate = counted
+        build = comp.compile_artefact
+
+        def built(*a, **k):
+            art = build(*a, **k)
+            if not art.build.cache_hit:
+                me.builds[me.current] += 1
+                me.build_s[me.current] += art.build.compile_s
+            return art
+        comp.compile_artefact = built
         for modname, names in self.STAGES.items():
             mod = run if modname == "run" else stages
             for name in names:
@@ -126,10 +138,13 @@ class StageCounter:
         return wrapped
 
     def table(self):
-        rows = ["| stage | simulations | wall [s] |", "|---|---|---|"]
-        for k in list(dict.fromkeys(list(self.wall) + list(self.sims))):
-            rows.append(f"| {k} | {self.sims[k]} | {self.wall[k]:.1f} |")
-        rows.append(f"| total | {sum(self.sims.values())} | |")
+        rows = ["| stage | simulations | models built | their build [s] | wall [s] |",
+                "|---|---|---|---|---|"]
+        for k in list(dict.fromkeys(list(self.wall) + list(self.sims) + list(self.builds))):
+            rows.append(f"| {k} | {self.sims[k]} | {self.builds[k]} | {self.build_s[k]:.1f} "
+                        f"| {self.wall[k]:.1f} |")
+        rows.append(f"| total | {sum(self.sims.values())} | {sum(self.builds.values())} "
+                    f"| {sum(self.build_s.values()):.1f} | |")
         return "\n".join(rows)
 
 
