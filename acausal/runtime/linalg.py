@@ -159,14 +159,9 @@ def event_matrix(cb, t, y, yp, ns):
     return np.hstack([Jy[:, ns:], Jyp[:, :ns]]), Jy[:, :ns]
 
 
-def solve_square(J, b):
-    """``J x = b`` for a square dense or sparse ``J`` (LU); least squares
-    when the LU finds it singular."""
-    return SquareSolver()(J, b)
-
-
 class SquareSolver:
-    """``J x = b`` as :func:`solve_square`, for a run of matrices that
+    """``J x = b`` for square dense or sparse matrices ``J`` (an LU; least
+    squares when the LU finds ``J`` singular), for a run of matrices that
     often repeat: the Newton iterations of one event's re-initialisation
     and the algebraic rates after it. At a stuck friction element that
     matrix is singular by structure, and the LU fails at every iteration

@@ -4,9 +4,27 @@ to least squares at once, with the same answer."""
 import numpy as np
 import scipy.linalg
 import scipy.sparse as sps
+import scipy.sparse.linalg  # noqa: F401  (sps.linalg)
 
 from acausal.runtime import linalg
-from acausal.runtime.linalg import SquareSolver, solve_square
+from acausal.runtime.linalg import SquareSolver
+
+
+def solve_square(J, b):
+    """The reference, written here: an LU (sparse, then dense), least
+    squares where it fails."""
+    if sps.issparse(J):
+        try:
+            x = sps.linalg.splu(J).solve(b)
+            if np.all(np.isfinite(x)):
+                return x
+        except RuntimeError:
+            pass
+        J = J.toarray()
+    try:
+        return scipy.linalg.solve(J, b)
+    except scipy.linalg.LinAlgError:
+        return np.linalg.lstsq(J, b, rcond=None)[0]
 
 
 def _counting_lu(monkeypatch):
