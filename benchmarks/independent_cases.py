@@ -139,7 +139,11 @@ def main(argv=None):
         effects = [float(e) for e in a.effects.split(",")] if case.scale and case.laws else [None]
         for eff in effects:
             for seed in (int(s) for s in a.seeds.split(",")):
-                if (name, eff, seed) in done:
+                if (name, eff, seed) in done:    # resumable: say so, not silently nothing
+                    at = "" if eff is None else f" effect {eff:g}"
+                    print(f"{name}{at} seed {seed}: already in {_shown(log)} under "
+                          f"label {a.label!r}; not run again (another --label runs it)",
+                          flush=True)
                     continue
                 r = run_one(case, eff, seed, a.workers)
                 r["label"] = a.label
