@@ -38,16 +38,21 @@ SETUP = dict(hypothesis="coulomb_friction", location="cam.pin_d", effect=(8.0, 8
 
 # profile buckets: (label, predicate on a function's file name and name)
 BUCKETS = [
-    ("C library builds (cc)", lambda f, n: "codegen_c" in f and "build" in n),
-    ("model building (flatten .. codegen)", lambda f, n: f.endswith("pipeline.py")
-     and n == "compile_model"),
-    ("least squares (scipy.optimize)", lambda f, n: "scipy/optimize" in f
-     and n == "least_squares"),
+    ("C library builds (generate the C, wait for cc)",
+     lambda f, n: f.endswith(os.path.join("backends", "compiled.py")) and n == "_build"),
+    ("model building (flatten .. generated Python)",
+     lambda f, n: f.endswith(os.path.join("compiler", "pipeline.py")) and n == "compile_artefact"),
+    ("simulations (with their first run's C library build)",
+     lambda f, n: f.endswith(os.path.join("runtime", "hybrid.py")) and n == "simulate"),
+    ("least squares (scipy.optimize, with the simulations it asks for)",
+     lambda f, n: "scipy/optimize" in f and n == "least_squares"),
 ]
 
 
 def split(stats):
-    """{bucket: cumulative seconds} of the outermost calls of each bucket."""
+    """{bucket: cumulative seconds} of the outermost calls of each bucket
+    (the buckets overlap where one calls another: a simulation's first run
+    builds its C library; a least-squares fit runs simulations)."""
     out = {}
     for label, pred in BUCKETS:
         tot = 0.0
