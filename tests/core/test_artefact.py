@@ -9,9 +9,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import sympy as sp
 
-from acausal import Model, ParameterError, compile_model
-from acausal.compiler.artefact import Artefact
+from acausal import Model, ModelError, ParameterError, compile_model
+from acausal.compiler.artefact import Artefact, Resolver
 from acausal.compiler.codegen import Callbacks
 from acausal.mechanics.translational import Damper, Fixed, Mass, Spring
 
@@ -54,9 +55,6 @@ def test_the_resolver_rewrites_each_expression_once_with_the_same_answer():
     """The artefact's resolver is the code generator's: the expressions it
     rewrote there come back as the same objects; a fresh resolver of the
     same model gives equal ones; a name it cannot give fails every time."""
-    import sympy as sp
-    from acausal import ModelError
-    from acausal.compiler.artefact import Resolver
     art = compile_model(_oscillator(), cache=False).artefact
     e = sp.Symbol("spring.f") * sp.Symbol("mass.v") + sp.Symbol("damper.f")
     first = art.resolve(e)
