@@ -174,7 +174,7 @@ class SquareSolver:
 
     def __call__(self, J, b):
         if self._singular is not None and _same_matrix(J, self._singular):
-            return _least_squares(J, b)
+            return _least_squares(_dense(J), b)
         if sps.issparse(J):
             try:
                 x = scipy.sparse.linalg.splu(J).solve(b)
@@ -182,16 +182,22 @@ class SquareSolver:
                     return x
             except RuntimeError:      # "Factor is exactly singular"
                 pass
+        A = _dense(J)
         try:
-            return scipy.linalg.solve(J.toarray() if sps.issparse(J) else J, b)
+            return scipy.linalg.solve(A, b)
         except (scipy.linalg.LinAlgError, ValueError):
             self._singular = J.copy()
-            return _least_squares(J, b)
+            return _least_squares(A, b)
 
 
-def _least_squares(J, b):
-    """The minimum-norm least-squares solution of ``J x = b`` (dense)."""
-    return np.linalg.lstsq(J.toarray() if sps.issparse(J) else J, b, rcond=None)[0]
+def _dense(J):
+    """``J`` as a dense array (a sparse one converted once)."""
+    return J.toarray() if sps.issparse(J) else J
+
+
+def _least_squares(A, b):
+    """The minimum-norm least-squares solution of ``A x = b`` (``A`` dense)."""
+    return np.linalg.lstsq(A, b, rcond=None)[0]
 
 
 def _same_matrix(J, K):
