@@ -9,10 +9,14 @@ class ForwardDifferences:
     differences with the absolute step ``step`` (backward where a forward step
     would cross the upper bound ``hi``). The residual at the point the
     optimiser just evaluated is reused, so a Jacobian costs one evaluation per
-    variable, as scipy's own."""
+    variable, as scipy's own. ``many``: ``fun`` of a list of points, in
+    order (``[fun(z) for z in zs]`` when not given), so that a caller can
+    run a Jacobian's evaluations side by side (a lone fit of the diagnosis:
+    :meth:`acausal.diagnose.stages.fitting.Objective.many`)."""
 
-    def __init__(self, fun, step, hi):
+    def __init__(self, fun, step, hi, many=None):
         self.fun, self.step, self.hi = fun, float(step), np.asarray(hi, float)
+        self.many = many if many is not None else (lambda zs: [self.fun(z) for z in zs])
         self._z = self._r = None
 
     def __call__(self, z):
@@ -23,12 +27,16 @@ class ForwardDifferences:
     def jac(self, z):
         z = np.asarray(z, float)
         r0 = self._r if self._z is not None and np.array_equal(z, self._z) else self(z)
-        J = np.empty((r0.size, z.size))
+        steps, points = [], []
         for i in range(z.size):
             h = self.step if z[i] + self.step <= self.hi[i] else -self.step
             zz = z.copy()
             zz[i] += h
-            J[:, i] = (np.asarray(self.fun(zz), float) - r0) / h
+            steps.append(h)
+            points.append(zz)
+        J = np.empty((r0.size, z.size))
+        for i, (r, h) in enumerate(zip(self.many(points), steps)):
+            J[:, i] = (np.asarray(r, float) - r0) / h
         return J
 
 

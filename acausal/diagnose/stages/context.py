@@ -62,20 +62,30 @@ def run_tasks(ex, fn, tasks, desc, progress, collect=None):
     plugs in here: results depend only on their task); a ``collect`` with
     ``get(task)`` (:class:`.resume.FitStore`) also gives the results of
     tasks that finished in an earlier, interrupted run, which are not
-    submitted again. Tasks are submitted longest first (:func:`longest_first`)."""
+    submitted again. Tasks are submitted longest first (:func:`longest_first`).
+    A lone task whose ``fn`` has an ``alone(task, executor)`` form (a fit
+    whose Jacobians' simulations the idle workers share:
+    :func:`.tasks.fit_here`) runs in this process that way: the same result."""
     lookup = getattr(collect, "get", None)
     out = [lookup(t) if lookup is not None else None for t in tasks]
     todo = longest_first([i for i, r in enumerate(out) if r is None], tasks)
-    futures = [ex.submit(fn, tasks[i]) for i in todo]
+    alone = getattr(fn, "alone", None)
+    if not (alone is not None and len(todo) == 1 and getattr(ex, "kind", "serial") != "serial"
+            and (getattr(ex, "workers", None) or 1) > 1):
+        alone = None
+    # one task and idle workers: it runs here, and they run its evaluations
+    # side by side (fn.alone, e.g. tasks.fit_here)
+    futures = [] if alone is not None else [ex.submit(fn, tasks[i]) for i in todo]
     index = {id(f): i for i, f in zip(todo, futures)}
     bar = None
     if progress:
         from tqdm.auto import tqdm
         bar = tqdm(total=len(tasks), desc=desc, unit="fit", initial=len(tasks) - len(todo))
     try:
-        for fut in ex.as_completed(futures):
-            i = index[id(fut)]
-            out[i] = fut.result()
+        done = ((todo[0], alone(tasks[todo[0]], ex)),) if alone is not None else (
+            (index[id(fut)], fut.result()) for fut in ex.as_completed(futures))
+        for i, result in done:
+            out[i] = result
             if collect is not None:
                 collect(tasks[i], out[i])
             if bar is not None:

@@ -172,6 +172,7 @@ class Objective:
         self.timed = True
         self.recent = OrderedDict()   # x bytes -> WeightedResiduals (the RECENT last)
         self.watch = None             # watch(x, data cost) after each evaluation (may raise)
+        self.batch = None             # simulations of several points side by side (many)
 
     def params(self, x):
         return {**self.fixed, **dict(zip(self.names, np.asarray(x, float).tolist()))}
@@ -188,16 +189,54 @@ class Objective:
         self._check()
         self.n_eval += 1
         self.n_sim += len(self.dataset.experiments)
+        return self._take(x, self._simulate(x))
+
+    def many(self, xs):
+        """``[self(x) for x in xs]``: the same vectors, counts, budget stops
+        and callbacks, in the same order. With ``batch`` (a callable from a
+        list of parameter dicts to their :func:`residuals_of`, None where a
+        simulation failed: :class:`acausal.diagnose.stages.tasks.Helpers`)
+        the simulations of the points the evaluation budget allows run side
+        by side first and are then taken in order, as if run one by one
+        (the simulations are deterministic); so only once a first
+        evaluation has set the residuals' size (a failure before it is
+        raised, as :meth:`__call__` does)."""
+        if self.batch is None or self.size is None or len(xs) < 2:
+            return [self(x) for x in xs]
+        room = len(xs)
+        if self.timed and self.max_evals is not None:
+            room = max(0, min(room, self.max_evals - self.n_eval))
+        got = list(self.batch([self.params(x) for x in xs[:room]])) if room else []
+        out = []
+        for x, g in zip(xs, got + [None] * (len(xs) - room)):
+            self._check()      # stops where one by one would have stopped
+            self.n_eval += 1
+            self.n_sim += len(self.dataset.experiments)
+            out.append(self._take(x, g))
+        return out
+
+    def _simulate(self, x):
+        """:func:`residuals_of` at ``x``, or the AcausalError it raised."""
         try:
-            vec = self._remember(x, residuals_of(self.pair, self.dataset, self.params(x),
-                                                 self.backend)).vector
+            return residuals_of(self.pair, self.dataset, self.params(x), self.backend)
+        except AcausalError as exc:
+            return exc
+
+    def _take(self, x, got):
+        """The vector of one evaluation whose simulation gave ``got`` (a
+        :class:`WeightedResiduals`, or the error / None where it failed):
+        remembered, the failures as :data:`PENALTY` (raised before a first
+        success sets the size), the watch called, the penalty rows added,
+        the best point kept."""
+        if got is None or isinstance(got, AcausalError):
+            if self.size is None:
+                raise got if got is not None else AcausalError("the simulation failed")
+            vec = np.full(self.size, PENALTY)
+        else:
+            vec = self._remember(x, got).vector
             self.size = vec.size
             if not np.all(np.isfinite(vec)):
                 vec = np.nan_to_num(vec, nan=PENALTY, posinf=PENALTY, neginf=-PENALTY)
-        except AcausalError:
-            if self.size is None:
-                raise
-            vec = np.full(self.size, PENALTY)
         if self.watch is not None:
             self.watch(np.asarray(x, float), float(vec @ vec))
         if self.penalty is not None:
@@ -207,7 +246,6 @@ class Objective:
         if c < self.best_cost:
             self.best_cost, self.best_x = c, np.array(x, float)
         return vec
-
 
     def _remember(self, x, out):
         self.recent[np.asarray(x, float).tobytes()] = out
@@ -285,7 +323,8 @@ def refine(obj, x_start, lo, hi, sc, max_nfev, tol):
     differences answer where a sensitivity run fails).
     Returns (x, jacobian in parameter units, ok, message); when the budget
     runs out the best point seen is kept and the Jacobian taken there."""
-    fd = ForwardDifferences(lambda z: obj(z * sc), FD_STEP, hi / sc)
+    fd = ForwardDifferences(lambda z: obj(z * sc), FD_STEP, hi / sc,
+                            many=lambda zs: obj.many([z * sc for z in zs]))
     jac, secant = fd.jac, None
     kind = getattr(obj, "jacobian", "differences")
     if kind == "sensitivities":

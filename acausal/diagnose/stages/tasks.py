@@ -21,6 +21,7 @@ tested at all.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import os
 import time
 from dataclasses import dataclass, field
@@ -31,6 +32,7 @@ from scipy.stats import qmc
 from ...studies.calibrate import model_dataset
 from ...data import Dataset, MeasuredExperiment, Trace
 from ...data.thinning import MAX_TRACE_SAMPLES, MIN_TRACE_SAMPLES, thin_traces  # noqa: F401
+from ...errors import AcausalError
 from ...infra.executor import worker_cache
 from ...modelfile import compile_file
 from ...studies.residuals import subset
@@ -159,6 +161,78 @@ def window(ds: Dataset, frac: float) -> Dataset:
     return Dataset(ds.folder, out, ds.instrument)
 
 
+# -- a lone fit's helpers -------------------------------------------------------------------
+@dataclass(frozen=True)
+class PointShare:
+    """Some of a lone fit's evaluations, run on a worker beside it: the
+    residuals of ``candidate``'s model at each of ``points`` (parameter
+    name -> value dicts) on the first ``frac`` of the traces
+    (:func:`window`)."""
+
+    problem: Problem
+    candidate: Candidate
+    frac: float
+    points: tuple
+
+    @property
+    def cost(self) -> float:
+        return float(len(self.points))
+
+
+def evaluate_points(share: PointShare) -> list:
+    """[:class:`~acausal.studies.residuals.WeightedResiduals`, or None where
+    the simulation failed] at each of the share's points (worker side)."""
+    p = share.problem
+    pair, ds = model_of(p, share.candidate), window(dataset_of(p), share.frac)
+    out = []
+    for params in share.points:
+        try:
+            out.append(residuals_of(pair, ds, dict(params), p.settings.integrator))
+        except AcausalError:
+            out.append(None)
+    return out
+
+
+@dataclass(frozen=True)
+class Helpers:
+    """The idle workers beside a fit that runs alone (a round of one task:
+    the located term's refits, the calibration). The fit runs in the
+    calling process, and each of its difference Jacobians is split into
+    contiguous shares of its points, one per worker
+    (:func:`evaluate_points`), then taken in order as if simulated one by
+    one (:meth:`.fitting.Objective.many`): the same fit, bit for bit, its
+    Jacobians' simulations side by side instead of on one worker while the
+    others wait. ``executor``: an :mod:`acausal.infra.executor` executor
+    with ``workers`` > 1."""
+
+    executor: object
+    problem: Problem
+    candidate: Candidate
+
+    def on(self, frac):
+        """The ``batch`` of an :class:`.fitting.Objective` on the first
+        ``frac`` of the traces."""
+        return functools.partial(self._evaluate, frac)
+
+    def _evaluate(self, frac, points):
+        n, k = len(points), max(1, int(self.executor.workers or 1))
+        shares = [PointShare(self.problem, self.candidate, frac,
+                             tuple(points[(n * i) // k:(n * (i + 1)) // k])) for i in range(k)]
+        futures = [self.executor.submit(evaluate_points, sh) for sh in shares if sh.points]
+        return [r for fut in futures for r in fut.result()]
+
+
+def fit_here(task: FitTask, executor) -> CandidateFit:
+    """:func:`fit_candidate` of a lone task, run in this process with the
+    ``executor``'s workers as its :class:`Helpers` (the same result)."""
+    return fit_candidate(task, Helpers(executor, task.problem, task.candidate))
+
+
+def calibrate_here(task: FitTask, executor) -> CandidateFit:
+    """:func:`calibrate_nominal` with :class:`Helpers` (as :func:`fit_here`)."""
+    return calibrate_nominal(task, Helpers(executor, task.problem, task.candidate))
+
+
 # -- starting points ----------------------------------------------------------------------
 def lhs_values(params, n, seed=0):
     """``n`` Latin-hypercube points over the parameters' bounds: each
@@ -253,11 +327,13 @@ def _tested(fits, ext, J_best, starts=()):
     return bool(np.any(effect >= 1.0))
 
 
-def fit_candidate(task: FitTask) -> CandidateFit:
-    """Fit one candidate from several starts (module doc); never raises."""
+def fit_candidate(task: FitTask, helpers: Helpers | None = None) -> CandidateFit:
+    """Fit one candidate from several starts (module doc); never raises.
+    ``helpers``: idle workers that run the difference Jacobians'
+    simulations side by side (:class:`Helpers`; the same result)."""
     t0 = time.perf_counter()
     try:
-        fit, starts = _multistart(task)
+        fit, starts = _multistart(task, helpers)
         loo = linear_loo(fit, penalty_of(task.candidate)) if fit.ok else {}
         return CandidateFit(task.candidate, fit, loo, None, time.perf_counter() - t0, starts)
     except Exception as exc:  # noqa: BLE001 - a candidate that cannot be built is reported
@@ -280,7 +356,7 @@ def _summary(fits, scored, ext=(), tested=True, starts=()):
     return best, Starts(scored, len(fits), sum(f.cost <= best.cost + tol for f in fits), tested)
 
 
-def _multistart(task: FitTask):
+def _multistart(task: FitTask, helpers=None):
     p, cand = task.problem, task.candidate
     s = p.settings
     params = list(task.free) + list(cand.params)
@@ -298,7 +374,7 @@ def _multistart(task: FitTask):
         return failed_fit(names, pts[0][0], obj, "every starting point failed"), Starts()
     picked = _pick(scored, len(cand.params), sc, s.refine)
     refiner = Refiner(pair, ds, names, lo, hi, sc, _windows(ds, s), s, task.budget_s,
-                      penalty_of(cand))
+                      penalty_of(cand), helpers)
     fits = refiner.all([x for _, x in picked])
     floors = [np.asarray(x, float) for x in task.floors]
     best = min(fits, key=lambda f: f.cost)
@@ -312,11 +388,12 @@ def _multistart(task: FitTask):
     return best, starts
 
 
-def calibrate_nominal(task: FitTask) -> CandidateFit:
+def calibrate_nominal(task: FitTask, helpers: Helpers | None = None) -> CandidateFit:
     """The nominal calibration: Latin-hypercube starts over the free
     parameters' bounds plus the model file's values, scored on the first
     window of the traces; the best ``refine`` are carried through the
-    growing windows (homotopy from the start of the record to all of it)."""
+    growing windows (homotopy from the start of the record to all of it).
+    ``helpers``: as :func:`fit_candidate`'s."""
     t0 = time.perf_counter()
     p, s = task.problem, task.problem.settings
     params = list(task.free)
@@ -333,12 +410,18 @@ def calibrate_nominal(task: FitTask) -> CandidateFit:
     if not scored:
         return CandidateFit(task.candidate, None, {}, "every starting point failed",
                             time.perf_counter() - t0)
-    fits = Refiner(pair, ds, names, lo, hi, sc, windows, s).all(
+    fits = Refiner(pair, ds, names, lo, hi, sc, windows, s, helpers=helpers).all(
         [x for _, x in scored[:max(1, s.refine if n_lhs else 1)]])
     best, starts = _summary(fits, len(scored))
     best = dataclasses.replace(best, n_sim=obj.n_sim + sum(f.n_sim for f in fits))
     loo = linear_loo(best) if best.ok else {}
     return CandidateFit(task.candidate, best, loo, None, time.perf_counter() - t0, starts)
+
+
+# a round of one such task runs it here, with the idle workers as its helpers
+# (.context.run_tasks)
+fit_candidate.alone = fit_here
+calibrate_nominal.alone = calibrate_here
 
 
 def penalty_of(cand):
@@ -417,6 +500,7 @@ class Refiner:
     settings: object
     budget_s: float | None = None
     penalty: object = None
+    helpers: Helpers | None = None   # idle workers for the Jacobians' simulations
 
     def window_fit(self, w, x, targets=()):
         """(fit on window ``w`` from ``x``, index of the ``targets`` fit it
@@ -429,6 +513,7 @@ class Refiner:
                         penalty=self.penalty, backend=s.integrator, jacobian=s.jacobian)
         tols = [agree_tolerance(t, self.names, self.sc, w >= 1.0) for t in targets]
         obj.watch = self._watch(targets, tols) if targets else None
+        obj.batch = self.helpers.on(w) if self.helpers is not None else None
         try:
             fit = finish(obj, *refine_or_keep(obj, x, self.lo, self.hi, self.sc, s.max_nfev,
                                               s.tol), self.lo)

@@ -1,0 +1,166 @@
+"""A fit that runs alone (a round of one task: the located term's refits,
+the calibration) runs in the calling process with the idle workers as its
+helpers (``tasks.Helpers``): its difference Jacobians' simulations are
+split over them and taken in order as if run one by one
+(``fitting.Objective.many``). The result must be the fit of one worker, bit
+for bit, with the same simulations counted, and an evaluation budget must
+stop it where it stops one by one. Real simulations of the latch striker
+(its generic located term, 18 weights, and a Coulomb friction) on
+synthetic data, on a real pool of two processes."""
+import dataclasses
+import os
+
+import numpy as np
+import pytest
+
+from acausal.diagnose.stages import context as C
+from acausal.diagnose.stages import locate as L
+from acausal.diagnose.stages.chain import candidates, load_problem
+from acausal.diagnose.stages.fitting import Budget, Objective, _OutOfTime, residuals_of
+from acausal.diagnose.stages.tasks import FitTask, Helpers, dataset_of, fit_candidate, \
+    fit_here, model_of
+from acausal.diagnose.synth import synthesize
+from acausal.infra.executor import open_executor
+
+HERE = os.path.dirname(__file__)
+LATCH = os.path.abspath(os.path.join(HERE, "..", "..", "models", "latch_striker.py"))
+
+
+@pytest.fixture(scope="module")
+def problem(tmp_path_factory):
+    d = tmp_path_factory.mktemp("lone")
+    # the data hold a friction the nominal model lacks, so the fits move
+    synthesize(LATCH, d / "data", hypothesis="coulomb_friction", location="latch",
+               effect=(6.0, 6.0), conditions={"F_coil": [20.0, 45.0]}, traces=["latch.s"],
+               sample_rate=5e3, noise={"latch.s": 5e-6}, resolution={"latch.s": 5e-6},
+               units={"time": "ms", "latch.s": "mm"}, seed=3)
+    return load_problem(LATCH, d / "data")[0]
+
+
+@pytest.fixture(scope="module")
+def located(problem):
+    cand = next(c for c, _, _ in L.generic_candidates(problem, 1, 9, 9) if c.location == "latch")
+    return FitTask(problem, cand, problem.free)
+
+
+def _same(a, b):
+    assert a.error is None and b.error is None
+    fa, fb = a.fit, b.fit
+    assert fa.names == fb.names and fa.values == fb.values
+    assert fa.cost == fb.cost and fa.n_sim == fb.n_sim and fa.ok == fb.ok
+    assert np.array_equal(fa.residuals, fb.residuals) and np.array_equal(fa.jacobian, fb.jacobian)
+    assert a.loo.keys() == b.loo.keys()
+    assert a.starts == b.starts
+
+
+@pytest.mark.parametrize("which", ["located", "friction"])
+def test_a_lone_fit_with_helpers_is_the_fit_of_one_worker(problem, located, which):
+    if which == "located":
+        task = located
+    else:
+        cand = candidates(problem, ["coulomb_friction"])[0]
+        task = FitTask(problem, cand, problem.free)
+    alone = fit_candidate(task)
+    assert alone.fit.n_sim > 4 * (len(task.free) + len(task.candidate.params))   # Jacobians ran
+    with open_executor(workers=2) as ex:
+        assert ex.kind == "processes" and ex.workers == 2
+        counted = _Counting(ex)
+        shared = fit_here(task, counted)
+    _same(alone, shared)
+    # the workers ran the Jacobians' simulations (two shares per Jacobian)
+    assert counted.points >= 2 * (len(task.free) + len(task.candidate.params)) - 1
+    assert counted.shares % 2 == 0 and counted.shares >= 4
+
+
+class _Counting:
+    """An executor that counts the shares and points submitted to it."""
+
+    def __init__(self, ex):
+        self.ex, self.kind, self.workers = ex, ex.kind, ex.workers
+        self.shares = self.points = 0
+
+    def submit(self, fn, share):
+        self.shares += 1
+        self.points += len(share.points)
+        return self.ex.submit(fn, share)
+
+
+def test_a_round_of_one_task_runs_here_with_helpers(problem, located):
+    seen = []
+
+    def fn(task):
+        raise AssertionError("a lone task with an alone form is not submitted")
+
+    def alone(task, ex):
+        seen.append((task, ex))
+        return "here"
+
+    fn.alone = alone
+
+    class Pool:                                   # what run_tasks reads of an executor
+        kind, workers = "processes", 2
+
+        def submit(self, f, t):
+            raise AssertionError("not submitted")
+
+    pool = Pool()
+    got = []
+    assert C.run_tasks(pool, fn, [located], "t", False, lambda t, r: got.append(r)) == ["here"]
+    assert seen == [(located, pool)] and got == ["here"]
+
+
+def _submitted(task):
+    return "submitted"
+
+
+_submitted.alone = lambda task, ex: "here"
+
+
+def test_serial_or_several_tasks_are_submitted_as_before(located):
+    fn = _submitted
+    with open_executor("serial") as ex:
+        ex.workers = 2                          # serial: nothing to share, whatever it says
+        assert C.run_tasks(ex, fn, [located], "t", False) == ["submitted"]
+    with open_executor(workers=2) as ex:
+        assert C.run_tasks(ex, fn, [located, located], "t", False) == ["submitted"] * 2
+
+
+def test_an_evaluation_budget_stops_the_batch_where_one_by_one_stops(problem, located):
+    pair, ds = model_of(problem, located.candidate), dataset_of(problem)
+    names = [q.name for q in located.candidate.params]
+    rng = np.random.default_rng(0)
+    xs = [0.05 * rng.standard_normal(len(names)) * np.array([q.scale for q in
+                                                            located.candidate.params])
+          for _ in range(8)]
+    batches = []
+
+    def serial_batch(points):
+        batches.append(len(points))
+        return [residuals_of(pair, ds, p, problem.settings.integrator) for p in points]
+
+    def run(batched):
+        obj = Objective(pair, ds, names, budget=Budget(evals=6),
+                        backend=problem.settings.integrator)
+        obj(np.zeros(len(names)))                 # the base: sets the size
+        if batched:
+            obj.batch = serial_batch
+        with pytest.raises(_OutOfTime):
+            obj.many(xs)
+        return obj
+
+    one, many = run(False), run(True)
+    assert batches == [5]                          # only what the budget allows is simulated
+    assert one.n_eval == many.n_eval == 6 and one.n_sim == many.n_sim
+    assert one.best_cost == many.best_cost and np.array_equal(one.best_x, many.best_x)
+    assert [k for k in one.recent] == [k for k in many.recent]
+
+
+def test_helpers_split_points_in_order_over_the_workers(problem, located):
+    with open_executor(workers=2) as ex:
+        h = Helpers(ex, problem, located.candidate)
+        pts = [{q.name: 0.01 * i * q.scale for q in located.candidate.params} for i in range(5)]
+        got = h.on(1.0)(pts)
+    pair, ds = model_of(problem, located.candidate), dataset_of(problem)
+    want = [residuals_of(pair, ds, p, problem.settings.integrator) for p in pts]
+    assert len(got) == 5
+    assert all(np.array_equal(g.vector, w.vector) for g, w in zip(got, want))
