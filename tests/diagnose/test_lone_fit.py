@@ -103,6 +103,10 @@ def test_a_round_of_one_task_runs_here_with_helpers(problem, located):
         def submit(self, f, t):
             raise AssertionError("not submitted")
 
+        def as_completed(self, futures):
+            assert not futures
+            return iter(())
+
     pool = Pool()
     got = []
     assert C.run_tasks(pool, fn, [located], "t", False, lambda t, r: got.append(r)) == ["here"]
@@ -116,13 +120,18 @@ def _submitted(task):
 _submitted.alone = lambda task, ex: "here"
 
 
-def test_serial_or_several_tasks_are_submitted_as_before(located):
+def test_serial_or_more_tasks_than_workers_are_submitted_as_before(located):
     fn = _submitted
     with open_executor("serial") as ex:
         ex.workers = 2                          # serial: nothing to share, whatever it says
         assert C.run_tasks(ex, fn, [located], "t", False) == ["submitted"]
     with open_executor(workers=2) as ex:
-        assert C.run_tasks(ex, fn, [located, located], "t", False) == ["submitted"] * 2
+        # more tasks than workers: every one submitted
+        assert C.run_tasks(ex, fn, [located] * 3, "t", False) == ["submitted"] * 3
+        # no more than workers: the longest here, the others submitted
+        short = dataclasses.replace(located, candidate=dataclasses.replace(
+            located.candidate, params=located.candidate.params[:2]))
+        assert C.run_tasks(ex, fn, [short, located], "t", False) == ["submitted", "here"]
 
 
 def test_an_evaluation_budget_stops_the_batch_where_one_by_one_stops(problem, located):
@@ -164,3 +173,15 @@ def test_helpers_split_points_in_order_over_the_workers(problem, located):
     want = [residuals_of(pair, ds, p, problem.settings.integrator) for p in pts]
     assert len(got) == 5
     assert all(np.array_equal(g.vector, w.vector) for g, w in zip(got, want))
+
+
+def test_a_round_of_two_gives_the_fits_of_one_worker_each(problem, located):
+    """Two tasks on two workers: the longer runs here with the other
+    worker's help once that worker is done with the shorter."""
+    friction = FitTask(problem, candidates(problem, ["coulomb_friction"])[0], problem.free)
+    tasks = [friction, located]
+    want = [fit_candidate(t) for t in tasks]
+    with open_executor(workers=2) as ex:
+        got = C.run_tasks(ex, fit_candidate, tasks, "t", False)
+    for a, b in zip(want, got):
+        _same(a, b)

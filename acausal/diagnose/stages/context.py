@@ -7,6 +7,7 @@ goes into the state it returns."""
 from __future__ import annotations
 
 import contextlib
+import itertools
 import time
 from dataclasses import dataclass, field
 from typing import Callable
@@ -63,27 +64,31 @@ def run_tasks(ex, fn, tasks, desc, progress, collect=None):
     ``get(task)`` (:class:`.resume.FitStore`) also gives the results of
     tasks that finished in an earlier, interrupted run, which are not
     submitted again. Tasks are submitted longest first (:func:`longest_first`).
-    A lone task whose ``fn`` has an ``alone(task, executor)`` form (a fit
-    whose Jacobians' simulations the idle workers share:
-    :func:`.tasks.fit_here`) runs in this process that way: the same result."""
+    When ``fn`` has an ``alone(task, executor)`` form (a fit whose
+    Jacobians' simulations idle workers share: :func:`.tasks.fit_here`) and
+    there are no more tasks than workers, the longest runs in this process
+    that way while the workers run the others: the same results."""
     lookup = getattr(collect, "get", None)
     out = [lookup(t) if lookup is not None else None for t in tasks]
     todo = longest_first([i for i, r in enumerate(out) if r is None], tasks)
     alone = getattr(fn, "alone", None)
-    if not (alone is not None and len(todo) == 1 and getattr(ex, "kind", "serial") != "serial"
-            and (getattr(ex, "workers", None) or 1) > 1):
+    workers = getattr(ex, "workers", None) or 1
+    if not (alone is not None and 1 <= len(todo) <= workers
+            and getattr(ex, "kind", "serial") != "serial" and workers > 1):
         alone = None
-    # one task and idle workers: it runs here, and they run its evaluations
-    # side by side (fn.alone, e.g. tasks.fit_here)
-    futures = [] if alone is not None else [ex.submit(fn, tasks[i]) for i in todo]
-    index = {id(f): i for i, f in zip(todo, futures)}
+    # no more tasks than workers: the longest runs here and the workers the
+    # others; a worker that is or falls idle runs the simulations of its
+    # evaluations side by side (fn.alone, e.g. tasks.fit_here)
+    here = todo[:1] if alone is not None else []
+    futures = [ex.submit(fn, tasks[i]) for i in todo[len(here):]]
+    index = {id(f): i for i, f in zip(todo[len(here):], futures)}
     bar = None
     if progress:
         from tqdm.auto import tqdm
         bar = tqdm(total=len(tasks), desc=desc, unit="fit", initial=len(tasks) - len(todo))
     try:
-        done = ((todo[0], alone(tasks[todo[0]], ex)),) if alone is not None else (
-            (index[id(fut)], fut.result()) for fut in ex.as_completed(futures))
+        done = itertools.chain(((i, alone(tasks[i], ex)) for i in here), (
+            (index[id(fut)], fut.result()) for fut in ex.as_completed(futures)))
         for i, result in done:
             out[i] = result
             if collect is not None:

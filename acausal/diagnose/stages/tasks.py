@@ -196,10 +196,11 @@ def evaluate_points(share: PointShare) -> list:
 @dataclass(frozen=True)
 class Helpers:
     """The idle workers beside a fit that runs alone (a round of one task:
-    the located term's refits, the calibration). The fit runs in the
-    calling process, and each of its difference Jacobians is split into
-    contiguous shares of its points, one per worker
-    (:func:`evaluate_points`), then taken in order as if simulated one by
+    the located term's refits, the calibration; the longest of a round of
+    no more tasks than workers). The fit runs in the calling process, and
+    each of its difference Jacobians is split into contiguous shares of its
+    points, two per worker (:func:`evaluate_points`), which the idle
+    workers take as they come, then taken in order as if simulated one by
     one (:meth:`.fitting.Objective.many`): the same fit, bit for bit, its
     Jacobians' simulations side by side instead of on one worker while the
     others wait. ``executor``: an :mod:`acausal.infra.executor` executor
@@ -215,7 +216,9 @@ class Helpers:
         return functools.partial(self._evaluate, frac)
 
     def _evaluate(self, frac, points):
-        n, k = len(points), max(1, int(self.executor.workers or 1))
+        # two shares per worker, so that a worker busy with another task
+        # (a round of two) joins in as soon as it falls idle
+        n, k = len(points), 2 * max(1, int(self.executor.workers or 1))
         shares = [PointShare(self.problem, self.candidate, frac,
                              tuple(points[(n * i) // k:(n * (i + 1)) // k])) for i in range(k)]
         futures = [self.executor.submit(evaluate_points, sh) for sh in shares if sh.points]
