@@ -95,6 +95,15 @@ def run_tasks(ex, fn, tasks, desc, progress, collect=None):
                 collect(tasks[i], out[i])
             if bar is not None:
                 bar.update(1)
+    except BaseException:
+        # stopped while a task ran here: what the workers finished is kept
+        if collect is not None:
+            for fut in futures:
+                i = index[id(fut)]
+                if out[i] is None and fut.done() and not fut.cancelled() \
+                        and fut.exception() is None:
+                    collect(tasks[i], fut.result())
+        raise
     finally:
         if bar is not None:
             bar.close()

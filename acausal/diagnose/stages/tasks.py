@@ -20,6 +20,7 @@ tested at all.
 """
 from __future__ import annotations
 
+import concurrent.futures as cf
 import dataclasses
 import functools
 import os
@@ -222,7 +223,18 @@ class Helpers:
         shares = [PointShare(self.problem, self.candidate, frac,
                              tuple(points[(n * i) // k:(n * (i + 1)) // k])) for i in range(k)]
         futures = [self.executor.submit(evaluate_points, sh) for sh in shares if sh.points]
-        return [r for fut in futures for r in fut.result()]
+        try:
+            return [r for fut in futures for r in fut.result()]
+        except (cf.BrokenExecutor, cf.CancelledError) as exc:
+            raise PoolLost(str(exc)) from exc
+
+
+class PoolLost(Exception):
+    """The executor lost a lone fit's helpers' work (a worker died, the pool
+    was shut down by an interruption): not the candidate's failure, so
+    :func:`fit_candidate` raises the executor's own error (``__cause__``), as
+    the round would have met it with the fit on a worker, instead of
+    reporting a failed fit that a checkpoint would keep."""
 
 
 def fit_here(task: FitTask, executor) -> CandidateFit:
@@ -339,6 +351,8 @@ def fit_candidate(task: FitTask, helpers: Helpers | None = None) -> CandidateFit
         fit, starts = _multistart(task, helpers)
         loo = linear_loo(fit, penalty_of(task.candidate)) if fit.ok else {}
         return CandidateFit(task.candidate, fit, loo, None, time.perf_counter() - t0, starts)
+    except PoolLost as lost:
+        raise lost.__cause__ from None
     except Exception as exc:  # noqa: BLE001 - a candidate that cannot be built is reported
         return CandidateFit(task.candidate, None, {}, f"{type(exc).__name__}: {exc}",
                             time.perf_counter() - t0)
