@@ -5,9 +5,10 @@ runs in the calling process with the idle workers as its helpers
 them and taken in order as if run one by one (``fitting.Objective.many``).
 The result must be the fit of one worker, bit for bit, with the same
 simulations counted; an evaluation budget must stop it where it stops one
-by one; a dead pool is the round's error, not the candidate's. Real simulations of the latch striker
-(its generic located term, 18 weights, and a Coulomb friction) on
-synthetic data, on a real pool of two processes."""
+by one; a dead pool is the round's error, not the candidate's. Real
+simulations of the latch striker (its generic located term, 18 weights,
+and a Coulomb friction) on synthetic data, on a real pool of two
+processes."""
 import concurrent.futures as cf
 import dataclasses
 import os
@@ -214,6 +215,13 @@ def _stopped(task, ex):
     raise KeyboardInterrupt
 
 
+def _stopping(task):
+    return "submitted"
+
+
+_stopping.alone = _stopped
+
+
 def test_a_round_stopped_while_its_task_runs_here_keeps_what_the_workers_finished(located):
     finished = cf.Future()
     finished.set_result("done on a worker")
@@ -227,16 +235,10 @@ def test_a_round_stopped_while_its_task_runs_here_keeps_what_the_workers_finishe
         def as_completed(self, futures):
             return iter(futures)
 
-    fn = _submitted
     kept = []
     short = dataclasses.replace(located, candidate=dataclasses.replace(
         located.candidate, params=located.candidate.params[:2]))
-    old = fn.alone
-    fn.alone = _stopped
-    try:
-        with pytest.raises(KeyboardInterrupt):
-            C.run_tasks(Pool(), fn, [short, located], "t", False,
-                        lambda t, r: kept.append((t, r)))
-    finally:
-        fn.alone = old
+    with pytest.raises(KeyboardInterrupt):
+        C.run_tasks(Pool(), _stopping, [short, located], "t", False,
+                    lambda t, r: kept.append((t, r)))
     assert kept == [(short, "done on a worker")]

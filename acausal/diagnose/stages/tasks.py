@@ -175,10 +175,6 @@ class PointShare:
     frac: float
     points: tuple
 
-    @property
-    def cost(self) -> float:
-        return float(len(self.points))
-
 
 def evaluate_points(share: PointShare) -> list:
     """[:class:`~acausal.studies.residuals.WeightedResiduals`, or None where
@@ -188,7 +184,7 @@ def evaluate_points(share: PointShare) -> list:
     out = []
     for params in share.points:
         try:
-            out.append(residuals_of(pair, ds, dict(params), p.settings.integrator))
+            out.append(residuals_of(pair, ds, params, p.settings.integrator))
         except AcausalError:
             out.append(None)
     return out
