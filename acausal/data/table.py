@@ -283,6 +283,8 @@ def _decode(path: Path, raw: list, first: int) -> list:
 def _chunk(path: Path, lines: list, first: int, names: list) -> np.ndarray:
     """The numbers of ``lines`` (file lines from ``first``), read by numpy;
     on any doubt, line by line, so that the error names its line and column."""
+    if not any(raw.strip() and not raw.lstrip().startswith("#") for raw in lines):
+        return np.empty((0, len(names)))      # (numpy warns on a chunk with no data)
     try:
         with np.errstate(all="ignore"):
             values = np.loadtxt(lines, delimiter=",", comments="#", ndmin=2, dtype=float)

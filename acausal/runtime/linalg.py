@@ -9,6 +9,9 @@ solved by SuperLU; a rectangular least-squares problem by the LU of the
 augmented system ``[[I, J], [J^T, 0]]`` (its solution is the least-squares
 one; Bjorck, "Numerical Methods for Least Squares Problems", 1996, sec. 2.5).
 """
+import re
+import warnings
+
 import numpy as np
 import scipy.linalg
 import scipy.sparse as sps
@@ -21,6 +24,15 @@ from ..compiler.codegen import Triplets
 # sparse Jacobians and solves them by sparse LU: the dense least squares grew
 # as n^3 (0.5 s per Newton step for a 200-mass chain, single-threaded)
 SPARSE_MIN = 200
+
+# scipy.linalg.solve warns (LinAlgWarning) when a matrix is ill-conditioned.
+# The iterations that call it here judge their own convergence (and a
+# singular matrix goes to least squares), so the warning tells a caller of
+# the library nothing it can act on: it is ignored for this module's calls
+# only (scipy attributes it to the module that called ``solve``). The command
+# line keeps every library warning from the terminal anyway (``cli._quiet_warnings``).
+warnings.filterwarnings("ignore", category=scipy.linalg.LinAlgWarning,
+                        module=re.escape(__name__) + "$")
 
 
 def jacobians(cb, t, y, yp, n):
