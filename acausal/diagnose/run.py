@@ -186,8 +186,12 @@ def designed(ctx: Context, s: State) -> State:
     index = family_index(s.problem.library)
     if not s.options.design:
         return dataclasses.replace(s, families=index)
+    def side_by_side(fn, jobs):       # the rivals' simulations on the executor
+        return ctx.run(fn, jobs, "designing the next experiment", checkpoint=False,
+                       progress=False)
     with ctx.clock.timing("design_s"):
-        nxt = next_experiment(s.problem, s.dataset, s.decision, s.ranking, index)
+        nxt = next_experiment(s.problem, s.dataset, s.decision, s.ranking, index,
+                              map=side_by_side)
     return dataclasses.replace(s, families=index, next_experiment=nxt)
 
 
@@ -219,11 +223,10 @@ def run_stages(model_path, data_folder, options: DiagnosisOptions | None = None,
         t_fit = clock.elapsed()
         for stage in (decided, members_fitted, pairs_searched, tied_fitted, cross_validated,
                       ranked, shown,
-                      located, profiled):
+                      located, profiled, extended, designed):
             s = _timed(stage, ctx, s)
-    ctx = Context(None, opts.progress, collect, clock)   # the stages below submit no task
-    s = _timed(designed, ctx, _timed(extended, ctx, s))
     t_cv = clock.elapsed() - t_fit
+    ctx = Context(None, opts.progress, collect, clock)   # the stage below submits no task
     s = _timed(viewed, ctx, s)
     return diagnosis_of(s, _timing(s, clock, t_fit, t_cv))
 

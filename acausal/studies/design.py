@@ -185,41 +185,79 @@ def score(predictions: Mapping[str, Mapping[str, np.ndarray] | None],
 MAX_SPREAD = 1.0     # floors: a rival's prediction spread beyond which an experiment is weighed down
 
 
+def rival_outcome(job):
+    """(prediction, variance or None) of one rival at one experiment, ``job``
+    = (rival, conditions): the rival's predicted signals and, for a rival
+    that gives one (a ``spread(conditions, prediction)`` method, as
+    :class:`ModelRival` with its parameters' covariance), the variance of
+    that prediction. A module-level function of one picklable job, so that
+    a ``map`` may run the rivals in worker processes (:func:`predicted`)."""
+    rival, conditions = job
+    pred = rival(conditions)
+    spread = getattr(rival, "spread", None)
+    return pred, (spread(conditions, pred) if pred is not None and callable(spread) else None)
+
+
+def serial_map(fn, jobs) -> list:
+    """``[fn(job) for job in jobs]``: the default ``map`` of the design."""
+    return [fn(job) for job in jobs]
+
+
 def predicted(rivals: Mapping[str, Rival], conditions, signals,
-              max_spread: float = MAX_SPREAD) -> _Score:
+              max_spread: float = MAX_SPREAD, map: Callable = serial_map) -> _Score:
     """:func:`score` of every rival at ``conditions``, with the variance of
-    each prediction for the rivals that give one (a ``spread(conditions,
-    prediction)`` method, as :class:`ModelRival` with its parameters'
-    covariance)."""
-    pred = {n: r(conditions) for n, r in rivals.items()}
-    var = {}
-    for n, r in rivals.items():
-        if pred[n] is not None and callable(getattr(r, "spread", None)):
-            var[n] = r.spread(conditions, pred[n])
+    each prediction for the rivals that give one (:func:`rival_outcome`).
+    ``map(fn, jobs)``: runs ``fn`` on each job, results in job order (the
+    diagnosis passes its executor's, so the rivals simulate side by side;
+    each rival's simulations are the same wherever they run)."""
+    return _scored(rivals, conditions, map(rival_outcome, [(r, conditions)
+                                                           for r in rivals.values()]),
+                   signals, max_spread)
+
+
+def _scored(rivals, conditions, outcomes, signals, max_spread):
+    pred = {n: o[0] for n, o in zip(rivals, outcomes)}
+    var = {n: o[1] for n, o in zip(rivals, outcomes)
+           if o[0] is not None and callable(getattr(rivals[n], "spread", None))}
     return score(pred, signals, var, max_spread)
 
 
 class _Evaluator:
-    """Every rival at one experiment (unit-cube coordinates), cached."""
+    """Every rival at one experiment (unit-cube coordinates), cached;
+    ``map`` as :func:`predicted`'s."""
 
-    def __init__(self, rivals, conditions, signals, fixed):
+    def __init__(self, rivals, conditions, signals, fixed, map=serial_map):
         self.rivals, self.conds, self.signals = dict(rivals), list(conditions), list(signals)
         self.fixed = dict(fixed or {})
         self.lo = np.array([c.low for c in self.conds], float)
         self.span = np.array([c.high - c.low for c in self.conds], float)
+        self.map = map
         self.cache, self.n = {}, 0
 
     def values(self, unit) -> dict:
         x = self.lo + np.clip(unit, 0.0, 1.0) * self.span
         return {**self.fixed, **{c.name: float(v) for c, v in zip(self.conds, x)}}
 
+    @staticmethod
+    def key(unit) -> tuple:
+        return tuple(np.round(np.clip(unit, 0.0, 1.0), 12))
+
     def __call__(self, unit) -> _Score:
-        key = tuple(np.round(np.clip(unit, 0.0, 1.0), 12))
-        if key not in self.cache:
+        self.prefetch([unit])
+        return self.cache[self.key(unit)]
+
+    def prefetch(self, units) -> None:
+        """Evaluate the experiments ``units`` not in the cache, every rival
+        at every one of them in one ``map`` (each counted in ``n``, in order)."""
+        keys = list(dict.fromkeys(k for k in map(self.key, units) if k not in self.cache))
+        conds = [self.values(np.array(k)) for k in keys]
+        jobs = [(r, c) for c in conds for r in self.rivals.values()]
+        outcomes = self.map(rival_outcome, jobs) if jobs else []
+        m = len(self.rivals)
+        for i, (k, c) in enumerate(zip(keys, conds)):
             self.n += 1
-            cond = self.values(np.array(key))
-            self.cache[key] = predicted(self.rivals, cond, self.signals)
-        return self.cache[key]
+            self.cache[k] = _scored(self.rivals, c, outcomes[i * m:(i + 1) * m],
+                                    self.signals, MAX_SPREAD)
 
     def loss(self, unit) -> float:
         """-log(1 + min D): smooth enough for Powell, finite where a rival fails."""
@@ -243,7 +281,8 @@ class Search:
 def design_experiment(rivals: Mapping[str, Rival], conditions: Sequence[Condition],
                       signals: Sequence[Signal], *, fixed: Mapping[str, float] | None = None,
                       reference: Mapping[str, float] | None = None, search: Search = Search(),
-                      min_separation: float = 3.0, times=None) -> NextExperiment:
+                      min_separation: float = 3.0, times=None,
+                      map: Callable = serial_map) -> NextExperiment:
     """The experiment within the conditions' ranges whose predicted outcomes
     differ most between ``rivals`` (name -> callable conditions -> {signal:
     samples}, or None when it cannot predict), in noise floors of the best of
@@ -253,15 +292,17 @@ def design_experiment(rivals: Mapping[str, Rival], conditions: Sequence[Conditio
     ``min_separation`` [floors]: below it the result is not ``decisive``
     (3 floors: the wrong rival's chi^2 rises by 9, p = 0.003 for one degree
     of freedom). ``times``: the rivals' sample times, kept in the result for
-    its plot."""
+    its plot. ``map(fn, jobs)``: how the rivals' predictions are computed
+    (:func:`predicted`; the hypercube's points all in one call)."""
     conds = list(conditions)
     if not conds:
         raise UsageError("no experiment conditions to search (declare `conditions` "
                          "with their ranges in the model file)")
-    ev = _Evaluator(rivals, conds, signals, fixed)
+    ev = _Evaluator(rivals, conds, signals, fixed, map)
     n0 = search.n_initial or max(12, 8 * len(conds))
     pts = qmc.LatinHypercube(d=len(conds), seed=search.seed).random(n0)
     pts = np.vstack([np.full(len(conds), 0.5), pts])
+    ev.prefetch(pts)
     scored = sorted(pts, key=ev.loss)
     for start in scored[:search.n_refine]:
         if not np.isfinite(ev(start).d2):
@@ -275,7 +316,7 @@ def design_experiment(rivals: Mapping[str, Rival], conditions: Sequence[Conditio
                            "predicted by every rival model")
     base = None
     if reference is not None:
-        ref = predicted(ev.rivals, {**ev.fixed, **reference}, ev.signals)
+        ref = predicted(ev.rivals, {**ev.fixed, **reference}, ev.signals, map=map)
         base = math.sqrt(max(ref.d2, 0.0)) if np.isfinite(ref.d2) else None
     return _result(ev, best_key, best, base, min_separation, times)
 

@@ -320,3 +320,58 @@ def test_an_experiment_beyond_the_spread_limit_is_weighed_down():
     assert nxt.conditions["a"] == pytest.approx(a[np.argmax(merit)], rel=2e-3)
     assert nxt.spread == pytest.approx(s * nxt.conditions["a"] ** 3 / f, rel=1e-9)
     assert a[np.argmax(d2)] == pytest.approx(2.0)       # unweighed: the bound
+
+
+class _FileRival:
+    """A rival that pickles: the model file's path and parameters; the
+    :class:`ModelRival` is made where it runs (the model compiled once per
+    process), as the diagnosis's rivals are."""
+
+    def __init__(self, path, params, steps):
+        self.path, self.params, self.steps = str(path), dict(params), list(steps)
+
+    def _rival(self):
+        return ModelRival(self.path, self.params, ["mass.s"], TIMES, steps=self.steps)
+
+    def __call__(self, conditions):
+        return self._rival()(conditions)
+
+    def spread(self, conditions, prediction):
+        return self._rival().spread(conditions, prediction)
+
+
+def test_the_rivals_simulated_side_by_side_give_the_same_design(tmp_path):
+    """The diagnosis runs the rivals' simulations on its workers (the
+    design's ``map``): the Coulomb slider and the constant-load slider,
+    each with a covariance step, designed one by one here and on a pool of
+    two processes, give the same experiment, separation, pairwise
+    distances, predictions and evaluation count, bit for bit."""
+    from acausal.diagnose.stages.context import Context
+    from acausal.infra.executor import open_executor
+    coulomb, load = tmp_path / "coulomb.py", tmp_path / "load.py"
+    coulomb.write_text(_SLIDER.format(law=_COULOMB, conditions=_RANGES))
+    load.write_text(_SLIDER.format(law=_LOAD, conditions=_RANGES))
+    rivals = {"coulomb": _FileRival(coulomb, {"F": 2.0}, [{"F": 0.01}]),
+              "load": _FileRival(load, {"F": -1.5}, [{"F": 0.02}])}
+    conds = conditions_of(compile_file(str(load))[0])
+    signals = [Signal("mass.s", FLOOR, "m")]
+    search = Search(n_initial=6, n_refine=1, max_refine_evals=8, seed=1)
+    one = design_experiment(rivals, conds, signals, search=search,
+                            reference={"s0": 0.1, "v0": 0.0})
+    jobs_seen = []
+    with open_executor(None, 2) as ex:
+        ctx = Context(ex, progress=False)
+
+        def side_by_side(fn, jobs):
+            jobs_seen.append(len(jobs))
+            return ctx.run(fn, jobs, "design", checkpoint=False, progress=False)
+        two = design_experiment(rivals, conds, signals, search=search,
+                                reference={"s0": 0.1, "v0": 0.0}, map=side_by_side)
+    assert jobs_seen[0] == 2 * 7                  # the hypercube's 6 points and the centre
+    assert two.conditions == one.conditions and two.signal == one.signal
+    assert two.separation == one.separation and two.pairwise == one.pairwise
+    assert two.n_evaluations == one.n_evaluations and two.baseline == one.baseline
+    assert two.spread == one.spread
+    for name in one.predictions:
+        np.testing.assert_array_equal(two.predictions[name], one.predictions[name])
+    assert one.separation > 3.0                   # a design that splits them (not all NaN)

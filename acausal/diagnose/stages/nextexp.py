@@ -87,26 +87,54 @@ def _signals(ds, ref):
     return signals_of(ds, names)
 
 
+@dataclass(frozen=True, eq=False)
+class CandidateRival:
+    """One member of the class as a rival of the design: the
+    :class:`acausal.studies.design.ModelRival` of its fitted model, made
+    where it runs (the model once per process, :func:`.tasks.model_of`),
+    so that the design's ``map`` can send it to the diagnosis's workers
+    (it pickles without a compiled model)."""
+
+    problem: object
+    candidate: object
+    params: dict
+    signals: tuple
+    times: np.ndarray
+    options: dict
+    steps: tuple
+
+    def _rival(self):
+        from ...studies.design import ModelRival
+        from .tasks import model_of
+        return ModelRival(model_of(self.problem, self.candidate), self.params, self.signals,
+                          self.times, self.options, self.steps)
+
+    def __call__(self, conditions):
+        return self._rival()(conditions)
+
+    def spread(self, conditions, prediction):
+        return self._rival().spread(conditions, prediction)
+
+
 def rivals(problem, rows, ref, signals):
-    """label -> :class:`acausal.design.ModelRival` of each row's fitted
-    model, with one step per principal direction of its parameters'
-    covariance (:func:`acausal.studies.design.covariance_steps`): the
-    design weighs each rival's predictions by how well its fit determines
-    them."""
-    from ...studies.design import ModelRival, covariance_steps
-    from .tasks import model_of
+    """label -> :class:`CandidateRival` of each row's fitted model, with one
+    step per principal direction of its parameters' covariance
+    (:func:`acausal.studies.design.covariance_steps`): the design weighs
+    each rival's predictions by how well its fit determines them."""
+    from ...studies.design import covariance_steps
     times = ref.trace.time if ref.trace is not None else np.array([0.0])
     opts = dict(backend=problem.settings.integrator)     # the fits' integrator
-    return {r.candidate.label: ModelRival(
-        model_of(problem, r.candidate), r.fit.values, [s.name for s in signals], times, opts,
-        steps=covariance_steps(r.fit.names, r.fit.values, r.fit.jacobian, r.fit.cost))
+    return {r.candidate.label: CandidateRival(
+        problem, r.candidate, dict(r.fit.values), tuple(s.name for s in signals), times, opts,
+        tuple(covariance_steps(r.fit.names, r.fit.values, r.fit.jacobian, r.fit.cost)))
         for r in rows}
 
 
-def _fixed_only(rv, signals, ref, times):
-    """The class at the reference experiment alone (no condition declared)."""
-    from ...studies.design import NextExperiment, predicted
-    sc = predicted(rv, dict(ref.conditions), signals)
+def _fixed_only(rv, signals, ref, times, map=None):
+    """The class at the reference experiment alone (no condition declared);
+    ``map`` as :func:`next_experiment`'s."""
+    from ...studies.design import NextExperiment, predicted, serial_map
+    sc = predicted(rv, dict(ref.conditions), signals, map=map or serial_map)
     sep = math.sqrt(max(sc.d2, 0.0)) if np.isfinite(sc.d2) else float("nan")
     pair = min(sc.pairwise, key=sc.pairwise.get) if sc.pairwise else " | "
     n = max(np.asarray(next(iter(sc.predictions.values()), [0.0])).size, 1)
@@ -119,10 +147,14 @@ def _fixed_only(rv, signals, ref, times):
                           1, sep, False, msg, times)
 
 
-def next_experiment(problem, ds, dec, rk, index=None) -> NextStep:
-    """Stage: the experiment that splits the best candidate's class (module doc)."""
+def next_experiment(problem, ds, dec, rk, index=None, map=None) -> NextStep:
+    """Stage: the experiment that splits the best candidate's class (module
+    doc). ``map(fn, jobs)``: how the rivals' simulations run (None: one
+    after another here; the diagnosis passes its executor's, the same
+    predictions side by side, :func:`acausal.studies.design.predicted`)."""
     import time
-    from ...studies.design import Search, conditions_of, design_experiment
+    from ...studies.design import Search, conditions_of, design_experiment, serial_map
+    map = map or serial_map
     from ...modelfile import compile_file
     t0 = time.perf_counter()
     rows = class_rows(dec, rk, index)
@@ -138,12 +170,13 @@ def next_experiment(problem, ds, dec, rk, index=None) -> NextStep:
         times = ref.trace.time if ref.trace is not None else None
         conds = conditions_of(compile_file(problem.model_path)[0])
         if not conds:
-            res = _fixed_only(rv, signals, ref, times)
+            res = _fixed_only(rv, signals, ref, times, map)
         else:
             search = Search(n_initial=max(8, 4 * len(conds)), n_refine=N_REFINE,
                             max_refine_evals=MAX_REFINE_EVALS)
             res = design_experiment(rv, conds, signals, fixed=dict(ref.conditions),
-                                    reference=dict(ref.conditions), search=search, times=times)
+                                    reference=dict(ref.conditions), search=search, times=times,
+                                    map=map)
     except AcausalError as exc:
         return NextStep(labels, None, f"not computed: {exc}", time.perf_counter() - t0,
                         ref.name)
