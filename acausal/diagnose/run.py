@@ -191,7 +191,7 @@ def designed(ctx: Context, s: State) -> State:
                        progress=False)
     with ctx.clock.timing("design_s"):
         nxt = next_experiment(s.problem, s.dataset, s.decision, s.ranking, index,
-                              map=side_by_side)
+                              map_jobs=side_by_side)
     return dataclasses.replace(s, families=index, next_experiment=nxt)
 
 

@@ -191,7 +191,7 @@ def rival_outcome(job):
     that gives one (a ``spread(conditions, prediction)`` method, as
     :class:`ModelRival` with its parameters' covariance), the variance of
     that prediction. A module-level function of one picklable job, so that
-    a ``map`` may run the rivals in worker processes (:func:`predicted`)."""
+    a ``map_jobs`` may run the rivals in worker processes (:func:`predicted`)."""
     rival, conditions = job
     pred = rival(conditions)
     spread = getattr(rival, "spread", None)
@@ -199,23 +199,22 @@ def rival_outcome(job):
 
 
 def serial_map(fn, jobs) -> list:
-    """``[fn(job) for job in jobs]``: the default ``map`` of the design."""
+    """``[fn(job) for job in jobs]``: the design's default ``map_jobs``."""
     return [fn(job) for job in jobs]
 
 
 def predicted(rivals: Mapping[str, Rival], conditions, signals,
-              max_spread: float = MAX_SPREAD, map: Callable = serial_map) -> _Score:
+              max_spread: float = MAX_SPREAD, map_jobs: Callable = serial_map) -> _Score:
     """:func:`score` of every rival at ``conditions``, with the variance of
     each prediction for the rivals that give one (:func:`rival_outcome`).
-    ``map(fn, jobs)``: runs ``fn`` on each job, results in job order (the
+    ``map_jobs(fn, jobs)``: runs ``fn`` on each job, results in job order (the
     diagnosis passes its executor's, so the rivals simulate side by side;
     each rival's simulations are the same wherever they run)."""
-    return _scored(rivals, conditions, map(rival_outcome, [(r, conditions)
-                                                           for r in rivals.values()]),
-                   signals, max_spread)
+    jobs = [(r, conditions) for r in rivals.values()]
+    return _scored(rivals, map_jobs(rival_outcome, jobs), signals, max_spread)
 
 
-def _scored(rivals, conditions, outcomes, signals, max_spread):
+def _scored(rivals, outcomes, signals, max_spread):
     pred = {n: o[0] for n, o in zip(rivals, outcomes)}
     var = {n: o[1] for n, o in zip(rivals, outcomes)
            if o[0] is not None and callable(getattr(rivals[n], "spread", None))}
@@ -224,14 +223,14 @@ def _scored(rivals, conditions, outcomes, signals, max_spread):
 
 class _Evaluator:
     """Every rival at one experiment (unit-cube coordinates), cached;
-    ``map`` as :func:`predicted`'s."""
+    ``map_jobs`` as :func:`predicted`'s."""
 
-    def __init__(self, rivals, conditions, signals, fixed, map=serial_map):
+    def __init__(self, rivals, conditions, signals, fixed, map_jobs=serial_map):
         self.rivals, self.conds, self.signals = dict(rivals), list(conditions), list(signals)
         self.fixed = dict(fixed or {})
         self.lo = np.array([c.low for c in self.conds], float)
         self.span = np.array([c.high - c.low for c in self.conds], float)
-        self.map = map
+        self.map_jobs = map_jobs
         self.cache, self.n = {}, 0
 
     def values(self, unit) -> dict:
@@ -248,16 +247,17 @@ class _Evaluator:
 
     def prefetch(self, units) -> None:
         """Evaluate the experiments ``units`` not in the cache, every rival
-        at every one of them in one ``map`` (each counted in ``n``, in order)."""
-        keys = list(dict.fromkeys(k for k in map(self.key, units) if k not in self.cache))
+        at every one of them in one ``map_jobs`` (each counted in ``n``, in order)."""
+        keys = list(dict.fromkeys(k for k in (self.key(u) for u in units)
+                                  if k not in self.cache))
         conds = [self.values(np.array(k)) for k in keys]
         jobs = [(r, c) for c in conds for r in self.rivals.values()]
-        outcomes = self.map(rival_outcome, jobs) if jobs else []
+        outcomes = self.map_jobs(rival_outcome, jobs) if jobs else []
         m = len(self.rivals)
-        for i, (k, c) in enumerate(zip(keys, conds)):
+        for i, k in enumerate(keys):
             self.n += 1
-            self.cache[k] = _scored(self.rivals, c, outcomes[i * m:(i + 1) * m],
-                                    self.signals, MAX_SPREAD)
+            self.cache[k] = _scored(self.rivals, outcomes[i * m:(i + 1) * m], self.signals,
+                                    MAX_SPREAD)
 
     def loss(self, unit) -> float:
         """-log(1 + min D): smooth enough for Powell, finite where a rival fails."""
@@ -282,7 +282,7 @@ def design_experiment(rivals: Mapping[str, Rival], conditions: Sequence[Conditio
                       signals: Sequence[Signal], *, fixed: Mapping[str, float] | None = None,
                       reference: Mapping[str, float] | None = None, search: Search = Search(),
                       min_separation: float = 3.0, times=None,
-                      map: Callable = serial_map) -> NextExperiment:
+                      map_jobs: Callable = serial_map) -> NextExperiment:
     """The experiment within the conditions' ranges whose predicted outcomes
     differ most between ``rivals`` (name -> callable conditions -> {signal:
     samples}, or None when it cannot predict), in noise floors of the best of
@@ -292,13 +292,13 @@ def design_experiment(rivals: Mapping[str, Rival], conditions: Sequence[Conditio
     ``min_separation`` [floors]: below it the result is not ``decisive``
     (3 floors: the wrong rival's chi^2 rises by 9, p = 0.003 for one degree
     of freedom). ``times``: the rivals' sample times, kept in the result for
-    its plot. ``map(fn, jobs)``: how the rivals' predictions are computed
+    its plot. ``map_jobs(fn, jobs)``: how the rivals' predictions are computed
     (:func:`predicted`; the hypercube's points all in one call)."""
     conds = list(conditions)
     if not conds:
         raise UsageError("no experiment conditions to search (declare `conditions` "
                          "with their ranges in the model file)")
-    ev = _Evaluator(rivals, conds, signals, fixed, map)
+    ev = _Evaluator(rivals, conds, signals, fixed, map_jobs)
     n0 = search.n_initial or max(12, 8 * len(conds))
     pts = qmc.LatinHypercube(d=len(conds), seed=search.seed).random(n0)
     pts = np.vstack([np.full(len(conds), 0.5), pts])
@@ -316,7 +316,7 @@ def design_experiment(rivals: Mapping[str, Rival], conditions: Sequence[Conditio
                            "predicted by every rival model")
     base = None
     if reference is not None:
-        ref = predicted(ev.rivals, {**ev.fixed, **reference}, ev.signals, map=map)
+        ref = predicted(ev.rivals, {**ev.fixed, **reference}, ev.signals, map_jobs=map_jobs)
         base = math.sqrt(max(ref.d2, 0.0)) if np.isfinite(ref.d2) else None
     return _result(ev, best_key, best, base, min_separation, times)
 

@@ -342,7 +342,7 @@ class _FileRival:
 
 def test_the_rivals_simulated_side_by_side_give_the_same_design(tmp_path):
     """The diagnosis runs the rivals' simulations on its workers (the
-    design's ``map``): the Coulomb slider and the constant-load slider,
+    design's ``map_jobs``): the Coulomb slider and the constant-load slider,
     each with a covariance step, designed one by one here and on a pool of
     two processes, give the same experiment, separation, pairwise
     distances, predictions and evaluation count, bit for bit."""
@@ -366,7 +366,7 @@ def test_the_rivals_simulated_side_by_side_give_the_same_design(tmp_path):
             jobs_seen.append(len(jobs))
             return ctx.run(fn, jobs, "design", checkpoint=False, progress=False)
         two = design_experiment(rivals, conds, signals, search=search,
-                                reference={"s0": 0.1, "v0": 0.0}, map=side_by_side)
+                                reference={"s0": 0.1, "v0": 0.0}, map_jobs=side_by_side)
     assert jobs_seen[0] == 2 * 7                  # the hypercube's 6 points and the centre
     assert two.conditions == one.conditions and two.signal == one.signal
     assert two.separation == one.separation and two.pairwise == one.pairwise

@@ -92,7 +92,7 @@ class CandidateRival:
     """One member of the class as a rival of the design: the
     :class:`acausal.studies.design.ModelRival` of its fitted model, made
     where it runs (the model once per process, :func:`.tasks.model_of`),
-    so that the design's ``map`` can send it to the diagnosis's workers
+    so that the design's ``map_jobs`` can send it to the diagnosis's workers
     (it pickles without a compiled model)."""
 
     problem: object
@@ -130,11 +130,11 @@ def rivals(problem, rows, ref, signals):
         for r in rows}
 
 
-def _fixed_only(rv, signals, ref, times, map=None):
+def _fixed_only(rv, signals, ref, times, map_jobs=None):
     """The class at the reference experiment alone (no condition declared);
-    ``map`` as :func:`next_experiment`'s."""
+    ``map_jobs`` as :func:`next_experiment`'s."""
     from ...studies.design import NextExperiment, predicted, serial_map
-    sc = predicted(rv, dict(ref.conditions), signals, map=map or serial_map)
+    sc = predicted(rv, dict(ref.conditions), signals, map_jobs=map_jobs or serial_map)
     sep = math.sqrt(max(sc.d2, 0.0)) if np.isfinite(sc.d2) else float("nan")
     pair = min(sc.pairwise, key=sc.pairwise.get) if sc.pairwise else " | "
     n = max(np.asarray(next(iter(sc.predictions.values()), [0.0])).size, 1)
@@ -147,14 +147,14 @@ def _fixed_only(rv, signals, ref, times, map=None):
                           1, sep, False, msg, times)
 
 
-def next_experiment(problem, ds, dec, rk, index=None, map=None) -> NextStep:
+def next_experiment(problem, ds, dec, rk, index=None, map_jobs=None) -> NextStep:
     """Stage: the experiment that splits the best candidate's class (module
-    doc). ``map(fn, jobs)``: how the rivals' simulations run (None: one
+    doc). ``map_jobs(fn, jobs)``: how the rivals' simulations run (None: one
     after another here; the diagnosis passes its executor's, the same
     predictions side by side, :func:`acausal.studies.design.predicted`)."""
     import time
     from ...studies.design import Search, conditions_of, design_experiment, serial_map
-    map = map or serial_map
+    map_jobs = map_jobs or serial_map
     from ...modelfile import compile_file
     t0 = time.perf_counter()
     rows = class_rows(dec, rk, index)
@@ -170,13 +170,13 @@ def next_experiment(problem, ds, dec, rk, index=None, map=None) -> NextStep:
         times = ref.trace.time if ref.trace is not None else None
         conds = conditions_of(compile_file(problem.model_path)[0])
         if not conds:
-            res = _fixed_only(rv, signals, ref, times, map)
+            res = _fixed_only(rv, signals, ref, times, map_jobs)
         else:
             search = Search(n_initial=max(8, 4 * len(conds)), n_refine=N_REFINE,
                             max_refine_evals=MAX_REFINE_EVALS)
             res = design_experiment(rv, conds, signals, fixed=dict(ref.conditions),
                                     reference=dict(ref.conditions), search=search, times=times,
-                                    map=map)
+                                    map_jobs=map_jobs)
     except AcausalError as exc:
         return NextStep(labels, None, f"not computed: {exc}", time.perf_counter() - t0,
                         ref.name)
