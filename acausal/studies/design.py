@@ -270,19 +270,21 @@ class Search:
     """How the conditions' ranges are searched: a Latin hypercube of
     ``n_initial`` points (default 8 per condition, at least 12), then a
     bounded Powell search from the ``n_refine`` best, each of at most
-    ``max_refine_evals`` evaluations; ``seed`` of the hypercube."""
+    ``max_refine_evals`` evaluations; ``seed`` of the hypercube;
+    ``map_jobs(fn, jobs)``: how the rivals' predictions are computed
+    (:func:`predicted`; the hypercube's points all in one call)."""
 
     n_initial: int | None = None
     n_refine: int = 3
     max_refine_evals: int = 60
     seed: int = 0
+    map_jobs: Callable = serial_map
 
 
 def design_experiment(rivals: Mapping[str, Rival], conditions: Sequence[Condition],
                       signals: Sequence[Signal], *, fixed: Mapping[str, float] | None = None,
                       reference: Mapping[str, float] | None = None, search: Search = Search(),
-                      min_separation: float = 3.0, times=None,
-                      map_jobs: Callable = serial_map) -> NextExperiment:
+                      min_separation: float = 3.0, times=None) -> NextExperiment:
     """The experiment within the conditions' ranges whose predicted outcomes
     differ most between ``rivals`` (name -> callable conditions -> {signal:
     samples}, or None when it cannot predict), in noise floors of the best of
@@ -292,13 +294,12 @@ def design_experiment(rivals: Mapping[str, Rival], conditions: Sequence[Conditio
     ``min_separation`` [floors]: below it the result is not ``decisive``
     (3 floors: the wrong rival's chi^2 rises by 9, p = 0.003 for one degree
     of freedom). ``times``: the rivals' sample times, kept in the result for
-    its plot. ``map_jobs(fn, jobs)``: how the rivals' predictions are computed
-    (:func:`predicted`; the hypercube's points all in one call)."""
+    its plot."""
     conds = list(conditions)
     if not conds:
         raise UsageError("no experiment conditions to search (declare `conditions` "
                          "with their ranges in the model file)")
-    ev = _Evaluator(rivals, conds, signals, fixed, map_jobs)
+    ev = _Evaluator(rivals, conds, signals, fixed, search.map_jobs)
     n0 = search.n_initial or max(12, 8 * len(conds))
     pts = qmc.LatinHypercube(d=len(conds), seed=search.seed).random(n0)
     pts = np.vstack([np.full(len(conds), 0.5), pts])
@@ -316,7 +317,8 @@ def design_experiment(rivals: Mapping[str, Rival], conditions: Sequence[Conditio
                            "predicted by every rival model")
     base = None
     if reference is not None:
-        ref = predicted(ev.rivals, {**ev.fixed, **reference}, ev.signals, map_jobs=map_jobs)
+        ref = predicted(ev.rivals, {**ev.fixed, **reference}, ev.signals,
+                        map_jobs=search.map_jobs)
         base = math.sqrt(max(ref.d2, 0.0)) if np.isfinite(ref.d2) else None
     return _result(ev, best_key, best, base, min_separation, times)
 

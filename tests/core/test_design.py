@@ -2,6 +2,7 @@
 blind test on a slider where Coulomb friction and a constant load are
 indistinguishable on the data so far; the truth is simulated by an
 independent scipy solve_ivp simulator, not by the project's model code."""
+import dataclasses
 import json
 import textwrap
 import time
@@ -342,7 +343,7 @@ class _FileRival:
 
 def test_the_rivals_simulated_side_by_side_give_the_same_design(tmp_path):
     """The diagnosis runs the rivals' simulations on its workers (the
-    design's ``map_jobs``): the Coulomb slider and the constant-load slider,
+    design's ``Search.map_jobs``): the Coulomb slider and the constant-load slider,
     each with a covariance step, designed one by one here and on a pool of
     two processes, give the same experiment, separation, pairwise
     distances, predictions and evaluation count, bit for bit."""
@@ -365,8 +366,9 @@ def test_the_rivals_simulated_side_by_side_give_the_same_design(tmp_path):
         def side_by_side(fn, jobs):
             jobs_seen.append(len(jobs))
             return ctx.run(fn, jobs, "design", checkpoint=False, progress=False)
-        two = design_experiment(rivals, conds, signals, search=search,
-                                reference={"s0": 0.1, "v0": 0.0}, map_jobs=side_by_side)
+        two = design_experiment(rivals, conds, signals,
+                                search=dataclasses.replace(search, map_jobs=side_by_side),
+                                reference={"s0": 0.1, "v0": 0.0})
     assert jobs_seen[0] == 2 * 7                  # the hypercube's 6 points and the centre
     assert two.conditions == one.conditions and two.signal == one.signal
     assert two.separation == one.separation and two.pairwise == one.pairwise

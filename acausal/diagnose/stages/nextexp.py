@@ -173,10 +173,9 @@ def next_experiment(problem, ds, dec, rk, index=None, map_jobs=None) -> NextStep
             res = _fixed_only(rv, signals, ref, times, map_jobs)
         else:
             search = Search(n_initial=max(8, 4 * len(conds)), n_refine=N_REFINE,
-                            max_refine_evals=MAX_REFINE_EVALS)
+                            max_refine_evals=MAX_REFINE_EVALS, map_jobs=map_jobs)
             res = design_experiment(rv, conds, signals, fixed=dict(ref.conditions),
-                                    reference=dict(ref.conditions), search=search, times=times,
-                                    map_jobs=map_jobs)
+                                    reference=dict(ref.conditions), search=search, times=times)
     except AcausalError as exc:
         return NextStep(labels, None, f"not computed: {exc}", time.perf_counter() - t0,
                         ref.name)
