@@ -11,8 +11,9 @@ reference experiment (the first with a trace). When the model file declares
 no conditions, the separation at the reference experiment is reported
 (the numbers, not a null) with a message saying what to declare.
 
-The stage simulates; the report only draws what it stored (each member's
-predicted signal).
+The stage simulates, on the diagnosis's workers (the design's
+``Search.map_jobs``; each rival a picklable :class:`CandidateRival`); the
+report only draws what it stored (each member's predicted signal).
 """
 from __future__ import annotations
 
