@@ -280,10 +280,15 @@ def _decode(path: Path, raw: list, first: int) -> list:
     return out
 
 
+def _holds_data(raw: str) -> bool:
+    """Whether a line of a trace holds values (not blank, not a comment)."""
+    return bool(raw.strip()) and not raw.lstrip().startswith("#")
+
+
 def _chunk(path: Path, lines: list, first: int, names: list) -> np.ndarray:
     """The numbers of ``lines`` (file lines from ``first``), read by numpy;
     on any doubt, line by line, so that the error names its line and column."""
-    if not any(raw.strip() and not raw.lstrip().startswith("#") for raw in lines):
+    if not any(_holds_data(raw) for raw in lines):
         return np.empty((0, len(names)))      # (numpy warns on a chunk with no data)
     try:
         with np.errstate(all="ignore"):
@@ -297,7 +302,7 @@ def _chunk(path: Path, lines: list, first: int, names: list) -> np.ndarray:
     out = []
     for k, raw in enumerate(lines):
         line = first + k
-        if not raw.strip() or raw.lstrip().startswith("#"):
+        if not _holds_data(raw):
             continue
         try:
             cells = next(csv.reader([raw], strict=True))

@@ -216,8 +216,7 @@ def predicted(rivals: Mapping[str, Rival], conditions, signals,
 
 def _scored(rivals, outcomes, signals, max_spread):
     pred = {n: o[0] for n, o in zip(rivals, outcomes)}
-    var = {n: o[1] for n, o in zip(rivals, outcomes)
-           if o[0] is not None and callable(getattr(rivals[n], "spread", None))}
+    var = {n: o[1] for n, o in zip(rivals, outcomes) if o[1] is not None}
     return score(pred, signals, var, max_spread)
 
 
