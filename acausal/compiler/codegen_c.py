@@ -35,6 +35,17 @@ class _Printer(NamedTemps, C99CodePrinter):
     def _print_Heaviside(self, expr):   # the Python code's heaviside: 1/2 at 0
         return f"acs_heaviside({self._print(expr.args[0])})"
 
+    # a condition folded into a Piecewise of truth values (|x| of a Piecewise x:
+    # x >= 0 becomes a Piecewise whose branches are true, false or relations):
+    # sympy prints C99's ``true``/``false``, which need <stdbool.h>; C's own
+    # truth values are 1 and 0 (MSL's OneWayClutch and Translational.Friction
+    # had fallen back to the sundae backend on "'true' undeclared")
+    def _print_BooleanTrue(self, expr):
+        return "1"
+
+    def _print_BooleanFalse(self, expr):
+        return "0"
+
 
 @dataclass(frozen=True)
 class CSource:

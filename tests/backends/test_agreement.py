@@ -192,6 +192,15 @@ def test_examples_agree(model):
     _check_agreement(f"models/examples/{model}.py")
 
 
+@pytest.mark.parametrize("model", ["Rotational/OneWayClutch", "Translational/Friction"])
+def test_msl_friction_examples_agree(model):
+    """Friction elements whose mode machine folds a condition into a
+    Piecewise of truth values (a freewheel's ``blocked``, a stop's): their C
+    once printed C99's ``true`` without <stdbool.h>, the compiler failed and
+    the run fell back to sundae, 10-20x slower in every fit."""
+    _check_agreement(f"models/msl/{model}.py")
+
+
 EXAMPLES = sorted(f[:-3] for f in os.listdir(os.path.join(ROOT, "models", "examples"))
                   if f.endswith(".py") and not f.startswith("_"))
 MODELS = sorted(f[:-3] for f in os.listdir(os.path.join(ROOT, "models"))

@@ -145,8 +145,18 @@ def _compile(cm, cc, libs, out):
 def _run_cc(cmd, what):
     proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:
-        raise Unavailable(f"the C compiler failed on {what}: "
-                          + (proc.stderr.strip().splitlines() or ["?"])[-1])
+        raise Unavailable(f"the C compiler failed on {what}: {cc_error(proc.stderr)}")
+
+
+def cc_error(stderr):
+    """The first error line of a C compiler's output, with the source's
+    folder left out (``model.c:348:1: error: 'true' undeclared ...``); its
+    last line was often only the caret under the code ("| ^~~~")."""
+    lines = [ln.strip() for ln in stderr.splitlines() if ln.strip()]
+    hit = next((ln for ln in lines if "error" in ln and ":" in ln), None) or \
+        (lines[-1] if lines else "?")
+    head, sep, rest = hit.partition(": ")
+    return (os.path.basename(head) + sep + rest) if sep and os.sep in head else hit
 
 
 def _driver_object(cc, src):
