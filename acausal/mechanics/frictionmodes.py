@@ -106,7 +106,10 @@ def magnitude(x):
 
 
 def _value(state, expr):
-    """The value of a sympy expression of model symbols in an event action."""
+    """The value of a sympy expression of model symbols in an event action
+    (a lone symbol is read as it is: what substituting it gives)."""
+    if isinstance(expr, sp.Symbol):
+        return float(state[expr])
     expr = sp.sympify(expr)
     if expr.is_number:
         return float(expr)
@@ -212,8 +215,30 @@ class PartialFrictionModes(Component):
         (the action runs at every event of every element: building the sympy
         condition and substituting into it was half of a stick-slip pair
         model's simulation time)."""
-        return bool(state[self.mode] == STUCK and state[self.startForward] == 0
-                    and state[self.startBackward] == 0)
+        m, sf, sb = self._flags()
+        return bool(state[m] == STUCK and state[sf] == 0 and state[sb] == 0)
+
+    def _built(self, key, make):
+        """``make()``, an expression of this element's symbols, built once per
+        path: the actions run at every event of the model, and building the
+        element's expressions again each time (a sympy Symbol per variable
+        read) was a fifth of a stick-slip model's simulation time."""
+        memo = self.__dict__.setdefault("_expressions", {})
+        k = (self.path, key)
+        if k not in memo:
+            memo[k] = make()
+        return memo[k]
+
+    def _flags(self):
+        """The symbols of (mode, startForward, startBackward)."""
+        return self._built("flags", lambda: (self.mode, self.startForward, self.startBackward))
+
+    def _velocity(self):
+        """``w`` of :meth:`friction_motion`."""
+        return self._built("w", lambda: self.friction_motion()[0])
+
+    def _blocked(self, d):
+        return self._built(("blocked", d), lambda: self.blocked(d))
 
     def _friction_elements(self):
         """Every friction element of the model this one belongs to, in the
@@ -302,40 +327,38 @@ class PartialFrictionModes(Component):
     # -- event actions (each writes absolute values: two of one element never
     #    fire at one instant, their conditions exclude each other) ------------------
     def _set(self, state, mode, sf=0, sb=0):
-        state[self.mode] = mode
-        state[self.startForward] = sf
-        state[self.startBackward] = sb
+        m, f, b = self._flags()
+        state[m] = mode
+        state[f] = sf
+        state[b] = sb
 
     def _direction(self, state, w):
         """Forward/Backward by the sign of w where not blocked, else Stuck."""
-        if w > 0 and not _true(state, self.blocked(1)):
+        if w > 0 and not _true(state, self._blocked(1)):
             return FORWARD
-        if w < 0 and not _true(state, self.blocked(-1)):
+        if w < 0 and not _true(state, self._blocked(-1)):
             return BACKWARD
         return STUCK
 
     def _engaged(self, state):
-        e = self.engagement()
+        e = self._built("engagement", self.engagement)
         return e is None or _value(state, e) > 0
 
     def _act_initial(self, state):
-        w, _ = self.friction_motion()
         if not self._engaged(state):
             self._set(state, FREE)
         else:
-            self._set(state, self._direction(state, _value(state, w)))
+            self._set(state, self._direction(state, _value(state, self._velocity())))
 
     def _act_release(self, state):
         self._set(state, FREE)
 
     def _act_engage(self, state):
-        w, _ = self.friction_motion()
-        self._set(state, self._direction(state, _value(state, w)))
+        self._set(state, self._direction(state, _value(state, self._velocity())))
 
     def _act_break(self, d):
         def act(state):
-            w, _ = self.friction_motion()
-            if d * _value(state, w) >= 0:        # moving that way, or at rest: slides
+            if d * _value(state, self._velocity()) >= 0:   # moving that way, or at rest: slides
                 self._set(state, d)
             else:                                 # wait until w has crossed zero
                 self._set(state, STUCK, sf=int(d == 1), sb=int(d == -1))
@@ -343,8 +366,9 @@ class PartialFrictionModes(Component):
 
     def _act_go(self, d):
         def act(state):
-            hold = _value(state, self.hold_level(d))
-            if d * (hold - _value(state, self.sa)) - TIE * (1 + abs(hold)) > 0:
+            hold = _value(state, self._built(("hold", d), lambda: self.hold_level(d)))
+            if d * (hold - _value(state, self._built("sa", lambda: self.sa))) \
+                    - TIE * (1 + abs(hold)) > 0:
                 self._set(state, STUCK)          # the start is over first (MSL order)
             else:
                 self._set(state, d)
@@ -371,7 +395,7 @@ class PartialFrictionModes(Component):
             if other is self:
                 return                            # none before this one holds the same motion
             if other._locked_now(state) and self._coupled(state, other):
-                share = _value(state, self.sa)
+                share = _value(state, self._built("sa", lambda: self.sa))
                 self._act_break(1 if share >= 0 else -1)(state)
                 return
 
@@ -394,11 +418,11 @@ class PartialFrictionModes(Component):
         return memo[key]
 
     def _act_slide_stop(self, state):
-        w, _ = self.friction_motion()
-        m = int(state[self.mode])
-        jump = self.jump_level()
+        w = self._velocity()
+        m = int(state[self._flags()[0]])
+        jump = self._built("jump", self.jump_level)
         if jump is not None and m * _value(state, w) < -_value(state, jump) \
-                and not _true(state, self.blocked(-m)):
+                and not _true(state, self._blocked(-m)):
             self._set(state, -m)                  # w jumped across zero (a reinit elsewhere)
         else:
             self._set(state, STUCK)
