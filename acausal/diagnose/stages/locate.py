@@ -96,16 +96,15 @@ RECHOOSE = 3          # the best node's setting chosen again at its fitted point
                       # this many times (_rechoose)
 LOCATED_EVALS = 6   # a located fit's budget, in evaluations of every experiment per
                  # parameter and window (FitSettings.evals_per_param; the first window a
-                 # third): deterministic, where the wall-time budget the other fits share
-                 # (chain.BUDGET_MIN_S, 60 s) stopped every refit of the cam detent case
-                 # (85-100 weights, 60-180 ms an evaluation at the fitted weights) at a
-                 # point that depended on the machine's load: the same data gave the
-                 # follower's term 13.9, 14.7 and 31.1 floors held-out in three runs
+                 # third): deterministic, where the wall-time budget the other fits
+                 # shared then (60 s; now a guard only, chain._budget) stopped every
+                 # refit of the cam detent case (85-100 weights, 60-180 ms an evaluation
+                 # at the fitted weights) at a point that depended on the machine's
+                 # load: the same data gave the follower's term 13.9, 14.7 and 31.1
+                 # floors held-out in three runs
 LOCATED_JACOBIAN = "secant"  # Broyden updates between difference Jacobians (a fresh one
                  # at the optimum for the intervals and leave-one-out): on that case the
                  # first located fit took 846 simulations against 1770, the same verdict
-GUARD = 10.0     # the wall-time budget of a located fit, in multiples of the other fits'
-                 # (chain._budget): a guard against a pathological run only
 FLOOR_REACH = 1.1     # the best term "reaches the floor" when its held-out RMS is at most
                  # this many floors (the nulls' held-out spread is 0.99-1.01 on the rig
                  # and stop rig, docs/diagnosis.md; a penalised term of tens of effective
@@ -227,11 +226,11 @@ def library_explains(rk) -> str | None:
 def located_tasks(problem, cal, cands) -> list:
     """The fit tasks of the generic term's candidates: ``problem``'s fits
     with the located settings (``LOCATED_EVALS`` evaluations per parameter,
-    the ``LOCATED_JACOBIAN``) and the wall-time budget a guard only."""
+    the ``LOCATED_JACOBIAN``); the wall time is the other fits' guard
+    (:func:`.chain.fit_tasks`), max(600 s, 120 x the nominal fit's)."""
     s = dataclasses.replace(problem.settings, evals_per_param=LOCATED_EVALS,
                             jacobian=LOCATED_JACOBIAN)
-    return [dataclasses.replace(t, budget_s=None if t.budget_s is None else GUARD * t.budget_s)
-            for t in fit_tasks(dataclasses.replace(problem, settings=s), cal, cands)]
+    return fit_tasks(dataclasses.replace(problem, settings=s), cal, cands)
 
 
 def _params(graph, loc, n_x, n_v):
