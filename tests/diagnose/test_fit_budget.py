@@ -1,17 +1,19 @@
 """Issue 24, item 5: a fit's budget is measured in simulations, so where it
 ends does not depend on how fast or how busy the machine is. The wall time
-is a guard against a pathological run only: at 12 x the nominal fit's wall
-time and at least 60 s it stopped a stick-slip pair's fit on a host loaded
-three times over, and the verdict depended on the load.
+is a guard against a pathological run only. At 12 x the nominal fit's wall
+time and at least 60 s it could bind under load: a stick-slip pair's window
+is 700 simulations of 35 ms, 25 s on a quiet host, past 60 s on one loaded
+three times over.
 
 Here the clock of the fits runs faster than the real one, so that the
-fit's longest least-squares run (one :class:`~acausal.diagnose.stages.
-fitting.Objective`, which the guard times) takes three minutes on it: a
-machine that much slower, or as busy (a stick-slip pair's window is 25 s
-on a quiet host). A candidate fitted with the tasks the diagnosis makes
+fit's longest least-squares run (one
+:class:`~acausal.diagnose.stages.fitting.Objective`, which the guard
+times) takes three minutes on it, as on a machine that much slower or
+busier. A candidate fitted with the tasks the diagnosis makes
 (:func:`~acausal.diagnose.stages.chain.fit_tasks`, its wall-time guard
-included) ends at the same point, bit for bit, as with the real clock. Real simulations of the latch striker on synthetic data holding a
-Coulomb friction the nominal model lacks."""
+included) ends at the same point, bit for bit, as with the real clock.
+Real simulations of the latch striker on synthetic data holding a Coulomb
+friction the nominal model lacks."""
 import os
 import time
 
