@@ -45,7 +45,7 @@ from .tasks import MAX_TRACE_SAMPLES, MIN_TRACE_SAMPLES, thin_traces  # noqa: F4
 # only, one that no fit reaches on a loaded machine. At 12 x the nominal fit and at
 # least 60 s it could: a stick-slip pair's window is 700 simulations of 35 ms, 25 s on
 # a quiet host and past 60 s on one loaded three times over, so where such a fit (or
-# a leave-one-out refit, at a third of it) stopped, and the verdict, depended on the
+# a leave-one-out refit, at a third of it) stopped, and the verdict, could depend on the
 # machine's load
 BUDGET_FACTOR = 120.0  # a fit's wall-time guard: this many times the nominal fit ...
 BUDGET_MIN_S = 600.0   # ... and at least this long [s]
