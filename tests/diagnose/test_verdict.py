@@ -259,7 +259,9 @@ def test_every_screened_rival_is_fitted_beyond_the_budget_briefly():
     cal = NS(fit=f0, nominal=NS(wall_s=1.0))
 
     def dec(per_sim):
-        fit = NS(n_sim=100, wall_s=100 * per_sim)
+        # the rate is CPU time: the wall time of a loaded host (here 50 x the
+        # CPU time) does not move the budget
+        fit = NS(n_sim=100, cpu_s=100 * per_sim, wall_s=5000 * per_sim)
         return NS(rows=[NS(fit=fit)])
     assert full_fit_simulations(prob, picks[0][0], 3) == 3 * 25 * 3
     fast = screened_tasks(prob, cal, dec(0.01), picks)

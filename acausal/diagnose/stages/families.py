@@ -110,15 +110,18 @@ SCREEN_FIT_S = 120.0  # seconds of simulation (one core) the screened members' f
 
 
 def seconds_per_simulation(dec, cal) -> float:
-    """The measured wall time of one simulation of one experiment with the
-    fits' backend: the median over the candidate fits so far (the nominal
-    calibration's when there are none; it includes the model's compile)."""
-    rates = [r.fit.wall_s / r.fit.n_sim for r in dec.rows
-             if getattr(r.fit, "n_sim", 0) > 0 and getattr(r.fit, "wall_s", 0) > 0]
+    """The measured time of one simulation of one experiment with the fits'
+    backend: the median over the candidate fits so far (the nominal
+    calibration's when there are none) of their last least-squares run's
+    CPU time over their simulations. CPU time, not wall time: how many
+    screened members get a full fit does not depend on what else the
+    machine runs (on a host loaded twice over, wall time would halve them)."""
+    rates = [r.fit.cpu_s / r.fit.n_sim for r in dec.rows
+             if getattr(r.fit, "n_sim", 0) > 0 and getattr(r.fit, "cpu_s", 0) > 0]
     if rates:
         return float(np.median(rates))
     f0 = cal.fit
-    return float(cal.nominal.wall_s / f0.n_sim) if f0.n_sim else 0.0
+    return float(f0.cpu_s / f0.n_sim) if f0.n_sim and f0.cpu_s > 0 else 0.0
 
 
 def full_fit_simulations(problem, cand, experiments) -> int:

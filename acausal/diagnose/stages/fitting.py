@@ -49,7 +49,8 @@ class Fit:
     signals: list                     # signal name of each residual
     ci95: dict = field(default_factory=dict)
     n_sim: int = 0
-    wall_s: float = 0.0
+    wall_s: float = 0.0               # wall time of the last least-squares run (Objective)
+    cpu_s: float = 0.0                # ... and its CPU time in this process
     ok: bool = True
     message: str = ""
 
@@ -165,7 +166,7 @@ class Objective:
         self.names = list(names)
         self.fixed = dict(fixed or {})
         self.budget_s, self.max_evals = budget_s, max_evals
-        self.t0 = time.perf_counter()
+        self.t0, self.c0 = time.perf_counter(), time.process_time()
         self.n_eval = self.n_sim = 0
         self.size = None
         self.best_cost, self.best_x = np.inf, None
@@ -400,7 +401,8 @@ def refine_or_keep(obj, x, lo, hi, sc, max_nfev, tol):
 def failed_fit(names, x0, obj, message):
     return Fit(list(names), dict(zip(names, np.asarray(x0, float).tolist())), float("inf"),
                np.zeros(0), np.zeros((0, len(names))), [], [], n_sim=obj.n_sim,
-               wall_s=time.perf_counter() - obj.t0, ok=False, message=message)
+               wall_s=time.perf_counter() - obj.t0, cpu_s=time.process_time() - obj.c0,
+               ok=False, message=message)
 
 
 def finish(obj, x, J, ok, message, lo):
@@ -413,7 +415,7 @@ def finish(obj, x, J, ok, message, lo):
     J = np.asarray(J)[:r.size].reshape(r.size, len(names)) if names else np.zeros((r.size, 0))
     out = Fit(names, dict(zip(names, np.asarray(x, float).tolist())), float(r @ r), r, J,
               groups, signals, n_sim=obj.n_sim, wall_s=time.perf_counter() - obj.t0,
-              ok=bool(ok), message=str(message))
+              cpu_s=time.process_time() - obj.c0, ok=bool(ok), message=str(message))
     out.ci95 = confidence(out, positive=[n for n, low in zip(names, lo) if low > 0])
     return out
 
