@@ -1126,6 +1126,7 @@ def _calibrate(cal, compile_file, file, data, fit, method, experiments, profile)
                   else _csv_list(experiments, "--experiments"))
     mf, cm = compile_file(file)
     ds = thin_traces(cal.model_dataset(file, data), say=True)
+    _compiled_note(cm, file, "calibrate")
     _condition_bounds(cm, ds)
     _condition_warnings(mf, ds)
     _trace_span_warnings(mf, ds)
@@ -1259,11 +1260,28 @@ def _trace_span_warnings(mf, ds):
                   "check the time column's unit, or the experiment's t0 and t_end")
 
 
+def _compiled_note(cm, file, what):
+    """One line on stderr when the command's backend is the compiled one and
+    this model cannot be built in C (no compiler, or an expression with no
+    C form): its simulations then run on sundae, 3-20 times slower, which a
+    long calibration or diagnosis should not do silently (``simulate`` says
+    it per run)."""
+    if os.environ.get("ACAUSAL_BACKEND") != "compiled":
+        return
+    from .runtime.backends.compiled import Unavailable, library
+    try:
+        library(cm)
+    except Unavailable as exc:
+        click.echo(f"acausal {what}: note: {file}: compiled backend unavailable: {exc}; "
+                   f"its simulations run on sundae (3-20x slower)", err=True)
+
+
 def _diagnosis_data_warnings(file, data):
     """The data checks calibrate makes (a condition outside its parameter's
     bounds; trace samples outside the model file's run) before a diagnosis: it said nothing of a trace to 50 s
     against a 0.3 s run. The dataset is read here once more (the diagnosis
-    reads its own); the compiled model is the process's cached one."""
+    reads its own); the compiled model is the process's cached one. Also
+    the note when that model cannot run in C (:func:`_compiled_note`)."""
     from .modelfile import compile_file
     from .studies import calibrate as cal
     try:
@@ -1271,6 +1289,7 @@ def _diagnosis_data_warnings(file, data):
         ds = cal.model_dataset(file, data)
     except AcausalError:      # the diagnosis reads them again and says what is wrong
         return
+    _compiled_note(cm, file, "diagnose")
     _condition_bounds(cm, ds)
     _trace_span_warnings(mf, ds)
 

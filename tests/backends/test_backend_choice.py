@@ -63,3 +63,47 @@ def test_commands_of_many_runs_default_to_compiled(monkeypatch, tmp_path):
     CliRunner().invoke(main, ["diagnose", OSC, str(tmp_path)])
     assert seen == ["compiled"] and "ACAUSAL_BACKEND" not in os.environ
     assert MANY_RUNS == {"calibrate", "sweep", "diagnose", "tolerance"}
+
+
+@pytest.mark.parametrize("cc", ["false", None])
+def test_calibrate_says_once_when_its_model_cannot_run_in_c(tmp_path, cc):
+    """calibrate (and diagnose) run on the compiled backend; a model that
+    cannot be built in C (here a C compiler that always fails) runs on
+    sundae, 3-20x slower: one note line says so and why, and the fit is
+    still right. With a working compiler there is no note. (MSL's
+    OneWayClutch had fallen back so for a printer's ``true``, unseen.)"""
+    import json
+    import shutil
+
+    import numpy as np
+    from click.testing import CliRunner
+
+    from acausal.cli import main
+    from acausal.data import Dataset, Instrument, MeasuredExperiment, Trace, write_dataset
+    from acausal.runtime.backends import compiled_available
+
+    if cc is None and compiled_available() is not None:
+        pytest.skip(compiled_available())
+    model = tmp_path / "slider.py"            # a model (and library) of this test's own
+    shutil.copy(os.path.join(ROOT, "tests", "diagnose", "slider_model.py"), model)
+    t = np.linspace(0.0, 0.25, 200)
+    rng = np.random.default_rng(1)
+    exps = [MeasuredExperiment(f"R{k}", {"s0": s0}, {}, Trace(
+        t, {"mass.s": s0 * np.cos(np.sqrt(120.0) * t) + rng.normal(0.0, 1e-5, t.size)}))
+        for k, s0 in enumerate((0.1, -0.07))]
+    write_dataset(tmp_path / "data", Dataset(None, exps, {"mass.s": Instrument(
+        "mass.s", noise_std=1e-5)}))
+    env = {"ACAUSAL_CACHE": str(tmp_path / "cache"), "CC": cc}
+    r = CliRunner(env=env).invoke(main, ["calibrate", str(model), str(tmp_path / "data"),
+                                         "--fit", "spring.c", "--json"])
+    assert r.exit_code == 0, r.output
+    notes = [ln for ln in r.stderr.splitlines() if "compiled backend unavailable" in ln]
+    if cc is None:
+        assert notes == []
+    else:
+        assert len(notes) == 1, r.stderr
+        assert str(model) in notes[0] and "the C compiler failed" in notes[0] \
+            and "run on sundae" in notes[0]
+    fitted = json.loads(r.stdout)["values"]["spring.c"]
+    fitted = fitted["value"] if isinstance(fitted, dict) else fitted
+    assert abs(fitted - 120.0) / 120.0 < 1e-3
