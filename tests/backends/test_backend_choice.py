@@ -104,6 +104,7 @@ def test_calibrate_says_once_when_its_model_cannot_run_in_c(tmp_path, cc):
         assert len(notes) == 1, r.stderr
         assert str(model) in notes[0] and "the C compiler failed" in notes[0] \
             and "run on sundae" in notes[0]
+        assert "exit status 1, no message" in notes[0]     # `false` prints nothing
     fitted = json.loads(r.stdout)["values"]["spring.c"]
     fitted = fitted["value"] if isinstance(fitted, dict) else fitted
     assert abs(fitted - 120.0) / 120.0 < 1e-3

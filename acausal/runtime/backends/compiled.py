@@ -145,16 +145,18 @@ def _compile(cm, cc, libs, out):
 def _run_cc(cmd, what):
     proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:
-        raise Unavailable(f"the C compiler failed on {what}: {cc_error(proc.stderr)}")
+        raise Unavailable(f"the C compiler failed on {what}: "
+                          f"{cc_error(proc.stderr, proc.returncode)}")
 
 
-def cc_error(stderr):
+def cc_error(stderr, status=None):
     """The first error line of a C compiler's output, with the source's
     folder left out (``model.c:348:1: error: 'true' undeclared ...``); its
-    last line was often only the caret under the code ("| ^~~~")."""
+    last line was often only the caret under the code ("| ^~~~"). With no
+    output: its exit status."""
     lines = [ln.strip() for ln in stderr.splitlines() if ln.strip()]
     hit = next((ln for ln in lines if "error" in ln and ":" in ln), None) or \
-        (lines[-1] if lines else "?")
+        (lines[-1] if lines else f"exit status {status}, no message")
     head, sep, rest = hit.partition(": ")
     return (os.path.basename(head) + sep + rest) if sep and os.sep in head else hit
 
