@@ -14,7 +14,6 @@ busier. A candidate fitted with the tasks the diagnosis makes
 included) ends at the same point, bit for bit, as with the real clock.
 Real simulations of the latch striker on synthetic data holding a Coulomb
 friction the nominal model lacks."""
-import os
 import time
 
 import numpy as np
@@ -22,23 +21,17 @@ import pytest
 
 from acausal.diagnose.problem import NOMINAL
 from acausal.diagnose.stages import fitting
-from acausal.diagnose.stages.chain import NominalFit, candidates, fit_tasks, load_problem
+from acausal.diagnose.stages.chain import NominalFit, candidates, fit_tasks
 from acausal.diagnose.stages.tasks import FitTask, calibrate_nominal, fit_candidate
-from acausal.diagnose.synth import synthesize
 
-HERE = os.path.dirname(__file__)
-LATCH = os.path.abspath(os.path.join(HERE, "..", "..", "models", "latch_striker.py"))
+from .latch_data import latch_friction_problem
+
 SLOW_RUN_S = 180.0   # [s] the fit's longest run on the slow clock (the old guard: 60 s)
 
 
 @pytest.fixture(scope="module")
 def task(tmp_path_factory):
-    d = tmp_path_factory.mktemp("budget")
-    synthesize(LATCH, d / "data", hypothesis="coulomb_friction", location="latch",
-               effect=(6.0, 6.0), conditions={"F_coil": [20.0, 45.0]}, traces=["latch.s"],
-               sample_rate=5e3, noise={"latch.s": 5e-6}, resolution={"latch.s": 5e-6},
-               units={"time": "ms", "latch.s": "mm"}, seed=5)
-    problem = load_problem(LATCH, d / "data")[0]
+    problem = latch_friction_problem(tmp_path_factory.mktemp("budget") / "data", seed=5)
     cal = NominalFit(calibrate_nominal(FitTask(problem, NOMINAL, problem.free)), ())
     cand = candidates(problem, ["coulomb_friction"])[0]
     return fit_tasks(problem, cal, [cand])[0]

@@ -11,7 +11,6 @@ and a Coulomb friction) on synthetic data, on a real pool of two
 processes."""
 import concurrent.futures as cf
 import dataclasses
-import os
 from concurrent.futures.process import BrokenProcessPool
 
 import numpy as np
@@ -19,26 +18,19 @@ import pytest
 
 from acausal.diagnose.stages import context as C
 from acausal.diagnose.stages import locate as L
-from acausal.diagnose.stages.chain import candidates, load_problem
+from acausal.diagnose.stages.chain import candidates
 from acausal.diagnose.stages.fitting import Budget, Objective, residuals_of
 from acausal.diagnose.stages.tasks import FitTask, Helpers, dataset_of, fit_candidate, \
     fit_here, model_of
-from acausal.diagnose.synth import synthesize
 from acausal.infra.executor import open_executor
 
-HERE = os.path.dirname(__file__)
-LATCH = os.path.abspath(os.path.join(HERE, "..", "..", "models", "latch_striker.py"))
+from .latch_data import latch_friction_problem
 
 
 @pytest.fixture(scope="module")
 def problem(tmp_path_factory):
-    d = tmp_path_factory.mktemp("lone")
     # the data hold a friction the nominal model lacks, so the fits move
-    synthesize(LATCH, d / "data", hypothesis="coulomb_friction", location="latch",
-               effect=(6.0, 6.0), conditions={"F_coil": [20.0, 45.0]}, traces=["latch.s"],
-               sample_rate=5e3, noise={"latch.s": 5e-6}, resolution={"latch.s": 5e-6},
-               units={"time": "ms", "latch.s": "mm"}, seed=3)
-    return load_problem(LATCH, d / "data")[0]
+    return latch_friction_problem(tmp_path_factory.mktemp("lone") / "data", seed=3)
 
 
 @pytest.fixture(scope="module")
