@@ -13,7 +13,11 @@ Every variable of a model is real. ``Abs`` is therefore differentiated as
 ``sign(u) * du/dx``: sympy's own rule, for a symbol it does not know to be
 real, writes ``re()`` and ``im()`` terms that no printer can generate (a
 quadratic drag ``-c*v*Abs(v)`` at a planar loop's joint, whose velocity is an
-expression of the loop's states, failed to compile that way).
+expression of the loop's states, failed to compile that way). For the same
+reason ``sign(u)`` differentiates to 0, its value everywhere but at u = 0
+(sympy's ``2 DiracDelta(u) du/dx`` for a real ``u``, an unprintable
+``Derivative`` otherwise): the sensitivity equations of that drag, whose
+second derivatives hold it, could not be generated.
 """
 import sympy as sp
 
@@ -45,6 +49,9 @@ def diff(expr, x):
     if isinstance(expr, sp.Abs):
         u = expr.args[0]
         return sp.sign(u) * diff(u, x)
+    if isinstance(expr, sp.sign):
+        # zero wherever it has a value: its jump at u = 0 is an event's business
+        return sp.S.Zero
     if (isinstance(expr, (sp.Max, sp.Min))
             or (isinstance(expr, sp.Function)
                 and type(expr)._eval_derivative is sp.Function._eval_derivative)):

@@ -17,7 +17,8 @@ from ..compiler.codegen import generate_observe_rows
 
 VECTOR_ROWS = 1000   # fewer rows than this: the per-row callback (no generation)
 _ROWS = weakref.WeakKeyDictionary()   # compiled model -> observe_rows (None: not vectorisable)
-# compiled model -> {variable index: _Column}: one variable's vectorised expression
+# owner (a compiled model) -> {key: _Column}: one expression vectorised (a variable
+# by its index, a sensitivity by its own key: expression_column)
 _COLUMNS = weakref.WeakKeyDictionary()
 
 
@@ -46,19 +47,45 @@ class _Column:
         self.fn, self.checked = fn, set()
 
 
-def _column_function(cm, k):
-    table = _COLUMNS.setdefault(cm, {})
-    col = table.get(k, False)
+def _column_function(owner, key, build):
+    table = _COLUMNS.setdefault(owner, {})
+    col = table.get(key, False)
     if col is False:
         try:
-            a = cm.artefact
-            expr = a.resolve(a.flat.variables[cm.var_names[k]].symbol)
-            col = _Column(generate_observe_rows([expr], a.dae.y, a.dae.yp,
-                                                list(a.parameters.symbols), list(cm.disc_syms)))
+            expr, y, yp, params, discretes = build()
+            col = _Column(generate_observe_rows([expr], y, yp, list(params), list(discretes)))
         except AttributeError:   # not a compiled model's artefact
             col = None
-        table[k] = col
+        table[key] = col
     return col
+
+
+def expression_column(owner, key, build, rows_of, per_row_value):
+    """One expression's value at each row, over all rows of each mode at
+    once (numpy); None when it cannot be vectorised. ``owner`` keeps the
+    generated function (a weak key: a compiled model), ``key`` names the
+    expression for it; ``build()`` gives (expression, y, yp, parameter
+    symbols, discrete symbols) of the callbacks the rows came from, the
+    first time only. ``rows_of`` = (p, t, y, yp, d); ``per_row_value(i)``
+    is the per-row callback's value at row ``i``: the first row of each
+    mode is checked against it once per owner and key (a guard against a
+    function the array printer writes wrong: then None, always)."""
+    col = _column_function(owner, key, build)
+    if col is None:
+        return None
+
+    def agrees(mode, i, first):
+        if mode in col.checked:
+            return True
+        ok = _agrees(first, np.array([per_row_value(i)], float))
+        if ok:
+            col.checked.add(mode)
+        return ok
+    out = _by_mode(col.fn, 1, rows_of, agrees)
+    if out is None:
+        _COLUMNS[owner][key] = None
+        return None
+    return out[0]
 
 
 def observed_column(cm, k, p, t, y, yp, d):
@@ -69,25 +96,13 @@ def observed_column(cm, k, p, t, y, yp, d):
     every variable row by row cost a fifth of a diagnosis (an independent
     cam follower case, 2026-11-27: ``per_row`` 17 % of its samples). The
     first row of each mode is checked against the per-row callback once
-    per model (a guard against a function the array printer writes wrong:
-    then the per-row path, always)."""
-    col = _column_function(cm, k)
-    if col is None:
-        return None
-
-    def agrees(key, i, first):
-        if key in col.checked:
-            return True
-        ok = _agrees(first, per_row(cm, p, t[i:i + 1], y[i:i + 1], yp[i:i + 1],
-                                    d[i:i + 1])[0, k:k + 1])
-        if ok:
-            col.checked.add(key)
-        return ok
-    out = _by_mode(col.fn, 1, (p, t, y, yp, d), agrees)
-    if out is None:
-        _COLUMNS[cm][k] = None
-        return None
-    return out[0]
+    per model (:func:`expression_column`)."""
+    def build():
+        a = cm.artefact
+        return (a.resolve(a.flat.variables[cm.var_names[k]].symbol), a.dae.y, a.dae.yp,
+                a.parameters.symbols, cm.disc_syms)
+    return expression_column(cm, k, build, (p, t, y, yp, d), lambda i: per_row(
+        cm, p, t[i:i + 1], y[i:i + 1], yp[i:i + 1], d[i:i + 1])[0, k])
 
 
 def per_row(cm, p, t, y, yp, d):

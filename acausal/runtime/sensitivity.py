@@ -210,6 +210,12 @@ class SensitivityModel:
         return observed + [obs_sens[k][j] for j in range(self.m)
                            for k in range(len(cm.var_names))]
 
+    def observed_sensitivity(self, k, j):
+        """d(the base model's observed variable ``k``)/d(parameter ``j``), an
+        expression of the augmented unknowns and discrete values (the observe
+        callback's entry ``n_obs (1 + j) + k``, n_obs the base's variables)."""
+        return self._lin.total(self.base.observed_exprs()[k])[j]
+
     def __getattr__(self, name):
         if name == "base":   # not set yet (copying, pickling)
             raise AttributeError(name)

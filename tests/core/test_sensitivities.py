@@ -16,6 +16,8 @@ from acausal.runtime.backends import compiled_available
 from acausal.runtime.model import compile_model
 from acausal.errors import ParameterError, UsageError
 from acausal.mechanics.contact import Contact, contact_period
+from acausal.lang import Eq, Parameter
+from acausal.mechanics.partials import PartialCompliantWithRelativeStates
 from acausal.mechanics.translational import Damper, Fixed, Force, Mass, Spring
 
 # the compiled backend's cases build a C library each (about a second): slow tier
@@ -320,3 +322,58 @@ def test_compiled_callbacks_of_a_sensitivity_model_match_its_python_ones():
     c[0](0.0, y, yp, rc)
     py[0](0.0, y, yp, rp)
     np.testing.assert_allclose(rc, rp, rtol=1e-12, atol=1e-300)
+
+
+class _QuadraticDrag(PartialCompliantWithRelativeStates):
+    """f = c v_rel |v_rel| (tension positive): a drag whose Jacobian holds
+    sign(v_rel) and whose sensitivity equations its derivative."""
+
+    c = Parameter(0.0, "N*s^2/m^2", "drag coefficient", min=0.0)
+
+    def equations(self):
+        return [Eq(self.f, self.c * self.v_rel * sp.Abs(self.v_rel))]
+
+
+def test_quadratic_drag_closed_form():
+    """m v' = -c v |v| from v0 > 0: v = v0 / (1 + a t), s = ln(1 + a t) m / c
+    with a = c v0 / m, differentiated by sympy here. The sensitivity
+    equations hold d sign(v)/dv (zero where it has a value); sympy's own
+    derivative of it is not printable, and no sensitivity of a quadratic
+    drag could be generated."""
+    model = Model()
+    model.mass = Mass(m=0.5, s=0.0, v=3.0)
+    model.drag = _QuadraticDrag(c=0.8)
+    model.ground = Fixed()
+    model.connect(model.ground.flange, model.drag.flange_a)
+    model.connect(model.drag.flange_b, model.mass.flange)
+    cm = compile_model(model)
+    res = cm.simulate(t_end=1.0, rtol=1e-11, atol=1e-14, output_step=0.05,
+                      sensitivities=["drag.c", "mass.m"])
+    t, M, C = sp.symbols("t M C", positive=True)
+    a = C * 3.0 / M
+    exact = {"mass.v": 3.0 / (1 + a * t), "mass.s": sp.log(1 + a * t) * M / C}
+    exact["drag.f"] = C * exact["mass.v"] ** 2
+    for var, e in exact.items():
+        for name, sym in (("drag.c", C), ("mass.m", M)):
+            want = sp.lambdify(t, sp.diff(e, sym).subs({M: 0.5, C: 0.8}), "numpy")(res.t)
+            got = res.sensitivity(var, name)
+            assert np.max(np.abs(got - want)) < 1e-7 * np.max(np.abs(want)), (var, name)
+
+
+def test_observed_sensitivities_by_column_equal_the_per_row_table():
+    """A sensitivity of one observed variable is computed alone, over all
+    rows of each mode at once (a fit's Jacobian reads one or two); the
+    bouncing contact (modes, discrete values that move with the parameters):
+    every variable's against the per-row table of all of them."""
+    cm = _bouncing()
+    names = ["contact.K", "contact.e"]
+    kw = dict(t_end=0.02, rtol=1e-10, atol=1e-14, sensitivities=names)
+    res = cm.simulate(**kw)
+    table = cm.simulate(**kw).sensitivities.observed()    # another run: its own table
+    assert len({n for _, n in res.events}) > 1 and res.d.shape[1] > 0
+    for j, name in enumerate(names):
+        for k, var in enumerate(cm.var_names):
+            want = table[:, j, k]
+            np.testing.assert_allclose(res.sensitivity(var, name), want, rtol=1e-12,
+                                       atol=1e-12 * np.max(np.abs(want)), err_msg=var)
+    assert res.sensitivities._obs is None      # never the whole table
