@@ -267,8 +267,11 @@ class Objective:
     def jac_x(self, x):
         """d residuals / d x from forward sensitivities
         (:func:`acausal.studies.residuals.weighted_jacobian` with :class:`FitRuns`),
-        penalty rows included; a failed run raises its AcausalError."""
+        penalty rows included; a failed run raises its AcausalError. It
+        spends the evaluations of the differences it stands for (one per
+        parameter), so a fit's budget allows it the same iterations either way."""
         self._check()
+        self.n_eval += len(self.names)
         self.n_sim += len(self.dataset.experiments)
         J = weighted_jacobian(self.pair, self.dataset, self.params(x), self.names,
                               FitRuns(self.backend))[1]
