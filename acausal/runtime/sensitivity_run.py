@@ -467,7 +467,8 @@ class Sensitivities:
         nobs = len(sm.base.var_names)
 
         def build():
-            return sm.observed_sensitivity(k, j), sm.dae.y, sm.dae.yp, sm.base.param_syms, sm.disc_syms
+            return (sm.observed_sensitivity(k, j), sm.dae.y, sm.dae.yp, sm.base.param_syms,
+                    sm.disc_syms)
 
         def per_row(i):
             cb = sm.callbacks(self.p, list(self.D[i]))
