@@ -10,9 +10,10 @@ and the free parameters' data Jacobians are taken once per node at the
 calibrated point, on the finest splines (``X_LADDER[-1]`` x
 ``V_LADDER[-1]`` knots); every coarser spline is exactly a finer one
 (:func:`.generic.refine_matrix`), so each resolution in ``X_LADDER`` x
-``V_LADDER`` and each smoothing weight in ``SMOOTH_GRID`` (position and
-velocity parts apart) is scored by its linearised leave-one-experiment-out
-error (the PRESS residuals of the penalised Gauss-Newton step: no
+``V_LADDER`` and the smoothing weights in ``SMOOTH_GRID`` (position and
+velocity parts apart, swept in turn: :func:`_search`) are scored by their
+linearised leave-one-experiment-out error (the PRESS residuals of the
+penalised Gauss-Newton step: no
 simulation), and the coarsest, then smoothest, whose error is within
 ``CV_TIE`` of the best is fitted in full (output error, from that step) at the nodes whose
 linearised error is within ``REFINE_WITHIN`` of the best (at most
@@ -559,10 +560,15 @@ def choose(cols: Columns, ranges, n, ladder_x=gen.X_LADDER, ladder_v=gen.V_LADDE
            grid=SMOOTH_GRID) -> Choice:
     """The resolution and smoothing of the term at one node (module doc),
     from its :class:`Columns` on the finest splines of the ladders; ``n``
-    data values (the smoothing weights are per value). Every setting is
+    data values (the smoothing weights are per value). Each resolution's
+    smoothing weights are searched by :func:`_search` (a sweep of each
+    part's weight in turn, not every pair of the grid), each setting met
     scored by its linearised leave-one-experiment-out RMS; of those within
     ``CV_TIE`` of the best the coarsest (fewest knots), then the smoothest
-    (fewest effective degrees of freedom), wins."""
+    (fewest effective degrees of freedom), wins. The choice is not a
+    continuous function of ``cols`` (the sweep's path and the pins' null-space
+    threshold: docs/diagnosis.md, "The located term's choice depends on
+    round-off")."""
     from ...infra.blas import single_threaded
     with single_threaded(cols.Jg.shape[1]):
         return _choose(cols, ranges, n, ladder_x, ladder_v, grid)
