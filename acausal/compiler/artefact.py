@@ -389,7 +389,12 @@ class Artefact:
     def observed_exprs(self):
         """The expressions the observe callback computes: every variable of
         :attr:`var_names`, resolved to the DAE's unknowns."""
-        return [self.resolve(self.flat.variables[n].symbol) for n in self.var_names]
+        return [self.observed_expr(n) for n in self.var_names]
+
+    def observed_expr(self, name):
+        """Variable ``name`` resolved to the DAE's unknowns (one entry of
+        :meth:`observed_exprs`)."""
+        return self.resolve(self.flat.variables[name].symbol)
 
     # -- solver slots ------------------------------------------------------------
     def _memoised(self, kind, key, make):

@@ -99,8 +99,8 @@ def observed_column(cm, k, p, t, y, yp, d):
     per model (:func:`expression_column`)."""
     def build():
         a = cm.artefact
-        return (a.resolve(a.flat.variables[cm.var_names[k]].symbol), a.dae.y, a.dae.yp,
-                a.parameters.symbols, cm.disc_syms)
+        return (a.observed_expr(cm.var_names[k]), a.dae.y, a.dae.yp, a.parameters.symbols,
+                cm.disc_syms)
     return expression_column(cm, k, build, (p, t, y, yp, d), lambda i: per_row(
         cm, p, t[i:i + 1], y[i:i + 1], yp[i:i + 1], d[i:i + 1])[0, k])
 

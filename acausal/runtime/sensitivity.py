@@ -214,7 +214,8 @@ class SensitivityModel:
         """d(the base model's observed variable ``k``)/d(parameter ``j``), an
         expression of the augmented unknowns and discrete values (the observe
         callback's entry ``n_obs (1 + j) + k``, n_obs the base's variables)."""
-        return self._lin.total(self.base.observed_exprs()[k])[j]
+        cm = self.base
+        return self._lin.total(cm.artefact.observed_expr(cm.var_names[k]))[j]
 
     def __getattr__(self, name):
         if name == "base":   # not set yet (copying, pickling)
