@@ -32,8 +32,8 @@ from .stages.chain import DiagnosisError
 from .stages.context import Clock, Context
 from .stages.families import family_index, fit_members, prefer_simplest
 from .stages.intervals import intervals
-from .stages.kinematics import Kinematics, equivalents, kinematics, prefer_site, \
-    tied_candidates
+from .stages.kinematics import Kinematics, equivalents, kinematics, placements, \
+    prefer_site, tied_candidates
 from .stages.locate import Location, locate
 from .stages.nextexp import next_experiment
 from .stages.resume import FitStore
@@ -75,15 +75,44 @@ def members_fitted(ctx: Context, s: State) -> State:
     return decided(ctx, dataclasses.replace(s, fits=s.fits + members.fits))
 
 
+def _allowed(options):
+    """Whether a site is among the user's ``locations`` (exact, or a prefix
+    followed by '.'), as a function of the site; None: every site is."""
+    locs = options.locations
+    if locs is None:
+        return None
+    return lambda loc: any(loc == w or loc.startswith(w + ".") for w in locs)
+
+
+def with_kinematics(ctx: Context, s: State) -> State:
+    """``s`` with its tied sites (:func:`.stages.kinematics.kinematics`, read
+    from the calibrated nominal runs) when not yet read."""
+    if s.kinematics is not None:
+        return s
+    with ctx.clock.timing("kinematics_s"):
+        return dataclasses.replace(s, kinematics=kinematics(s.problem, s.calibration))
+
+
 def pairs_searched(ctx: Context, s: State) -> State:
     """When the best single cause leaves misfit (option ``pairs``): the pair
-    search (:func:`.stages.chain.search_pairs`) and, when a pair comes out
+    search (:func:`.stages.chain.search_pairs`, rigidly tied sites one place:
+    :meth:`.stages.kinematics.Kinematics.places`) and, when a pair comes out
     best, its members refitted alone from the pair's point
     (:func:`.stages.chain.member_refit_tasks`), each followed by the decision."""
     if not (s.options.pairs and stages.pairs_needed(s.decision)):
         return s
+    s = with_kinematics(ctx, s)
     with ctx.clock.timing("pairs_s"):
-        got = stages.search_pairs(ctx, s.problem, s.calibration, s.decision)
+        got = stages.search_pairs(ctx, s.problem, s.calibration, s.decision,
+                                  s.kinematics.places())
+        moves = placements(s.problem, s.kinematics, got.fits, _allowed(s.options))
+        if moves:
+            rows = {r.candidate.key: r for r in s.decision.rows}
+            more = ctx.run(fit_candidate, [stages.with_floors(t, rows) for t in
+                                           stages.placement_tasks(s.problem, s.calibration,
+                                                                  moves)],
+                           "fitting pairs at rigidly tied sites")
+            got = dataclasses.replace(got, fits=got.fits + tuple(more))
         s = decided(ctx, dataclasses.replace(s, fits=s.fits + got.fits, pair_search=got,
                                              pair_screen_n_sim=got.screen_n_sim))
         again = stages.member_refit_tasks(s.problem, s.calibration, s.decision)
@@ -103,13 +132,8 @@ def tied_fitted(ctx: Context, s: State) -> State:
     d = s.decision
     if d is None or not d.discrepancy or not d.rows:
         return s
-    with ctx.clock.timing("kinematics_s"):
-        kin = kinematics(s.problem, s.calibration)
-    s = dataclasses.replace(s, kinematics=kin)
-    locs = s.options.locations
-    allowed = None if locs is None else (
-        lambda loc: any(loc == w or loc.startswith(w + ".") for w in locs))
-    cands = tied_candidates(s.problem, kin, d.rows, allowed)
+    s = with_kinematics(ctx, s)
+    cands = tied_candidates(s.problem, s.kinematics, d.rows, _allowed(s.options))
     if not cands:
         return s
     with ctx.clock.timing("tied_s"):

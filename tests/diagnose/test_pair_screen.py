@@ -211,3 +211,75 @@ def test_a_cause_at_a_tied_site_is_fitted_at_the_other_site_too():
     assert [q.start for q in p.params] == pytest.approx([0.004, 0.3])
     assert tied_candidates(problem, Kinematics(), [cf]) == []
 
+
+
+def test_rigidly_tied_sites_are_one_place_and_loose_ties_are_not():
+    """A gear (spread 3e-14) and a chain of rigid ties through a third site
+    make one place, named by its first site; a tie at 2 % (a four-bar over
+    its stroke) leaves its sites apart; no ties, no places."""
+    kin = Kinematics((Tie("motor", "load", 0.2, 3e-14), Tie("hook", "shaft", -1.6e-3, 0.02),
+                      Tie("pin", "hook", -1.0, 1e-4), Tie("lever", "pin", 2.0, 5e-4)))
+    assert kin.places() == {"motor": "load", "load": "load", "pin": "hook", "hook": "hook",
+                            "lever": "hook"}
+    assert kin.places(tol=1e-6) == {"motor": "load", "load": "load"}
+    assert Kinematics().places() == {}
+
+
+def test_a_pair_at_rigidly_tied_sites_is_screened_once():
+    """The geared drive's motor and load as one place: Coulomb friction at
+    both is one law (not a pair), and of the four placements of friction +
+    drag only the first predicted is screened; without places each
+    placement is its own pair."""
+    places = {"motor": "load", "load": "load"}
+    rows = [_fake("cf", "load", 1.0), _fake("cf", "motor", 1.0), _fake("qd", "load", 2.0),
+            _fake("qd", "motor", 2.0), _fake("cl", "frame", 3.0)]
+    assert psc.same_cause(INDEX, Candidate("cf", "motor"), Candidate("cf", "load"), places)
+    assert not psc.same_cause(INDEX, Candidate("cf", "motor"), Candidate("cf", "load"))
+    f0 = Fit(["k.c"], {"k.c": 0.0}, 20.0, np.zeros(4), np.zeros((4, 1)), [], [])
+    every = [p.key for p in psc.screen_all(f0, FREE, rows, INDEX, 1.0)]
+    once = [p.key for p in psc.screen_all(f0, FREE, rows, INDEX, 1.0, places=places)]
+    assert len(every) == 10 and frozenset({("cf", "motor"), ("cf", "load")}) in every
+    placed = [psc.placed_key(tuple(k), places) for k in once]
+    assert sorted(map(sorted, placed)) == sorted(map(sorted, [
+        {("cf", "load"), ("qd", "load")}, {("cf", "load"), ("cl", "frame")},
+        {("qd", "load"), ("cl", "frame")}]))
+    assert frozenset({("cf", "load"), ("qd", "load")}) in once     # the first placement
+
+
+def test_the_other_placements_of_a_pair_at_rigid_sites_are_fitted_from_its_fit():
+    """A pair fitted at the lever's slider (rigidly tied to the wheel at the
+    arm ARM) and the free tip: its friction moved to the wheel, seeded at
+    the torque the arm converts the force to, the other member and the
+    free parameter at the pair's fit; a loose tie, a single cause, or a
+    placement already fitted gives nothing."""
+    from acausal.diagnose.stages.chain import placement_tasks
+    from acausal.diagnose.stages.kinematics import placements
+    lever = os.path.join(HERE, "lever_model.py")
+    problem = Problem(lever, "", "acausal.diagnose.library.hypotheses",
+                      (free_param("k.c", 500.0, 200.0, 1000.0),))
+
+    def fitted(hid, loc, values):
+        cand = Candidate(hid, loc, tuple(Param(k, 0.0, 0.0, 1e3, 1.0, 0.0)
+                                         for k in values if k.startswith("hyp")))
+        fit = Fit(list(values), dict(values), 1.0, np.zeros(3), np.zeros((3, len(values))),
+                  [], [])
+        return SimpleNamespace(candidate=cand, fit=fit)
+
+    pair = fitted("coulomb_friction+constant_load", "slider+tip",
+                  {"k.c": 510.0, "hyp_cf.F": 0.08, "hyp_cl.F": 0.3})
+    rigid = Kinematics((Tie("wheel", "slider", -0.05, 1e-8),), ())
+    ((row, cand),) = placements(problem, rigid, [pair])
+    assert row is pair
+    assert (cand.hypothesis, cand.location) == ("coulomb_friction+constant_load", "wheel+tip")
+    assert [q.start for q in cand.params] == pytest.approx([0.08 * 0.05, 0.3])
+    cal = SimpleNamespace(fit=pair.fit, nominal=SimpleNamespace(wall_s=0.1))
+    (task,) = placement_tasks(problem, cal, [(row, cand)])
+    assert [q.start for q in task.free] == [510.0]
+    assert task.problem.settings.windows == (1.0,) and task.problem.settings.lhs == 0
+    loose = Kinematics((Tie("wheel", "slider", -0.05, 0.02),), ())
+    assert placements(problem, loose, [pair]) == []
+    single = fitted("coulomb_friction", "slider", {"k.c": 500.0, "hyp_cf.F": 0.08})
+    assert placements(problem, rigid, [single]) == []
+    there = fitted("coulomb_friction+constant_load", "wheel+tip",
+                   {"k.c": 510.0, "hyp_cf.tau": 0.004, "hyp_cl.F": 0.3})
+    assert placements(problem, rigid, [pair, there]) == []

@@ -222,48 +222,65 @@ def pairs_needed(dec) -> bool:
     return not vd.explains(best, vd.threshold_of(best.fit.n, best, max(len(best.loo), 1)))
 
 
-def pair_candidates(problem: Problem, dec, top=PAIR_TOP) -> tuple:
+def pair_candidates(problem: Problem, dec, top=PAIR_TOP, places=None) -> tuple:
     """Pairs among the ``top`` best tested single candidates (two
     hypotheses, or one at two sites: the second's sub-model renamed; two
     members of one family at one site are never a pair:
     :func:`.pairscreen.same_cause`), each parameter seeded from its single
-    fit (its neutral value kept as the prior). The best single's pairs with
-    every other candidate are screened by :func:`search_pairs`
-    (:mod:`.pairsearch`), every pair of singles by :mod:`.pairscreen`."""
+    fit (its neutral value kept as the prior); of pairs at rigidly tied
+    sites (``places``: :meth:`.kinematics.Kinematics.places`) only the
+    first. The best single's pairs with every other candidate are screened
+    by :func:`search_pairs` (:mod:`.pairsearch`), every pair of singles by
+    :mod:`.pairscreen`."""
     if load_library(problem.library).build_pair is None:
         return ()
     index = family_index(problem.library)
     singles = _singles(dec)[:top]
     ab = [(a, b) for i, a in enumerate(singles) for b in singles[i + 1:]]
-    return tuple(_pair(a, b) for a, b in ab
-                 if not pscreen.same_cause(index, a.candidate, b.candidate))
+    return _first_placed((_pair(a, b) for a, b in ab
+                          if not pscreen.same_cause(index, a.candidate, b.candidate, places)),
+                         places)
+
+
+def _first_placed(cands, places, done=()) -> tuple:
+    """``cands`` without those whose key is in ``done`` (candidate keys);
+    with rigidly tied ``places`` (:func:`.pairscreen.placed_key`), also
+    without those whose place key is one of ``done``'s or an earlier one's
+    (either order of a pair)."""
+    if not places:
+        return tuple(c for c in cands if c.key not in done)
+    seen = {pscreen.placed_key(zip(h.split("+"), loc.split("+")), places) for h, loc in done}
+    out = []
+    for c in cands:
+        key = pscreen.placed_key(c.members(), places)
+        if key not in seen:
+            seen.add(key)
+            out.append(c)
+    return tuple(out)
 
 
 def _singles(dec):
     return [r for r in dec.rows if "+" not in r.candidate.hypothesis and r.starts.tested]
 
 
-def partners(dec, done, index=None) -> tuple:
+def partners(dec, done, index=None, places=None) -> tuple:
     """The best tested single's pairs with every other single candidate
     (tested alone or not: a free parameter may have absorbed it), the
     partner at its neutral value, at another site or at the same site when
     of another family (``index``: :class:`~..library.loader.FamilyIndex`;
     None: each hypothesis its own family); pairs whose key is in ``done``
-    are left out."""
+    (candidate keys), or with rigidly tied ``places`` whose place key
+    (:func:`.pairscreen.placed_key`) is one of those or an earlier pair's,
+    are left out (:func:`_first_placed`)."""
     singles = _singles(dec)
     if not singles:
         return ()
     index = index or FamilyIndex({}, {})
     best = singles[0]
-    out = []
-    for r in dec.rows:
-        if "+" in r.candidate.hypothesis or pscreen.same_cause(index, best.candidate,
-                                                                r.candidate):
-            continue
-        c = _pair(best, r, neutral=True)
-        if c.key not in done:
-            out.append(c)
-    return tuple(out)
+    pairs = (_pair(best, r, neutral=True) for r in dec.rows
+             if "+" not in r.candidate.hypothesis
+             and not pscreen.same_cause(index, best.candidate, r.candidate, places))
+    return _first_placed(pairs, places, done)
 
 
 @dataclass(frozen=True)
@@ -284,27 +301,35 @@ class PairSearch:
     unfitted: tuple = ()
 
 
-def search_pairs(ctx: Context, problem: Problem, cal: NominalFit, dec: Decision) -> PairSearch:
+def search_pairs(ctx: Context, problem: Problem, cal: NominalFit, dec: Decision,
+                 places=None) -> PairSearch:
     """Stage 3b: the pairs among the best singles (:func:`pair_candidates`)
     fitted; the best single's pairs with every other candidate screened by
     short fits, the best few fitted in full (:mod:`.pairsearch`); every pair
     of singles screened by a linearised step from the singles' own fits,
     and those within reach of the best fitted in full, in two rounds
     (:mod:`.pairscreen`); then the best pair with a simpler member of a
-    family in place of a richer one, fitted briefly from it."""
+    family in place of a richer one, fitted briefly from it. ``places``
+    (:meth:`.kinematics.Kinematics.places`): rigidly tied sites are one
+    place, and a pair is searched at one placement only (the tied-sites
+    stage fits the best ones at the others)."""
     if load_library(problem.library).build_pair is None:
         return PairSearch()
     index = family_index(problem.library)
-    top = pair_candidates(problem, dec)
+    top = pair_candidates(problem, dec, places=places)
     tasks = fit_tasks(problem, cal, top)
     budget = _budget(cal)
-    others = partners(dec, {c.key for c in top}, index)
+    others = partners(dec, {c.key for c in top}, index, places)
     screened = ctx.run(ps.screen_pair, ps.screen_tasks(problem, _singles(dec)[0], others),
                        "screening pairs") if others else []
     best = _singles(dec)[0] if others else None
     tasks += ps.full_tasks(problem, cal, ps.keep(best, screened) if best else [], budget)
     done = {_pair_key(t.candidate) for t in tasks}
-    preds = pscreen.screen_all(cal.fit, problem.free, dec.rows, index, dec.c_hat)
+    placed = {pscreen.placed_key(t.candidate.members(), places) for t in tasks}
+    preds = pscreen.screen_all(cal.fit, problem.free, dec.rows, index, dec.c_hat,
+                               places=places)
+    preds = [p for p in preds if pscreen.placed_key(
+        (p.a.candidate.key, p.b.candidate.key), places) not in placed or p.key in done]
     first, _ = pscreen.picks([p for p in preds if p.key not in done])
     attempted = done | {p.key for p in first}
     tasks += [_predicted_task(problem, cal, p, budget) for p in first]
@@ -401,6 +426,20 @@ def member_refit_tasks(problem: Problem, cal, dec) -> list:
             continue
         cand = dataclasses.replace(single.candidate, params=tuple(
             p.moved(v[n]) for p, n in zip(single.candidate.params, names)))
+        task = fit_tasks(problem.from_fit(), cal, [cand])[0]
+        out.append(dataclasses.replace(task, free=tuple(p.moved(v[p.name]) for p in task.free)))
+    return out
+
+
+def placement_tasks(problem: Problem, cal, moves) -> list:
+    """The :class:`FitTask` of each (fitted row, candidate) of
+    :func:`.kinematics.placements` (a pair at another placement of rigidly
+    tied sites, seeded from the row's fit converted through the ratio): one
+    refinement on the whole record (:meth:`.problem.Problem.from_fit`), the
+    free parameters starting at the row's values."""
+    out = []
+    for row, cand in moves:
+        v = row.fit.values
         task = fit_tasks(problem.from_fit(), cal, [cand])[0]
         out.append(dataclasses.replace(task, free=tuple(p.moved(v[p.name]) for p in task.free)))
     return out

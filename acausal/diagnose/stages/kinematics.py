@@ -78,6 +78,16 @@ RATIO_PCT = (2.0, 98.0)   # percentiles of the ratio's variation (a glitch at an
 # a looser "about +-1": on the planar breaker the cam pin turns at -1.0017
 # times the hook (spread 4e-5) and its angle is not the measured hook angle.
 SAME_TOL = 1e-3
+# Sites tied this closely (the spread of :func:`tie`) are one place to the
+# pair search (:meth:`Kinematics.places`): a cause at either moves the data as
+# the same cause at the other does, to this fraction of its effect, so a
+# pair fitted at one stands in the search for the same pair at the other
+# (a rigid gear, a lever, a body and the joint that carries it; the geared
+# drive's motor and load: 3e-14). The sites are still both fitted before
+# either is shown (:func:`tied_candidates`). Not the looser ties of
+# :data:`KIN_TOL`: the breaker's hook and main shaft (2.8 %) are told apart
+# by the data when the effect is large.
+RIGID_TOL = 1e-3
 
 
 @dataclass(frozen=True)
@@ -115,6 +125,23 @@ class Kinematics:
     def signal_of(self, loc):
         """The traced signal that records ``loc``'s coordinate, or None."""
         return next((sig for site, sig in self.measured if site == loc), None)
+
+    def places(self, tol=RIGID_TOL) -> dict:
+        """site -> its place: the first (in name order) of the sites tied to
+        it, directly or through others, within ``tol`` (:data:`RIGID_TOL`);
+        only sites so tied are keys (any other site is its own place)."""
+        rigid = [t for t in self.ties if t.spread <= tol]
+        parent = {x: x for t in rigid for x in (t.a, t.b)}
+
+        def root(x):
+            while parent[x] != x:
+                x = parent[x]
+            return x
+
+        for t in rigid:
+            ra, rb = root(t.a), root(t.b)
+            parent[max(ra, rb)] = min(ra, rb)
+        return {x: root(x) for x in parent}
 
 
 def rates(runs) -> np.ndarray:
@@ -321,13 +348,37 @@ def tied_candidates(problem, kin: Kinematics, rows, allowed=None) -> list:
     through the rate ratio (:func:`convert`), the others at the row's fit."""
     if not kin.ties or not rows:
         return []
+    have = {tuple(_members(r.candidate)) for r in rows}
+    best = rows[0].aicc
+    top = [r for r in rows if r.aicc <= best + TIED_REACH][:TIED_ROWS]
+    return [c for _, c in _moves(problem, kin, top, have, allowed)]
+
+
+def placements(problem, kin: Kinematics, fits, allowed=None, tol=RIGID_TOL) -> list:
+    """[(fit, candidate)]: each pair among ``fits`` (fitted candidates:
+    ``.candidate``, ``.fit``) with a member at a site rigidly tied to another
+    (within ``tol``: :meth:`Kinematics.places`), that member moved there,
+    seeded as :func:`tied_candidates` seeds it; none already among ``fits``.
+    The pair search fits a pair at one placement of rigidly tied sites
+    (:func:`.chain.search_pairs`); these are its other placements, each a
+    refinement of the converted fit."""
+    rigid = dataclasses.replace(kin, ties=tuple(t for t in kin.ties if t.spread <= tol))
+    pairs = [f for f in fits if f.fit is not None and f.fit.ok
+             and "+" in (f.candidate.hypothesis or "")]
+    if not rigid.ties or not pairs:
+        return []
+    have = {tuple(_members(f.candidate)) for f in fits}
+    return list(_moves(problem, rigid, pairs, have, allowed))
+
+
+def _moves(problem, kin: Kinematics, rows, have, allowed):
+    """(row, candidate) for each of ``rows`` with one member moved to a site
+    tied to its own (:func:`tied_candidates`); ``have``: member lists
+    (sorted tuples) already fitted, extended with those returned."""
     lib = load_library(problem.library)
     graph = lib.graph_of(problem.model_path)
     index = family_index(problem.library)
-    have = {tuple(_members(r.candidate)) for r in rows}
-    best = rows[0].aicc
-    out = []
-    for row in [r for r in rows if r.aicc <= best + TIED_REACH][:TIED_ROWS]:
+    for row in rows:
         members = row.candidate.members()
         for i, (h, loc, names) in enumerate(members):
             hyp = lib.HYPOTHESES.get(h)
@@ -345,8 +396,7 @@ def tied_candidates(problem, kin: Kinematics, rows, allowed=None) -> list:
                                 else None) for k, (_, at, _) in enumerate(members)]
                 cand = cands[0] if len(cands) == 1 else pair_of(*cands)
                 have.add(tuple(sorted(want)))
-                out.append(cand)
-    return out
+                yield row, cand
 
 
 def _moved(lib, graph, row, k, site, ratio):

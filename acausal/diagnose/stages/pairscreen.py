@@ -92,14 +92,28 @@ class Predicted:
         return f"{self.a.candidate.label} + {self.b.candidate.label}"
 
 
-def same_cause(index, a, b) -> bool:
+def same_cause(index, a, b, places=None) -> bool:
     """Whether single candidates ``a`` and ``b`` cannot form a pair: one
     hypothesis at one site, or two members of one family at one site
-    (``index``: :class:`~..library.loader.FamilyIndex`)."""
-    if a.location != b.location:
+    (``index``: :class:`~..library.loader.FamilyIndex`); ``places``: site ->
+    place (:meth:`.kinematics.Kinematics.places`: rigidly tied sites are one
+    place; None or a site not in it: each site its own)."""
+    if place_of(places, a.location) != place_of(places, b.location):
         return False
     return a.hypothesis == b.hypothesis or index.family(a.hypothesis) == index.family(
         b.hypothesis)
+
+
+def place_of(places, loc):
+    """The place of site ``loc`` (:func:`same_cause`)."""
+    return loc if not places else places.get(loc, loc)
+
+
+def placed_key(members, places=None) -> frozenset:
+    """The set of a candidate's (hypothesis, place) members (``members``:
+    [(hypothesis, location, ...)], :meth:`~..problem.Candidate.members`): a
+    pair at rigidly tied sites has the key of the same pair at the others."""
+    return frozenset((m[0], place_of(places, m[1])) for m in members)
 
 
 def _columns(fit, names):
@@ -137,17 +151,20 @@ def predict(f0, free, a, b, bounds_of_param):
     return predicted_step(base, J_own, J_free, (lo, hi))
 
 
-def screen_all(f0, free, rows, index, c_hat, done=()) -> list:
+def screen_all(f0, free, rows, index, c_hat, done=(), places=None) -> list:
     """:class:`Predicted` of every admissible pair of the single ``rows``
     (module doc), best predicted AICc first; pairs whose key set is in
-    ``done`` (frozensets of the two singles' keys) are left out."""
+    ``done`` (frozensets of the two singles' keys) are left out. With
+    ``places`` (:func:`same_cause`), a pair at rigidly tied sites is left
+    out after the best predicted one of its place key (:func:`placed_key`):
+    its fit would be that pair's again."""
     singles = [r for r in rows if "+" not in r.candidate.hypothesis and r.fit is not None]
     bounds = {p.name: (p.low, p.high) for r in singles for p in r.candidate.params}
     n, k0 = f0.n, f0.k
     out = []
     for i, a in enumerate(singles):
         for b in singles[i + 1:]:
-            if same_cause(index, a.candidate, b.candidate):
+            if same_cause(index, a.candidate, b.candidate, places):
                 continue
             if frozenset((a.candidate.key, b.candidate.key)) in done:
                 continue
@@ -160,6 +177,15 @@ def screen_all(f0, free, rows, index, c_hat, done=()) -> list:
             gain = max(0.0, single - aicc)
             out.append(Predicted(a, b, S, aicc, single, MARGIN + SHARE * gain))
     out.sort(key=lambda p: p.aicc)
+    if places:
+        seen = set()
+        kept = []
+        for p in out:
+            key = placed_key((p.a.candidate.key, p.b.candidate.key), places)
+            if key not in seen:
+                seen.add(key)
+                kept.append(p)
+        out = kept
     return out
 
 
