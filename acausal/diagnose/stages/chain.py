@@ -311,8 +311,9 @@ def search_pairs(ctx: Context, problem: Problem, cal: NominalFit, dec: Decision,
     (:mod:`.pairscreen`); then the best pair with a simpler member of a
     family in place of a richer one, fitted briefly from it. ``places``
     (:meth:`.kinematics.Kinematics.places`): rigidly tied sites are one
-    place, and a pair is searched at one placement only (the tied-sites
-    stage fits the best ones at the others)."""
+    place, and a pair is searched at one placement only (its other
+    placements are refined from its fit afterwards:
+    :func:`.kinematics.placements`, :func:`placement_tasks`)."""
     if load_library(problem.library).build_pair is None:
         return PairSearch()
     index = family_index(problem.library)
