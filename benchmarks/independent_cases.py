@@ -83,6 +83,10 @@ def run_one(case, effect, seed, workers=2, keep=None):
                 params={k: v["value"] for c in out.get("causes") or []
                         for k, v in c["parameters"].items()},
                 unexplained=out.get("unexplained"), errors=j["errors"], ok=j["ok"],
+                # a named cause's tied sites where the same cause was not fitted
+                unfitted_tied=[(c["cause"], e["location"]) for c in out.get("causes") or []
+                               for e in c.get("equivalent_sites") or []
+                               if e.get("fitted") is None],
                 wrong=j["wrong"], why=j["why"],
                 heldout_before=out["gain"]["before"]["heldout"],
                 heldout_after=out["gain"]["after"]["heldout"],
