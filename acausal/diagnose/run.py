@@ -64,11 +64,23 @@ def decided(ctx: Context, s: State) -> State:
 def members_fitted(ctx: Context, s: State) -> State:
     """The other members of each competitive family fitted and the decision
     taken again with them (:func:`.stages.families.fit_members`; option
-    ``families``)."""
+    ``families``): at rigidly tied sites (:meth:`.stages.kinematics.Kinematics.places`)
+    at one of them, then each fitted member at the others from its converted
+    fit (:func:`.stages.kinematics.placements`)."""
     if not s.options.families:
         return s
+    if s.decision is not None and s.decision.discrepancy:
+        s = with_kinematics(ctx, s)
+    places = s.kinematics.places() if s.kinematics is not None else None
     with ctx.clock.timing("families_s"):
-        members = fit_members(ctx, s.problem, s.calibration, s.decision)
+        members = fit_members(ctx, s.problem, s.calibration, s.decision, places)
+        moves = placements(s.problem, s.kinematics, members.fits, _allowed(s.options),
+                           singles=True, fitted=s.decision.rows) if places else []
+        if moves:
+            more = ctx.run(fit_candidate, stages.placement_tasks(s.problem, s.calibration,
+                                                                 moves),
+                           "fitting family members at rigidly tied sites")
+            members = dataclasses.replace(members, fits=members.fits + tuple(more))
     s = dataclasses.replace(s, members=members)
     if not members.fits:
         return s

@@ -28,6 +28,7 @@ import numpy as np
 
 from ..library.loader import FamilyIndex, family_index, load_library  # noqa: F401 (re-exported)
 from ..problem import Candidate, Param
+from .pairscreen import place_of
 from .screen import screened
 from .chain import fit_tasks
 from .tasks import fit_candidate
@@ -36,13 +37,22 @@ from .verdict import explains, param_checks
 TOP = 4               # members are fitted at the sites of the TOP best single candidates
 
 
-def heads(dec, index: FamilyIndex, top=TOP) -> list:
+def heads(dec, index: FamilyIndex, top=TOP, places=None) -> list:
     """The competitive head rows: family heads among the ``top`` best tested
-    single candidates."""
+    single candidates; of heads at rigidly tied sites (``places``:
+    :meth:`.kinematics.Kinematics.places`) only the first, whose members
+    stand for the others' (their other placements are refined from their
+    fits: :func:`.kinematics.placements`)."""
     singles = [r for r in dec.rows if "+" not in r.candidate.hypothesis
                and r.starts.tested][:top]
-    return [r for r in singles if r.candidate.hypothesis in index.of
-            and index.is_head(r.candidate.hypothesis)]
+    out, seen = [], set()
+    for r in singles:
+        h = r.candidate.hypothesis
+        key = (h, place_of(places, r.candidate.location))
+        if h in index.of and index.is_head(h) and key not in seen:
+            seen.add(key)
+            out.append(r)
+    return out
 
 
 def _seeded(spec, head_values, head_prefix):
@@ -50,11 +60,11 @@ def _seeded(spec, head_values, head_prefix):
     return Param.from_spec(spec, head_values.get(f"{head_prefix}.{short}"))
 
 
-def member_candidates(problem, dec, index: FamilyIndex, done=()) -> list:
+def member_candidates(problem, dec, index: FamilyIndex, done=(), places=None) -> list:
     """[(Candidate, head row)] of every other member at each competitive
-    head's site (not already fitted: ``done`` keys)."""
+    head's site (not already fitted: ``done`` keys; ``places``: :func:`heads`)."""
     lib = load_library(problem.library)
-    rows = heads(dec, index)
+    rows = heads(dec, index, places=places)
     if not rows:
         return []
     graph = lib.graph_of(problem.model_path)
@@ -80,22 +90,24 @@ class Members:
     unfitted: tuple = ()
 
 
-def fit_members(ctx, problem, cal, dec) -> Members:
+def fit_members(ctx, problem, cal, dec, places=None) -> Members:
     """Stage: the other members of each competitive family, fitted at the
     head's site with the free parameters starting from the head's fit, and
     the members elsewhere that a one-step score screen finds promising
     (:mod:`.screen`; only when a discrepancy is found: on data the model
-    explains there is no cause class to refine)."""
+    explains there is no cause class to refine). ``places``
+    (:meth:`.kinematics.Kinematics.places`): rigidly tied sites are one
+    place, and a member is fitted or screened at one of them only."""
     if not dec.discrepancy:
         return Members()
     index = family_index(problem.library)
     done = {r.candidate.key for r in dec.rows} | {r.candidate.key for r in dec.failed}
-    pairs = member_candidates(problem, dec, index, done)
+    pairs = member_candidates(problem, dec, index, done, places)
     tasks = fit_tasks(problem, cal, [c for c, _ in pairs])
     tasks = [dataclasses.replace(t, free=tuple(p.moved(head.fit.values[p.name])
                                                for p in t.free))
              for t, (_, head) in zip(tasks, pairs)]
-    rest = other_members(problem, dec, index, done | {c.key for c, _ in pairs})
+    rest = other_members(problem, dec, index, done | {c.key for c, _ in pairs}, places)
     # every member the screen finds within reach is fitted (issue 24: no
     # rival is left unfitted for a budget); a screened member starts where
     # the step predicts, so one refinement suffices, and beyond the budget
@@ -158,15 +170,18 @@ def screened_tasks(problem, cal, dec, picks, seconds=SCREEN_FIT_S) -> list:
     return out
 
 
-def other_members(problem, dec, index: FamilyIndex, done) -> list:
+def other_members(problem, dec, index: FamilyIndex, done, places=None) -> list:
     """Every non-head member at every site where its head was fitted (the
     user's choice of hypotheses and locations holds), not in ``done``
-    (keys), each from its own start."""
+    (keys), each from its own start; at rigidly tied sites (``places``)
+    only where neither it nor the same member at a site of its place is in
+    ``done`` or already taken."""
     lib = load_library(problem.library)
     graph = lib.graph_of(problem.model_path)
     sites = {(index.family(r.candidate.hypothesis), r.candidate.location) for r in dec.rows
              if r.candidate.hypothesis in index.of and index.is_head(r.candidate.hypothesis)}
     out = []
+    taken = {(h, place_of(places, loc)) for h, loc in done} if places else set()
     for fam, ms in index.members.items():
         for mid in ms[1:]:
             h = lib.HYPOTHESES.get(mid)
@@ -174,6 +189,11 @@ def other_members(problem, dec, index: FamilyIndex, done) -> list:
                 continue
             for loc in h.candidates(graph):
                 if (mid, loc) not in done and (fam, loc) in sites:
+                    if places:
+                        key = (mid, place_of(places, loc))
+                        if key in taken:
+                            continue
+                        taken.add(key)
                     out.append(Candidate(mid, loc, tuple(_seeded(s, {}, "")
                                                          for s in h.params(graph, loc))))
     return out

@@ -354,21 +354,24 @@ def tied_candidates(problem, kin: Kinematics, rows, allowed=None) -> list:
     return [c for _, c in _moves(problem, kin, top, have, allowed)]
 
 
-def placements(problem, kin: Kinematics, fits, allowed=None, tol=RIGID_TOL) -> list:
+def placements(problem, kin: Kinematics, fits, allowed=None, tol=RIGID_TOL,
+               singles=False, fitted=()) -> list:
     """[(fit, candidate)]: each pair among ``fits`` (fitted candidates:
-    ``.candidate``, ``.fit``) with a member at a site rigidly tied to another
-    (within ``tol``: :meth:`Kinematics.places`), that member moved there,
-    seeded as :func:`tied_candidates` seeds it; none already among ``fits``.
-    The pair search fits a pair at one placement of rigidly tied sites
-    (:func:`.chain.search_pairs`); these are its other placements, each a
+    ``.candidate``, ``.fit``; with ``singles``, each single cause too) with
+    a member at a site rigidly tied to another (within ``tol``:
+    :meth:`Kinematics.places`), that member moved there, seeded as
+    :func:`tied_candidates` seeds it; none already among ``fits`` or
+    ``fitted`` (other rows). The pair search and the family stage fit a cause
+    at one placement of rigidly tied sites (:func:`.chain.search_pairs`,
+    :func:`.families.fit_members`); these are its other placements, each a
     refinement of the converted fit."""
     rigid = dataclasses.replace(kin, ties=tuple(t for t in kin.ties if t.spread <= tol))
-    pairs = [f for f in fits if f.fit is not None and f.fit.ok
-             and "+" in (f.candidate.hypothesis or "")]
-    if not rigid.ties or not pairs:
+    moved = [f for f in fits if f.fit is not None and f.fit.ok and f.candidate.hypothesis
+             and (singles or "+" in f.candidate.hypothesis)]
+    if not rigid.ties or not moved:
         return []
-    have = {tuple(_members(f.candidate)) for f in fits}
-    return list(_moves(problem, rigid, pairs, have, allowed))
+    have = {tuple(_members(f.candidate)) for f in list(fits) + list(fitted)}
+    return list(_moves(problem, rigid, moved, have, allowed))
 
 
 def _moves(problem, kin: Kinematics, rows, have, allowed):
