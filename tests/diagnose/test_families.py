@@ -345,3 +345,39 @@ def test_blind_dead_band_is_named_by_the_spring_family(tmp_path):
     assert out["cause"] == "dead_band_spring" and out["location"] == "spring"
     assert out["parameters"]["hyp_db.b"]["value"] == pytest.approx(0.01, rel=0.05)
     assert out["gain"]["after"]["heldout"] <= 1.5
+
+
+def test_members_at_rigidly_tied_sites_are_fitted_at_one_of_them():
+    """The lever (tests/diagnose/lever_model.py): its wheel and slider turn
+    at a fixed ratio. With the two as one place, Coulomb friction competitive
+    at both spends its members at the first only, and the screen offers each
+    member at one site of the place; without places, at both."""
+    from acausal.diagnose.stages.families import other_members
+    lever = os.path.join(HERE, "lever_model.py")
+    prob = Problem(lever, "", "acausal.diagnose.library.hypotheses", ())
+    dec = _Dec([_row("coulomb_friction", "slider", {"k.c": 500.0, "hyp_cf.F": 0.08}),
+                _row("coulomb_friction", "wheel", {"k.c": 500.0, "hyp_cf.tau": 0.004}),
+                _row("constant_load", "tip", {"k.c": 500.0, "hyp_cl.F": 0.3})])
+    idx = family_index(prob.library)
+    places = {"wheel": "slider", "slider": "slider"}
+    assert [r.candidate.location for r in heads(dec, idx)] == ["slider", "wheel"]
+    assert [r.candidate.location for r in heads(dec, idx, places=places)] == ["slider"]
+    both = member_candidates(prob, dec, idx)
+    one = member_candidates(prob, dec, idx, places=places)
+    assert {c.location for c, _ in both} == {"slider", "wheel"}
+    assert {c.location for c, _ in one} == {"slider"}
+    assert sorted(c.hypothesis for c, _ in one) == sorted(
+        c.hypothesis for c, _ in both if c.location == "slider")
+    done = {r.candidate.key for r in dec.rows}
+    every = other_members(prob, dec, idx, done)
+    placed = other_members(prob, dec, idx, done, places)
+    by_site = {}
+    for c in every:
+        by_site.setdefault(c.hypothesis, set()).add(c.location)
+    assert any(sites >= {"wheel", "slider"} for sites in by_site.values())
+    assert all(sum(1 for c in placed if c.hypothesis == h and c.location in ("wheel", "slider"))
+               == 1 for h, sites in by_site.items() if sites >= {"wheel", "slider"})
+    # a member already fitted at one site of the place is not offered at the other
+    taken = done | {("stribeck_friction", "slider")}
+    assert ("stribeck_friction", "wheel") not in {
+        c.key for c in other_members(prob, dec, idx, taken, places)}

@@ -280,6 +280,13 @@ def test_the_other_placements_of_a_pair_at_rigid_sites_are_fitted_from_its_fit()
     assert placements(problem, loose, [pair]) == []
     single = fitted("coulomb_friction", "slider", {"k.c": 500.0, "hyp_cf.F": 0.08})
     assert placements(problem, rigid, [single]) == []
+    # a single cause (a family member) moves too when asked, unless the
+    # other placement is among the rows already fitted
+    ((_, moved),) = placements(problem, rigid, [single], singles=True)
+    assert (moved.hypothesis, moved.location) == ("coulomb_friction", "wheel")
+    assert moved.params[0].start == pytest.approx(0.08 * 0.05)
+    at_wheel = fitted("coulomb_friction", "wheel", {"k.c": 500.0, "hyp_cf.tau": 0.004})
+    assert placements(problem, rigid, [single], singles=True, fitted=[at_wheel]) == []
     there = fitted("coulomb_friction+constant_load", "wheel+tip",
                    {"k.c": 510.0, "hyp_cf.tau": 0.004, "hyp_cl.F": 0.3})
     assert placements(problem, rigid, [pair, there]) == []
