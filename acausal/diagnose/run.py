@@ -74,13 +74,8 @@ def members_fitted(ctx: Context, s: State) -> State:
     places = s.kinematics.places() if s.kinematics is not None else None
     with ctx.clock.timing("families_s"):
         members = fit_members(ctx, s.problem, s.calibration, s.decision, places)
-        moves = placements(s.problem, s.kinematics, members.fits, _allowed(s.options),
-                           singles=True, fitted=s.decision.rows) if places else []
-        if moves:
-            more = ctx.run(fit_candidate, stages.placement_tasks(s.problem, s.calibration,
-                                                                 moves),
-                           "fitting family members at rigidly tied sites")
-            members = dataclasses.replace(members, fits=members.fits + tuple(more))
+        more = _other_placements(ctx, s, members.fits, "family members", singles=True)
+        members = dataclasses.replace(members, fits=members.fits + more)
     s = dataclasses.replace(s, members=members)
     if not members.fits:
         return s
@@ -94,6 +89,24 @@ def _allowed(options):
     if locs is None:
         return None
     return lambda loc: any(loc == w or loc.startswith(w + ".") for w in locs)
+
+
+def _other_placements(ctx: Context, s: State, fits, what, singles=False) -> tuple:
+    """The fits of ``fits``' other placements at rigidly tied sites
+    (:func:`.stages.kinematics.placements`: pairs, and single causes too
+    with ``singles``; none already among ``fits`` or the decision's rows),
+    each refined from its converted fit (:func:`.stages.chain.placement_tasks`;
+    a pair with a floor at each member's own fit, :func:`.stages.chain.with_floors`)."""
+    if s.kinematics is None:
+        return ()
+    moves = placements(s.problem, s.kinematics, fits, _allowed(s.options), singles=singles,
+                       fitted=s.decision.rows)
+    if not moves:
+        return ()
+    rows = {r.candidate.key: r for r in s.decision.rows}
+    tasks = [stages.with_floors(t, rows) for t in stages.placement_tasks(s.problem,
+                                                                         s.calibration, moves)]
+    return tuple(ctx.run(fit_candidate, tasks, f"fitting {what} at rigidly tied sites"))
 
 
 def with_kinematics(ctx: Context, s: State) -> State:
@@ -117,14 +130,8 @@ def pairs_searched(ctx: Context, s: State) -> State:
     with ctx.clock.timing("pairs_s"):
         got = stages.search_pairs(ctx, s.problem, s.calibration, s.decision,
                                   s.kinematics.places())
-        moves = placements(s.problem, s.kinematics, got.fits, _allowed(s.options))
-        if moves:
-            rows = {r.candidate.key: r for r in s.decision.rows}
-            more = ctx.run(fit_candidate, [stages.with_floors(t, rows) for t in
-                                           stages.placement_tasks(s.problem, s.calibration,
-                                                                  moves)],
-                           "fitting pairs at rigidly tied sites")
-            got = dataclasses.replace(got, fits=got.fits + tuple(more))
+        got = dataclasses.replace(got, fits=got.fits + _other_placements(ctx, s, got.fits,
+                                                                         "pairs"))
         s = decided(ctx, dataclasses.replace(s, fits=s.fits + got.fits, pair_search=got,
                                              pair_screen_n_sim=got.screen_n_sim))
         again = stages.member_refit_tasks(s.problem, s.calibration, s.decision)

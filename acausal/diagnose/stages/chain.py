@@ -250,13 +250,8 @@ def _first_placed(cands, places, done=()) -> tuple:
     if not places:
         return tuple(c for c in cands if c.key not in done)
     seen = {pscreen.placed_key(zip(h.split("+"), loc.split("+")), places) for h, loc in done}
-    out = []
-    for c in cands:
-        key = pscreen.placed_key(c.members(), places)
-        if key not in seen:
-            seen.add(key)
-            out.append(c)
-    return tuple(out)
+    return tuple(pscreen.first_of_each(cands, lambda c: pscreen.placed_key(c.members(), places),
+                                       seen))
 
 
 def _singles(dec):

@@ -28,7 +28,7 @@ import numpy as np
 
 from ..library.loader import FamilyIndex, family_index, load_library  # noqa: F401 (re-exported)
 from ..problem import Candidate, Param
-from .pairscreen import place_of
+from .pairscreen import first_of_each, place_of
 from .screen import screened
 from .chain import fit_tasks
 from .tasks import fit_candidate
@@ -45,14 +45,9 @@ def heads(dec, index: FamilyIndex, top=TOP, places=None) -> list:
     fits: :func:`.kinematics.placements`)."""
     singles = [r for r in dec.rows if "+" not in r.candidate.hypothesis
                and r.starts.tested][:top]
-    out, seen = [], set()
-    for r in singles:
-        h = r.candidate.hypothesis
-        key = (h, place_of(places, r.candidate.location))
-        if h in index.of and index.is_head(h) and key not in seen:
-            seen.add(key)
-            out.append(r)
-    return out
+    return first_of_each((r for r in singles if r.candidate.hypothesis in index.of
+                          and index.is_head(r.candidate.hypothesis)),
+                         lambda r: (r.candidate.hypothesis, place_of(places, r.candidate.location)))
 
 
 def _seeded(spec, head_values, head_prefix):

@@ -109,6 +109,18 @@ def place_of(places, loc):
     return loc if not places else places.get(loc, loc)
 
 
+def first_of_each(items, key, seen=()) -> list:
+    """``items`` in order, each kept only when ``key(item)`` is neither in
+    ``seen`` nor an earlier item's."""
+    seen, out = set(seen), []
+    for it in items:
+        k = key(it)
+        if k not in seen:
+            seen.add(k)
+            out.append(it)
+    return out
+
+
 def placed_key(members, places=None) -> frozenset:
     """The set of a candidate's (hypothesis, place) members (``members``:
     [(hypothesis, location, ...)], :meth:`~..problem.Candidate.members`): a
@@ -178,14 +190,8 @@ def screen_all(f0, free, rows, index, c_hat, done=(), places=None) -> list:
             out.append(Predicted(a, b, S, aicc, single, MARGIN + SHARE * gain))
     out.sort(key=lambda p: p.aicc)
     if places:
-        seen = set()
-        kept = []
-        for p in out:
-            key = placed_key((p.a.candidate.key, p.b.candidate.key), places)
-            if key not in seen:
-                seen.add(key)
-                kept.append(p)
-        out = kept
+        out = first_of_each(out, lambda p: placed_key((p.a.candidate.key, p.b.candidate.key),
+                                                      places))
     return out
 
 
