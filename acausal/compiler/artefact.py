@@ -24,6 +24,7 @@ Lookups derived from these (a variable's slot, the slot table, the state
 guesses' order) are computed on first use and memoised by the record's own
 methods, which give the same answer every time.
 """
+import hashlib
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 
@@ -33,6 +34,7 @@ import sympy as sp
 from ..errors import ModelError, ParameterError
 from ..lang.symbols import base_and_order, time
 from .codegen import Triplets
+from .substitute import Substitution, substitute
 
 
 @dataclass(frozen=True)
@@ -270,13 +272,16 @@ class Resolver:
     """Rewrites expressions of model symbols in the DAE's y and y' symbols,
     free parameters, discrete values and time: parameter ``bindings``, then
     ``aliases`` (and their derivatives), then the DAE's ``explicit``
-    solutions; ``known`` the symbols a result may contain. Each expression
-    is rewritten once per resolver: the events' conditions are resolved
-    for the Python code, again for the C code and for the sensitivities'
-    roots (on the planar breaker 0.1-0.2 s of every model build)."""
-    bindings: dict
-    aliases: dict
-    explicit: dict
+    solutions (each a :class:`~acausal.compiler.substitute.Substitution`);
+    ``known`` the symbols a result may contain. Each expression is rewritten
+    once per resolver (the events' conditions are resolved for the Python
+    code, again for the C code and for the sensitivities' roots), and each
+    substitution is remembered across the models a process compiles
+    (:func:`~acausal.compiler.substitute.substitute`: on the planar breaker
+    the event conditions' rewriting had been 0.1-0.2 s of every model build)."""
+    bindings: Substitution
+    aliases: Substitution
+    explicit: Substitution
     known: frozenset
     _done: dict = field(default_factory=dict, compare=False, repr=False)
 
@@ -284,7 +289,8 @@ class Resolver:
     def of(cls, reduced, dae, param_syms, disc_syms):
         known = frozenset(set(dae.y) | {s for s in dae.yp if s is not None}
                           | set(param_syms) | set(disc_syms) | {time})
-        return cls(dict(reduced.param_subs), reduced.subs, dae.explicit, known)
+        return cls(Substitution(reduced.param_subs), Substitution(reduced.subs),
+                   Substitution(dae.explicit or {}), known)
 
     def __call__(self, expr):
         e = sp.sympify(expr)
@@ -296,11 +302,8 @@ class Resolver:
         return out
 
     def _rewrite(self, e, expr):
-        if self.bindings:
-            e = e.xreplace(self.bindings)
-        e = e.xreplace(self.aliases)
-        if self.explicit:
-            e = e.xreplace(self.explicit)
+        for sub in (self.bindings, self.aliases, self.explicit):
+            e = substitute(e, sub)
         bad = [s for s in e.free_symbols if s not in self.known]
         if bad:
             raise ModelError(f"{expr} cannot be evaluated: {bad[0].name} is not available "
@@ -312,10 +315,13 @@ class Resolver:
 class BuildInfo:
     """How the artefact was made: wall time of each compile stage [s]
     (``stage_s``; benchmarks/scaling.py prints them), the whole compile
-    ``compile_s`` [s], and whether it was read from the store (``cache_hit``)."""
+    ``compile_s`` [s], whether it was read from the store (``cache_hit``)
+    and the store's key of the model (``key``: a digest of the flattened
+    model and the compiler; None when the store was not used)."""
     stage_s: dict
     compile_s: float
     cache_hit: bool
+    key: str | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -361,6 +367,15 @@ class Artefact:
         return replace(self, parameters=parameters, starts=starts)
 
     # -- the generated code ----------------------------------------------------
+    def identity(self):
+        """A digest that fixes the compiled equations, for the stores of what
+        is derived from them (the compiled backend's libraries, the
+        sensitivity models): the compile store's key, else (no store) the
+        digest of the generated Python source."""
+        if self.build.key is not None:
+            return self.build.key
+        return hashlib.sha256(self.code.source.encode()).hexdigest()
+
     def callbacks(self, p, d):
         """The :class:`~acausal.compiler.codegen.Callbacks` of parameter vector
         ``p`` and discrete values ``d``."""
@@ -374,11 +389,12 @@ class Artefact:
         n, ns = len(self.dae.y), self.dae.n_states
         n_fixed = len(self.starts.fixed)
         npar = len(self.parameters.symbols)
-        fill = self.code.fixjac
+        code = self.code     # (its Python is written when a run first needs it)
 
         def fixed_jac(t, *args):
             F = Triplets((n_fixed, n + ns)) if sparse else np.zeros((n_fixed, n + ns))
-            fill(t, args[:n], args[n:2 * n], args[2 * n:2 * n + npar], args[2 * n + npar:], F)
+            code.fixjac(t, args[:n], args[n:2 * n], args[2 * n:2 * n + npar],
+                        args[2 * n + npar:], F)
             return F.tocsr() if sparse else F
         return fixed_jac
 

@@ -30,11 +30,12 @@ import sympy as sp
 
 from ..infra import store
 
-FORMAT = 3
+FORMAT = 4    # 4: the Python source may be absent (written at its first use)
 NAMESPACE = "compile"
 _COMPILER_MODULES = ("compiler/flatten", "compiler/aliases", "compiler/structure",
                      "compiler/causalize", "compiler/codegen", "compiler/pipeline",
-                     "compiler/artefact", "compiler/cache", "compiler/units", "lang/fastdiff",
+                     "compiler/artefact", "compiler/cache", "compiler/units", "compiler/substitute",
+                     "lang/fastdiff",
                      "lang/symbols", "lang/declare")
 _source_hash = []
 
@@ -47,7 +48,7 @@ class Entry:
     graph: object
     root_starts: dict
     dae: object
-    source: str
+    source: str | None   # the generated Python source; None until a run needs it
     sparsity: object
     root_via: dict = None   # root -> (alias name, sign, offset): start values set per run
     propagated: dict = None  # guesses of frame positions/angles from the start values

@@ -12,6 +12,7 @@ event-time sensitivities need (:mod:`acausal.runtime.sensitivity`).
 import functools
 import linecache
 import math
+import threading
 from dataclasses import dataclass
 from typing import Callable, NamedTuple, Optional
 
@@ -20,6 +21,7 @@ import sympy as sp
 from sympy.printing.pycode import PythonCodePrinter
 
 from ..lang.fastdiff import diff
+from .substitute import Substitution, substitute
 
 _counter = [0]
 
@@ -146,6 +148,7 @@ class Names:
         self.map[time] = _real("t")
         self.allowed = set(self.map.values())
         self.code = {s: v.name for s, v in self.map.items()}
+        self._sub = Substitution(self.map)
 
     def check(self, exprs, what):
         """``exprs`` as sympy expressions, checked to use only the DAE's
@@ -153,35 +156,12 @@ class Names:
         return [_known(sp.sympify(e), self.map, what) for e in exprs]
 
     def rename(self, exprs, what):
-        """``exprs`` with the DAE's symbols replaced by the generated names."""
+        """``exprs`` with the DAE's symbols replaced by the generated names
+        (:func:`~acausal.compiler.substitute.substitute`: remembered across
+        the models of a process)."""
         memo = {}
-        return [_known(replace_shared(sp.sympify(e), self.map, memo), self.allowed, what)
+        return [_known(substitute(sp.sympify(e), self._sub, memo), self.allowed, what)
                 for e in exprs]
-
-
-def replace_shared(expr, mapping, memo=None):
-    """``expr.xreplace(mapping)`` that rebuilds each distinct sub-expression
-    once (``memo``: node -> its replacement, shared across calls). sympy's
-    xreplace walks the tree, so a sub-expression shared by many parents
-    (the chain rule's products in sensitivity equations) is rebuilt once
-    per path to it: 1.2 million rebuilds for the breaker's observed
-    variables with three parameters' sensitivities."""
-    memo = {} if memo is None else memo
-
-    def walk(e):
-        hit = memo.get(e)
-        if hit is not None:
-            return hit
-        if e in mapping:
-            out = mapping[e]
-        elif not e.args:
-            out = e
-        else:
-            args = [walk(a) for a in e.args]
-            out = e.func(*args) if any(a is not b for a, b in zip(args, e.args)) else e
-        memo[e] = out
-        return out
-    return walk(expr)
 
 
 def _known(e, symbols, what):
@@ -407,16 +387,81 @@ class Callbacks(NamedTuple):
     init_check: Optional[Callable] = None
 
 
-@dataclass(frozen=True, eq=False)
 class Generated:
-    """What :func:`generate` returns: the source, ``make(p, d)`` (the
-    :class:`Callbacks` for one parameter vector and set of discrete values),
-    ``fixjac(t, y, yp, p, d, F)`` (fills the fixed-start rows ``F``) and the
-    iteration matrix's :class:`Sparsity`."""
-    source: str
-    make: object
-    fixjac: object
-    sparsity: Sparsity
+    """The generated Python callbacks of one model: ``source``, ``make(p,
+    d)`` (the :class:`Callbacks` for one parameter vector and set of
+    discrete values), ``fixjac(t, y, yp, p, d, F)`` (fills the fixed-start
+    rows ``F``) and the iteration matrix's :class:`Sparsity`.
+
+    The source has two parts, the callbacks (``make``) and ``fixjac``. The
+    sparsity is known at once; the source is given whole (``source``) or
+    each part is written by its writer (``writers``: name -> function of no
+    argument giving the part's text) at its first use, and compiled then. A
+    model that the compiled backend runs needs only ``fixjac`` (the
+    initialisation's choice of guesses; every other callback is C,
+    :mod:`acausal.runtime.backends.compiled`): writing the whole Python took
+    a fifth of a diagnosis candidate's build. ``on_write(source)`` is told
+    of a whole source assembled here (the compile store keeps it)."""
+
+    PARTS = ("make", "fixjac")
+
+    def __init__(self, sparsity, source=None, writers=None, on_write=None):
+        if source is None and writers is None:
+            raise ValueError("Generated needs a source or its writers")  # internal
+        self.sparsity = sparsity
+        self._parts = dict(zip(self.PARTS, _split(source))) if source is not None else {}
+        self._source, self._writers, self._on_write = source, writers, on_write
+        self._functions = {}
+        self._lock = threading.RLock()
+
+    def _part(self, name):
+        with self._lock:
+            if name not in self._parts:
+                self._parts[name] = self._writers[name]()
+                if len(self._parts) == len(self.PARTS):
+                    self._assemble()     # the whole is written: kept
+            return self._parts[name]
+
+    def _assemble(self):
+        if self._source is None:
+            self._source = "".join(self._parts[k] for k in self.PARTS)
+            if self._on_write is not None:
+                self._on_write(self._source)
+
+    @property
+    def source(self):
+        """The generated Python source (its parts written now if they were not)."""
+        with self._lock:
+            for k in self.PARTS:
+                self._part(k)
+            self._assemble()
+            return self._source
+
+    def _function(self, name):
+        with self._lock:
+            if name not in self._functions:
+                self._functions[name] = _exec_part(self._part(name), name)
+            return self._functions[name]
+
+    @property
+    def make(self):
+        """``make(p, d)``: the :class:`Callbacks` of one mode."""
+        made = self._function("make")
+        return lambda p, d: Callbacks(*made(p, d))
+
+    @property
+    def fixjac(self):
+        """``fixjac(t, y, yp, p, d, F)``: fills the fixed-start rows ``F``."""
+        return self._function("fixjac")
+
+
+_FIXJAC_HEADER = "def fixjac(t, y, yp, p, d, F):"
+
+
+def _split(source):
+    """(the callbacks' part, fixjac's part) of a whole generated source."""
+    k = source.index(_FIXJAC_HEADER)
+    return source[:k], source[k:]
 
 
 def _make_prologue(npar, nd):
@@ -435,20 +480,44 @@ def _make_prologue(npar, nd):
                "        return ieee[0][k]"])
 
 
+def _unknown_symbols(dae):
+    """(y symbols, y' symbols or None) of the generated code."""
+    n = len(dae.y)
+    return ([_real(f"y{i}") for i in range(n)],
+            [_real(f"yp{i}") if dae.yp[i] is not None else None for i in range(n)])
+
+
+def iteration_sparsity(dae, params, discretes):
+    """The :class:`Sparsity` of ``dae``'s iteration matrix: the entries the
+    generated Jacobian fills (:func:`jacobian_entries`, kept for the code
+    generators that ask for the same residuals next)."""
+    res = Names(dae.y, dae.yp, params, discretes).rename(dae.residuals, "a residual")
+    ysyms, ypsyms = _unknown_symbols(dae)
+    return _sparsity(len(dae.y), jacobian_entries(res, ysyms, ypsyms, dae.jacobian_columns))
+
+
 def generate(dae, params, discretes, roots, observed, fixed_rows=()):
-    """Generate and compile the callbacks (see :class:`Generated`).
+    """The callbacks (see :class:`Generated`); the source is written at its
+    first use (:func:`write_callbacks`, :func:`write_fixjac`), the sparsity now.
 
     ``roots``: list of root expressions (resolved); ``observed``: list of
     expressions (resolved) for every reported variable; ``fixed_rows``:
     indices into ``observed`` of the variables with fixed start values.
     """
+    return Generated(iteration_sparsity(dae, params, discretes), writers=dict(
+        make=functools.partial(write_callbacks, dae, params, discretes, roots, observed),
+        fixjac=functools.partial(write_fixjac, dae, params, discretes,
+                                 [observed[k] for k in fixed_rows])))
+
+
+def write_callbacks(dae, params, discretes, roots, observed):
+    """The Python source of ``make(p, d)`` (arguments as :func:`generate`)."""
     n = len(dae.y)
     names = Names(dae.y, dae.yp, params, discretes)
     res = names.rename(dae.residuals, "a residual")
     g = names.check(roots, "an event")
     obs = names.check(observed, "an observed variable")
-    ysyms = [_real(f"y{i}") for i in range(n)]
-    ypsyms = [_real(f"yp{i}") if dae.yp[i] is not None else None for i in range(n)]
+    ysyms, ypsyms = _unknown_symbols(dae)
     cj = sp.Symbol("cj")
     entries = jacobian_entries(res, ysyms, ypsyms, dae.jacobian_columns)
     sparsity = _sparsity(n, entries)
@@ -456,9 +525,6 @@ def generate(dae, params, discretes, roots, observed, fixed_rows=()):
     jyp = [(i, j, dyp) for i, j, _, dyp in entries if dyp != 0]
     jcomb = [(i, j, dy + cj * dyp) for i, j, dy, dyp in entries]
     csc_pos = {(i, j): k for k, (i, j) in enumerate(zip(sparsity.rows, sparsity.cols))}
-    fixed = fixed_entries(dict(zip(fixed_rows, names.rename([obs[k] for k in fixed_rows],
-                                                             "a fixed start"))),
-                           fixed_rows, ysyms, ypsyms, dae.n_states)
     npar, nd = len(params), len(discretes)
     unpack = _unpack("y", n, "y", _B, conv="_floats") + _unpack("yp", n, "yp", _B, conv="_floats")
     L = _make_prologue(npar, nd)
@@ -486,30 +552,45 @@ def generate(dae, params, discretes, roots, observed, fixed_rows=()):
         obs, [f"o[{i}]" for i in range(len(obs))], _B, symbols=names.code) + [
         f"{_B}return o"], "other(4)(t, y, yp)", ret=True)
     L += ["    return res, jac, roots, jacs, observe, count, jac_csc"]
-    L += _guarded("def fixjac(t, y, yp, p, d, F):", [], [
+    return "\n".join(L) + "\n"
+
+
+def write_fixjac(dae, params, discretes, fixed_observed):
+    """The Python source of ``fixjac(t, y, yp, p, d, F)``: the derivatives of
+    ``fixed_observed`` (the resolved expressions of the variables with fixed
+    start values, in order) over z = (y, y' of the states)."""
+    n = len(dae.y)
+    names = Names(dae.y, dae.yp, params, discretes)
+    ysyms, ypsyms = _unknown_symbols(dae)
+    renamed = names.rename(names.check(fixed_observed, "an observed variable"),
+                           "a fixed start")
+    rows = list(range(len(renamed)))
+    fixed = fixed_entries(dict(zip(rows, renamed)), rows, ysyms, ypsyms, dae.n_states)
+    npar, nd = len(params), len(discretes)
+    L = _guarded(_FIXJAC_HEADER, [], [
         line for v, m in (("p", npar), ("d", nd), ("y", n), ("yp", n))
         for line in _unpack(v, m, v, _B, conv="_consts")]
         + _body([e for _, _, e in fixed], [f"F[{a}, {k}]" for a, k, _ in fixed], _B),
         "_fixjac_ieee(t, y, yp, p, d, F)")
-    src = "\n".join(L) + "\n"
-    make, fixjac = load(src)
-    return Generated(src, make, fixjac, sparsity)
+    return "\n".join(L) + "\n"
 
 
 def load(src):
-    """Compile generated source; returns its (make, fixjac), ``make(p, d)``
-    giving :class:`Callbacks`. Used again when a compiled model is read back
-    from the cache."""
+    """Compile a whole generated source; returns its (make, fixjac),
+    ``make(p, d)`` giving :class:`Callbacks`."""
+    g = Generated(None, source=src)
+    return g.make, g.fixjac
+
+
+def _exec_part(src, name):
+    """The function ``name`` of generated source ``src``, compiled, with the
+    IEEE variant it falls back on (:data:`_IEEE_ERRORS`)."""
     _counter[0] += 1
     fname = f"<acausal-generated-{_counter[0]}>"
     linecache.cache[fname] = (len(src), None, src.splitlines(True), fname)
     ns, ieee = exec_twins(compile(src, fname, "exec"))
-    ns.update(_make_ieee=ieee["make"], _fixjac_ieee=ieee["fixjac"])
-    made = ns["make"]
-
-    def make(p, d):
-        return Callbacks(*made(p, d))
-    return make, ns["fixjac"]
+    ns[f"_{name}_ieee"] = ieee[name]
+    return ns[name]
 
 
 def exec_twins(code):

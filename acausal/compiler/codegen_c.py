@@ -20,7 +20,8 @@ from sympy.printing.c import C99CodePrinter
 from sympy.printing.codeprinter import PrintMethodNotImplementedError
 
 from .codegen import (NamedTemps, Names, fixed_entries, jacobian_entries,
-                      repeated_subexpressions, replace_shared)
+                      repeated_subexpressions)
+from .substitute import replace_shared
 
 
 class _Printer(NamedTemps, C99CodePrinter):

@@ -8,6 +8,7 @@ re-generating anything; the runtime simulates it
 :func:`compile_artefact`). The stages' outputs are kept in the store's
 ``compile`` namespace (:mod:`acausal.compiler.cache`).
 """
+import dataclasses
 import time as _time
 
 import numpy as np
@@ -17,7 +18,7 @@ from . import cache as compile_cache
 from .aliases import eliminate_aliases
 from .artefact import Artefact, BuildInfo, ParameterSpace, Resolver, StartPlan
 from .causalize import build_dae
-from .codegen import Generated, generate, load as load_generated
+from .codegen import Generated, iteration_sparsity, write_callbacks, write_fixjac
 from ..infra import store
 from ..lang.declare import Start
 from ..lang.fastdiff import diff
@@ -39,28 +40,50 @@ def compile_artefact(model, cache=True):
     entry = compile_cache.load(key) if key is not None else None
     hit = entry is not None
     if entry is None:
-        # the code generator's resolver becomes the artefact's: what it
-        # resolved (every event condition) is not resolved again for the C code
-        entry, code, resolve = _compile(model, flat, stage_s, key)
+        entry = _compile(model, flat, stage_s, key)
         if key is not None:
             compile_cache.save(entry)
-    else:
-        make, fixjac = load_generated(entry.source)
-        code = Generated(entry.source, make, fixjac, entry.sparsity)
-        resolve = None
     parameters = ParameterSpace.of(flat, entry.reduced.param_subs)
     disc_syms = [d.symbol for d in flat.discretes.values()]
-    if resolve is None:
-        resolve = Resolver.of(entry.reduced, entry.dae, parameters.symbols, disc_syms)
+    resolve = Resolver.of(entry.reduced, entry.dae, parameters.symbols, disc_syms)
+    code = _python_code(flat, entry, parameters.symbols, disc_syms, resolve)
     return Artefact(model, flat, entry.reduced, entry.graph, entry.dae, parameters,
                     StartPlan.of(flat, entry, parameters), resolve,
-                    code, BuildInfo(stage_s, _time.perf_counter() - t0, hit))
+                    code, BuildInfo(stage_s, _time.perf_counter() - t0, hit, key))
+
+
+def _python_code(flat, entry, param_syms, disc_syms, resolve):
+    """The model's generated Python callbacks
+    (:class:`~acausal.compiler.codegen.Generated`): the store entry's source,
+    else each part written at its first use from the resolved roots and
+    observed variables (a model the compiled backend runs needs only the
+    fixed-start rows), the whole then kept in the store's entry (when it
+    has a key)."""
+    if entry.source is not None:
+        return Generated(entry.sparsity, source=entry.source)
+    variables = list(flat.variables.values())
+
+    def write_make():
+        observed = [resolve(info.symbol) for info in variables]
+        roots = [resolve(e.expr) for e in flat.events] + \
+            [resolve(a.expr) for a in flat.assertions]
+        return write_callbacks(entry.dae, list(param_syms), disc_syms, roots, observed)
+
+    def write_fixed():
+        fixed = [resolve(info.symbol) for info in variables if info.start.fixed]
+        return write_fixjac(entry.dae, list(param_syms), disc_syms, fixed)
+
+    def keep(source):
+        if entry.key is not None:
+            compile_cache.save(dataclasses.replace(entry, source=source))
+    return Generated(entry.sparsity, writers=dict(make=write_make, fixjac=write_fixed),
+                     on_write=keep)
 
 
 def _compile(model, flat, stage_s, key):
     """The compile stages after flattening: a
-    :class:`acausal.compiler.cache.Entry`, the generated code and the
-    :class:`~acausal.compiler.artefact.Resolver` it used."""
+    :class:`acausal.compiler.cache.Entry` (without the Python source:
+    :func:`_python_code`)."""
     param_syms = ParameterSpace.of(flat, {}).symbols
     disc_syms = [d.symbol for d in flat.discretes.values()]
     clock = _Stages(stage_s)
@@ -83,15 +106,11 @@ def _compile(model, flat, stage_s, key):
     clock.lap("structure")
     dae = build_dae(g, dummies, set(param_syms), values)
     clock.lap("causalize")
-    resolve = Resolver.of(red, dae, param_syms, disc_syms)
-    observed = [resolve(info.symbol) for info in flat.variables.values()]
-    roots = [resolve(e.expr) for e in flat.events] + [resolve(a.expr) for a in flat.assertions]
-    fixed_rows = [k for k, info in enumerate(flat.variables.values()) if info.start.fixed]
-    gen = generate(dae, list(param_syms), disc_syms, roots, observed, fixed_rows)
+    sparsity = iteration_sparsity(dae, list(param_syms), disc_syms)
     clock.lap("codegen")
-    entry = compile_cache.Entry(key, red, g, root_starts, dae, gen.source, gen.sparsity,
-                                root_via, propagated)
-    return entry, gen, resolve
+    # the Python source is written at its first use (_python_code)
+    return compile_cache.Entry(key, red, g, root_starts, dae, None, sparsity,
+                               root_via, propagated)
 
 
 def _start_values(flat, root_starts, graph):

@@ -102,6 +102,12 @@ class CompiledModel:
         """The discrete values' start values."""
         return self.artefact.discrete_start()
 
+    def identity(self):
+        """A digest that fixes the compiled equations (the compiled backend's
+        libraries and the sensitivity models are stored under it:
+        :meth:`~acausal.compiler.artefact.Artefact.identity`)."""
+        return self.artefact.identity()
+
     # -- symbols and slots ---------------------------------------------------------------
     def resolve(self, expr):
         """``expr`` in the DAE's unknowns, free parameters, discrete values and time."""

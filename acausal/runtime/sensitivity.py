@@ -137,7 +137,7 @@ class SensitivityModel:
         self.disc_syms = list(cm.disc_syms) + self.sd_syms
         roots = [cm.resolve(e.expr) for e in cm.events] + \
             [cm.resolve(a.expr) for a in cm.assertions]
-        key = _cache_key(cm, names, self.dae.residuals)
+        key = self.key = _cache_key(cm, names, self.dae.residuals)
         hit = _cache_load(key)
         if hit is None:
             columns = self._jacobian_columns()
@@ -216,6 +216,12 @@ class SensitivityModel:
         callback's entry ``n_obs (1 + j) + k``, n_obs the base's variables)."""
         cm = self.base
         return self._lin.total(cm.artefact.observed_expr(cm.var_names[k]))[j]
+
+    def identity(self):
+        """A digest that fixes the augmented equations: their store key (the
+        base model's :meth:`~acausal.runtime.model.CompiledModel.identity`,
+        the parameters, the augmented residuals, the generators)."""
+        return self.key
 
     def __getattr__(self, name):
         if name == "base":   # not set yet (copying, pickling)
@@ -322,11 +328,11 @@ def _size(expr, limit):
 
 
 def _cache_key(cm, names, residuals):
-    """Key of a sensitivity model in the store: the base model's generated
-    source (which fixes its DAE), the parameter names, the augmented
+    """Key of a sensitivity model in the store: the base model's identity
+    (which fixes its DAE), the parameter names, the augmented
     residuals (which the derivative rules of the model's own functions
     shape) and the generators' sources."""
-    h = hashlib.sha256(cm.source.encode())
+    h = hashlib.sha256(cm.identity().encode())
     h.update("\0".join(names).encode())
     h.update(digest(residuals).encode())
     here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))   # the acausal package

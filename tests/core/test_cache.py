@@ -80,3 +80,45 @@ def test_cache_can_be_disabled(tmp_path, monkeypatch):
     monkeypatch.setenv("ACAUSAL_CACHE", str(tmp_path))
     compile_model(two_masses(), cache=False)
     assert not list(tmp_path.glob("**/*.pkl"))
+
+
+def _entry(cm):
+    from acausal.compiler import cache as compile_cache
+    return compile_cache.load(cm.artefact.build.key)
+
+
+def test_the_python_source_is_written_at_its_first_use_and_kept(cache):
+    """A model the compiled backend runs never needs its generated Python
+    (its callbacks are C): the source is written when a run first needs it,
+    then kept in the store, and it is the source an eager compile writes."""
+    from acausal.runtime.backends import compiled_available
+    why = compiled_available()
+    if why:
+        pytest.skip(f"no compiled backend: {why}")
+    cm = compile_model(two_masses(damper=True))
+    assert _entry(cm).source is None
+    rc = cm.simulate(t_end=0.5, rtol=1e-9, atol=1e-12, output_step=0.01, backend="compiled")
+    assert rc.stats["backend"] == "compiled"
+    assert _entry(cm).source is None           # the C run did not write it
+    rs = cm.simulate(t_end=0.5, rtol=1e-9, atol=1e-12, output_step=0.01, backend="sundae")
+    np.testing.assert_allclose(rs["b.s"], rc["b.s"], atol=1e-8)
+    kept = _entry(cm).source
+    assert kept is not None and kept == cm.source
+    again = compile_model(two_masses(damper=True))
+    assert again.cache_hit and again.source == kept
+    fresh = compile_model(two_masses(damper=True), cache=False)
+    assert fresh.source == kept                # written at once or later: one text
+
+
+def test_identity_fixes_the_equations(cache):
+    """The stores of what is derived from the equations (compiled libraries,
+    sensitivity models) are keyed by the model's identity: the same model
+    has one, another structure or parameter value another; without the
+    store it is the digest of the generated source."""
+    import hashlib
+    a, b = compile_model(two_masses()), compile_model(two_masses())
+    assert a.identity() == b.identity()
+    assert compile_model(two_masses(c=300.0)).identity() != a.identity()
+    assert compile_model(two_masses(damper=True)).identity() != a.identity()
+    off = compile_model(two_masses(), cache=False)
+    assert off.identity() == hashlib.sha256(off.source.encode()).hexdigest()

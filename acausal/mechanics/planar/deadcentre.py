@@ -24,6 +24,7 @@ joint's ``drives`` discrete, decided at the start from the compiled model's
 states). It warns (:class:`DeadCentreWarning`, one line naming the loop,
 its joints and the followers) and the run goes on; IDA does not stop for it.
 """
+import functools
 import itertools
 import math
 import warnings
@@ -67,15 +68,28 @@ def monitor_events(joint):
             continue
         comps = {p: root.find(p) for p in loop.joints}
         for k, trio in enumerate(itertools.combinations(loop.joints, 3)):
-            sine = minor_sine([column(comps[p]) for p in trio])
-            if sine is None:
-                continue
             drivers = [p for p in loop.joints if p not in trio]
-            armed = sp.And(*[Eq(comps[p].drives, 1) for p in drivers])
-            g = Piecewise((sine**2 - DEAD_CENTRE_SIN**2, armed), (1, True))
+            g = _dead_centre_root(tuple(column(comps[p]) for p in trio),
+                                  tuple(comps[p].drives for p in drivers))
+            if g is None:
+                continue
             evs.append(Event(f"{joint.path}.dead_centre{k}", g, -1,
                              _warner(loop, trio, drivers), observer=True))
     return evs
+
+
+@functools.lru_cache(maxsize=1024)
+def _dead_centre_root(cols, drives):
+    """The root of three joints' columns ``cols`` armed by the ``drives``
+    flags of the others, or None (no revolute among them). Remembered by its
+    arguments, which are the same expressions in every model built from one
+    mechanism: building the sine (square roots compared in a Piecewise) was
+    a third of each planar breaker diagnosis candidate's build."""
+    sine = minor_sine(list(cols))
+    if sine is None:
+        return None
+    armed = sp.And(*[Eq(d, 1) for d in drives])
+    return Piecewise((sine**2 - DEAD_CENTRE_SIN**2, armed), (1, True))
 
 
 def _warner(loop, trio, drivers):

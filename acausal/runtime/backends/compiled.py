@@ -95,12 +95,12 @@ def _build_dir():
 
 
 def _key(cm, cc, libs):
-    """Cache key of a model's library: the model's generated Python source
-    (which fixes its DAE, roots and symbols), the C generator, the driver,
+    """Cache key of a model's library: the model's identity (a digest that
+    fixes its DAE, roots and symbols), the C generator, the driver,
     the compiler and the SUNDIALS libraries; so a cached library is found
     without generating C again."""
     import acausal.compiler.codegen_c as gen
-    parts = [cm.source, cc] + libs
+    parts = [cm.identity(), cc] + libs
     for path in (_DRIVER, _REINIT, gen.__file__):
         with open(path) as fh:
             parts.append(fh.read())
