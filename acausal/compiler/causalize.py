@@ -27,6 +27,7 @@ import sympy as sp
 from ..errors import StructuralError
 from ..lang.fastdiff import diff
 from ..lang.symbols import ordered
+from .substitute import Substitution, substitute
 
 
 @dataclass
@@ -163,10 +164,12 @@ def _causalize_block(block, eqs, unknowns, yp_set, params, values, out):
 
 
 def _subs(expr, explicit):
+    """``expr`` with the explicit solutions found so far substituted (their
+    keys are unknowns: symbols), remembered across models
+    (:func:`~acausal.compiler.substitute.substitute`)."""
     if not explicit:
         return expr
-    hit = {s: explicit[s] for s in expr.free_symbols if s in explicit}
-    return expr.xreplace(hit) if hit else expr
+    return substitute(expr, Substitution(explicit, by_symbol=True))
 
 
 def _numeric(expr, values):

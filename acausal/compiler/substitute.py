@@ -39,9 +39,10 @@ class Substitution:
 
     __slots__ = ("items", "by_symbol")
 
-    def __init__(self, items):
-        self.items = dict(items)
-        self.by_symbol = all(isinstance(k, sp.Symbol) for k in self.items)
+    def __init__(self, items, by_symbol=None):
+        self.items = items           # (not copied: read at each substitution)
+        self.by_symbol = (all(isinstance(k, sp.Symbol) for k in items)
+                          if by_symbol is None else by_symbol)
 
     def __bool__(self):
         return bool(self.items)

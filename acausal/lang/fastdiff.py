@@ -19,36 +19,56 @@ reason ``sign(u)`` differentiates to 0, its value everywhere but at u = 0
 ``Derivative`` otherwise): the sensitivity equations of that drag, whose
 second derivatives hold it, could not be generated.
 """
+import functools
+
 import sympy as sp
+
+MEMO_SIZE = 50_000   # derivatives remembered per process (least recently used dropped)
 
 
 def diff(expr, x):
-    """d expr / d x for a symbol ``x``; same value as ``sympy.diff``."""
+    """d expr / d x for a symbol ``x``; same value as ``sympy.diff``.
+    Remembered per process: a diagnosis compiles dozens of models that
+    share most of their equations, and so most of their Jacobians' entries
+    (the same expression object for the same arguments)."""
+    try:
+        hash(expr)
+    except TypeError:       # (a mutable matrix: not remembered)
+        return _diff(expr, x)
+    return _remembered(expr, x)
+
+
+@functools.lru_cache(maxsize=MEMO_SIZE)
+def _remembered(expr, x):
+    return _diff(expr, x)
+
+
+def _diff(expr, x):
     if expr == x:
         return sp.S.One
     if not expr.has(x):
         return sp.S.Zero
     if expr.is_Add:
-        return sp.Add(*[diff(a, x) for a in expr.args if a.has(x)])
+        return sp.Add(*[_diff(a, x) for a in expr.args if a.has(x)])
     if expr.is_Mul:
         args = expr.args
         terms = []
         for k, a in enumerate(args):
             if a.has(x):
-                terms.append(sp.Mul(*(args[:k] + args[k + 1:] + (diff(a, x),))))
+                terms.append(sp.Mul(*(args[:k] + args[k + 1:] + (_diff(a, x),))))
         return sp.Add(*terms)
     if expr.is_Pow and not expr.exp.has(x):
         base, p = expr.args
-        return p * base ** (p - 1) * diff(base, x)
+        return p * base ** (p - 1) * _diff(base, x)
     if isinstance(expr, sp.Piecewise) and not any(c.has(x) for _, c in expr.args):
         # the conditions are those of an evaluated Piecewise already: keep them
-        pieces = [(diff(e, x), c) for e, c in expr.args]
+        pieces = [(_diff(e, x), c) for e, c in expr.args]
         if all(d == 0 for d, _ in pieces):
             return sp.S.Zero
         return sp.Piecewise(*pieces, evaluate=False)
     if isinstance(expr, sp.Abs):
         u = expr.args[0]
-        return sp.sign(u) * diff(u, x)
+        return sp.sign(u) * _diff(u, x)
     if isinstance(expr, sp.sign):
         # zero wherever it has a value: its jump at u = 0 is an event's business
         return sp.S.Zero
@@ -58,7 +78,7 @@ def diff(expr, x):
         # chain rule, as Function._eval_derivative (not for Abs & co., which
         # define their own derivative)
         try:
-            return sp.Add(*[expr.fdiff(k + 1) * diff(a, x)
+            return sp.Add(*[expr.fdiff(k + 1) * _diff(a, x)
                             for k, a in enumerate(expr.args) if a.has(x)])
         except sp.ArgumentIndexError:
             pass
