@@ -19,7 +19,7 @@ import sympy as sp
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.codeprinter import PrintMethodNotImplementedError
 
-from .codegen import (NamedTemps, Names, fixed_entries, jacobian_entries,
+from .codegen import (NamedTemps, Names, PrintMemo, fixed_entries, jacobian_entries,
                       repeated_subexpressions)
 from .substitute import replace_shared
 
@@ -63,14 +63,20 @@ def _decls(n, has_yp):
     return lines
 
 
+_PRINTED = PrintMemo()   # the C printer's definitions, across models
+
+
 def _body(exprs, targets):
     if not exprs:
         return []
     repeated = repeated_subexpressions(exprs)
     names = {e: f"c_{k}" for k, e in enumerate(repeated)}
     printer = _Printer(names)
-    lines = [f"  const double {names[e]} = {printer.definition(e)};" for e in repeated]
-    lines += [f"  {t} = {printer.definition(e)};" for t, e in zip(targets, exprs)]
+
+    def code(e):
+        return _PRINTED.definition(printer, e)
+    lines = [f"  const double {names[e]} = {code(e)};" for e in repeated]
+    lines += [f"  {t} = {code(e)};" for t, e in zip(targets, exprs)]
     return lines
 
 
