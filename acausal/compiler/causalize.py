@@ -149,7 +149,7 @@ def _causalize_block(block, eqs, unknowns, yp_set, params, values, out):
         return
     exprs = [_subs(eqs[ei][0], explicit) for ei, _ in block]
     us = [unknowns[ui] for _, ui in block]
-    sol = _solve_linear_block(exprs, us, params, values)
+    sol = _solved_block(exprs, us, params, values)
     if sol is not None:
         for (ei, ui), u, v in zip(block, us, sol):
             if u in yp_set:
@@ -206,6 +206,31 @@ def _safe_coefficient(c, params):
     if c.free_symbols <= params:
         return True
     return not c.has(sp.Piecewise, sp.Heaviside, sp.sign, sp.Abs, sp.Max, sp.Min)
+
+
+_BLOCKS = {}          # solved blocks, across the models of a process (insertion order)
+_BLOCKS_SIZE = 2_000
+
+
+def _solved_block(exprs, us, params, values):
+    """:func:`_solve_linear_block`, remembered across the models one process
+    compiles (the breaker's candidates share its three linear blocks, whose
+    solution, ``cancel`` included, was a fifth of each build) under what the
+    solution depends on: the equations, the unknowns, which of their
+    symbols are parameters and the start values of their symbols (the
+    numeric pivots)."""
+    syms = set().union(*(e.atoms(sp.Symbol) for e in exprs))
+    key = (tuple(exprs), tuple(us), frozenset(syms & params),
+           frozenset((s, values[s]) for s in syms if values and s in values))
+    try:
+        return _BLOCKS[key]
+    except KeyError:
+        pass
+    sol = _solve_linear_block(exprs, us, params, values)
+    if len(_BLOCKS) >= _BLOCKS_SIZE:
+        _BLOCKS.clear()
+    _BLOCKS[key] = sol
+    return sol
 
 
 def _solve_linear_block(exprs, us, params, values=None, max_size=12, max_varying=2):

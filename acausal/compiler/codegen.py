@@ -13,7 +13,6 @@ import functools
 import linecache
 import math
 import threading
-from collections import OrderedDict
 from dataclasses import dataclass
 from typing import Callable, NamedTuple, Optional
 
@@ -82,27 +81,27 @@ class PrintMemo:
     VARIANTS = 4
 
     def __init__(self):
-        self._memo = OrderedDict()
+        self._memo = {}          # (insertion order: the oldest first)
         self._lock = threading.Lock()
 
     def definition(self, printer, expr):
         """``printer.definition(expr)``, remembered (``printer`` a
         :class:`NamedTemps` printer of one kind and settings per memo)."""
         temps = printer.temps
-        with self._lock:
-            variants = self._memo.get(expr)
-            if variants is not None:
-                self._memo.move_to_end(expr)
-                for text, trace in variants:
-                    if all(temps.get(e) == n for e, n in trace):
-                        return text
+        variants = self._memo.get(expr)
+        if variants is not None:
+            for text, trace in variants:
+                if all(temps.get(e) == n for e, n in trace):
+                    return text
         text, trace = printer.traced_definition(expr)
         with self._lock:
-            variants = self._memo.setdefault(expr, [])
+            if variants is None:
+                if len(self._memo) >= self.SIZE:     # the oldest half dropped
+                    for k in list(self._memo)[:self.SIZE // 2]:
+                        del self._memo[k]
+                variants = self._memo.setdefault(expr, [])
             variants.insert(0, (text, trace))
             del variants[self.VARIANTS:]
-            if len(self._memo) > self.SIZE:
-                self._memo.popitem(last=False)
         return text
 
 

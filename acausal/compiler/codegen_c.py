@@ -13,6 +13,7 @@ equations), and the iteration matrix's entries are the Python code's
 (:func:`acausal.compiler.codegen.jacobian_entries`); sympy's C99 printer
 writes the expressions (Piecewise as ``?:``).
 """
+import functools
 from dataclasses import dataclass
 
 import sympy as sp
@@ -141,6 +142,14 @@ def _fixjac(cm, observed, ysyms, ypsyms):
         _body([e for _, _, e in entries], [f"F[{a * width + col}]" for a, col, _ in entries])
 
 
+@functools.lru_cache(maxsize=20_000)
+def _iteration_entry(dy, dyp, cj):
+    """``dy + cj*dyp``: one object for the same parts across models (the
+    printed-definition memo then finds it by identity, not by comparing
+    trees)."""
+    return dy + cj * dyp
+
+
 def generate_c(cm):
     """C source of ``acs_res``, ``acs_jac`` (column-major ``J = dF/dy + cj
     dF/dy'``, every entry written), ``acs_roots`` for compiled model ``cm``
@@ -170,7 +179,7 @@ def generate_c(cm):
     jac, targets = [], []
     columns = dae.jacobian_columns
     for i, j, dy, dyp in jacobian_entries(res, ysyms, ypsyms, columns):
-        jac.append(dy + cj * dyp)
+        jac.append(_iteration_entry(dy, dyp, cj))
         targets.append(f"J[{j * n + i}]")
     decl = _decls(n, has_yp) + _pd_decls(len(cm.param_syms), len(cm.disc_syms))
     L = ["#include <math.h>", "#include <string.h>",
