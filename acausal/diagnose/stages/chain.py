@@ -324,8 +324,7 @@ def search_pairs(ctx: Context, problem: Problem, cal: NominalFit, dec: Decision,
     placed = {pscreen.placed_key(t.candidate.members(), places) for t in tasks}
     preds = pscreen.screen_all(cal.fit, problem.free, dec.rows, index, dec.c_hat,
                                places=places)
-    preds = [p for p in preds if pscreen.placed_key(
-        (p.a.candidate.key, p.b.candidate.key), places) not in placed or p.key in done]
+    preds = _unplaced(preds, done, placed, places)
     first, _ = pscreen.picks([p for p in preds if p.key not in done])
     attempted = done | {p.key for p in first}
     tasks += [_predicted_task(problem, cal, p, budget) for p in first]
@@ -362,6 +361,17 @@ def search_pairs(ctx: Context, problem: Problem, cal: NominalFit, dec: Decision,
     return PairSearch(tuple(fits), sum(r.n_sim for r in screened), len(preds),
                       len(reach), len(first) + len(more), share,
                       tuple(Unfitted(p.label, p.aicc) for p in left))
+
+
+def _unplaced(preds, done, placed, places):
+    """The screen's predictions ``preds`` without the other placements of
+    the pairs already being fitted (``placed``: their place keys; a pair is
+    fitted at one placement of rigidly tied sites, its others refined from
+    its fit); the prediction of a pair being fitted itself (its key in
+    ``done``) stays: the observed share compares it with the fit."""
+    def place(p):
+        return pscreen.placed_key((p.a.candidate.key, p.b.candidate.key), places)
+    return [p for p in preds if p.key in done or place(p) not in placed]
 
 
 def _pair_key(cand) -> frozenset:
