@@ -12,7 +12,9 @@ event-time sensitivities need (:mod:`acausal.runtime.sensitivity`).
 import functools
 import linecache
 import math
+import os
 import threading
+import weakref
 from dataclasses import dataclass
 from typing import Callable, NamedTuple, Optional
 
@@ -82,6 +84,12 @@ class PrintMemo:
 
     def __init__(self):
         self._memo = {}          # (insertion order: the oldest first)
+        self._lock = threading.Lock()
+        # a lock copied by fork while another thread held it would stay locked
+        me = weakref.ref(self)
+        os.register_at_fork(after_in_child=lambda: me() and me()._new_lock())
+
+    def _new_lock(self):
         self._lock = threading.Lock()
 
     def definition(self, printer, expr):

@@ -22,6 +22,7 @@ that the result depends on when every key is a symbol
 same input, so what is generated from it is the same text.
 """
 from collections import OrderedDict
+import os
 import threading
 
 import sympy as sp
@@ -29,6 +30,15 @@ import sympy as sp
 MEMO_SIZE = 40_000    # remembered substitutions per process (least recently used dropped)
 _memo = OrderedDict()
 _lock = threading.Lock()
+
+
+def _new_lock_in_child():
+    # a lock copied by fork while another thread held it would stay locked
+    global _lock
+    _lock = threading.Lock()
+
+
+os.register_at_fork(after_in_child=_new_lock_in_child)
 
 
 class Substitution:

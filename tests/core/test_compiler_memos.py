@@ -105,3 +105,29 @@ def test_printed_definitions_match_fresh_printing_on_random_systems():
         exprs = [_random_expr(rng) for _ in range(rng.randint(2, 6))]
         exprs = [e for e in exprs if not e.is_Atom] or [x + y]
         assert _c_body(exprs, memo) == _fresh_c_body(exprs)
+
+
+def test_a_forked_worker_does_not_inherit_a_held_memo_lock():
+    """A pool forks its workers while another thread of the parent may hold
+    a memo's lock: the child gets fresh locks (else its first compile would
+    wait forever)."""
+    import os
+    import sys
+    if not hasattr(os, "fork"):
+        import pytest
+        pytest.skip("no fork here")
+    from acausal.compiler import substitute as S
+    from acausal.compiler.codegen_c import _PRINTED
+    S._lock.acquire()
+    _PRINTED._lock.acquire()
+    try:
+        pid = os.fork()
+        if pid == 0:
+            free = S._lock.acquire(timeout=2) and _PRINTED._lock.acquire(timeout=2)
+            sys.stdout.flush()
+            os._exit(0 if free else 1)
+        _, status = os.waitpid(pid, 0)
+    finally:
+        S._lock.release()
+        _PRINTED._lock.release()
+    assert os.waitstatus_to_exitcode(status) == 0
