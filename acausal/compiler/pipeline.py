@@ -46,10 +46,23 @@ def compile_artefact(model, cache=True):
     parameters = ParameterSpace.of(flat, entry.reduced.param_subs)
     disc_syms = [d.symbol for d in flat.discretes.values()]
     resolve = Resolver.of(entry.reduced, entry.dae, parameters.symbols, disc_syms)
+    if not hit:
+        # every variable, event and assertion in the DAE's terms now, so that a
+        # model that cannot be evaluated fails at its compile (the resolver
+        # keeps them for the code generators)
+        _resolve_all(flat, resolve)
     code = _python_code(flat, entry, parameters.symbols, disc_syms, resolve)
     return Artefact(model, flat, entry.reduced, entry.graph, entry.dae, parameters,
                     StartPlan.of(flat, entry, parameters), resolve,
                     code, BuildInfo(stage_s, _time.perf_counter() - t0, hit, key))
+
+
+def _resolve_all(flat, resolve):
+    """(observed, roots): every variable, then every event's and assertion's
+    root, resolved (:class:`~acausal.compiler.artefact.Resolver`)."""
+    observed = [resolve(info.symbol) for info in flat.variables.values()]
+    roots = [resolve(e.expr) for e in flat.events] + [resolve(a.expr) for a in flat.assertions]
+    return observed, roots
 
 
 def _python_code(flat, entry, param_syms, disc_syms, resolve):
@@ -64,9 +77,7 @@ def _python_code(flat, entry, param_syms, disc_syms, resolve):
     variables = list(flat.variables.values())
 
     def write_make():
-        observed = [resolve(info.symbol) for info in variables]
-        roots = [resolve(e.expr) for e in flat.events] + \
-            [resolve(a.expr) for a in flat.assertions]
+        observed, roots = _resolve_all(flat, resolve)
         return write_callbacks(entry.dae, list(param_syms), disc_syms, roots, observed)
 
     def write_fixed():

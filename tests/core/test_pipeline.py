@@ -316,3 +316,27 @@ def test_unknown_parameter_keyword_lists_the_valid_ones():
     with pytest.raises(ParameterError) as err:
         Mass(mass=1.0)
     assert "'mass'" in str(err.value) and "m" in str(err.value)
+
+
+def test_an_event_that_cannot_be_evaluated_fails_at_the_compile():
+    """The generated callbacks are written when a run needs them, but every
+    event condition and variable is resolved at the compile: a model whose
+    event asks for a derivative the model never computes fails there, in
+    one line naming it, not at its first run."""
+    from acausal import Model, compile_model
+    from acausal.errors import ModelError
+    from acausal.lang import Event
+    from acausal.lang.symbols import der
+    from acausal.mechanics.translational import Fixed, Mass, Spring
+
+    class Watched(Mass):
+        def events(self):
+            return list(super().events()) + [Event(f"{self.path}.jerk", der(der(self.a)), -1)]
+    m = Model()
+    m.ground = Fixed()
+    m.b = Watched(m=1.0, s=0.1, v=0.0)
+    m.k = Spring(c=10.0)
+    m.connect(m.ground.flange, m.k.flange_a)
+    m.connect(m.k.flange_b, m.b.flange)
+    with pytest.raises(ModelError, match=r"der\(der\(b\.a\)\) cannot be evaluated"):
+        compile_model(m, cache=False)
