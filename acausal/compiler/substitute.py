@@ -54,9 +54,6 @@ class Substitution:
         self.by_symbol = (all(isinstance(k, sp.Symbol) for k in items)
                           if by_symbol is None else by_symbol)
 
-    def __bool__(self):
-        return bool(self.items)
-
 
 def replace_shared(expr, mapping, memo=None):
     """``expr.xreplace(mapping)`` that rebuilds each distinct sub-expression

@@ -175,23 +175,13 @@ def other_members(problem, dec, index: FamilyIndex, done, places=None) -> list:
     graph = lib.graph_of(problem.model_path)
     sites = {(index.family(r.candidate.hypothesis), r.candidate.location) for r in dec.rows
              if r.candidate.hypothesis in index.of and index.is_head(r.candidate.hypothesis)}
-    out = []
-    taken = {(h, place_of(places, loc)) for h, loc in done} if places else set()
-    for fam, ms in index.members.items():
-        for mid in ms[1:]:
-            h = lib.HYPOTHESES.get(mid)
-            if h is None:
-                continue
-            for loc in h.candidates(graph):
-                if (mid, loc) not in done and (fam, loc) in sites:
-                    if places:
-                        key = (mid, place_of(places, loc))
-                        if key in taken:
-                            continue
-                        taken.add(key)
-                    out.append(Candidate(mid, loc, tuple(_seeded(s, {}, "")
-                                                         for s in h.params(graph, loc))))
-    return out
+    found = [(mid, loc, h) for fam, ms in index.members.items() for mid in ms[1:]
+             if (h := lib.HYPOTHESES.get(mid)) is not None
+             for loc in h.candidates(graph) if (fam, loc) in sites]
+    kept = first_of_each(found, lambda f: (f[0], place_of(places, f[1])),
+                         {(h, place_of(places, loc)) for h, loc in done})
+    return [Candidate(mid, loc, tuple(_seeded(s, {}, "") for s in h.params(graph, loc)))
+            for mid, loc, h in kept]
 
 
 PARSIMONY = 2.0       # AICc units: an extra parameter that gains less is uninformative
