@@ -23,6 +23,7 @@ import sympy as sp
 from sympy.printing.pycode import PythonCodePrinter
 
 from ..lang.fastdiff import diff
+from ..lang.splines import hat_slope, hat_slope_array, hat_sum, hat_sum_array
 from .substitute import Substitution, substitute
 
 _counter = [0]
@@ -135,6 +136,16 @@ class _Printer(NamedTemps, PythonCodePrinter):
     def _print_Heaviside(self, expr):
         return f"heaviside({self._print(expr.args[0])})"
 
+    def _print_HatSum(self, expr):    # lang.splines: the namespace's hat_sum(_array)
+        return self._spline("_hatsum", expr)
+
+    def _print_HatSlope(self, expr):
+        return self._spline("_hatslope", expr)
+
+    def _spline(self, name, expr):
+        x, lo, hi, *w = (self._print(a) for a in expr.args)
+        return f"{name}({x}, {lo}, {hi}, ({', '.join(w)},))"
+
     def _print_Pow(self, expr, rational=False):
         """A non-integer power other than a square root as ``pow(b, e)``:
         Python's ``**`` of a negative float makes a complex number without
@@ -153,7 +164,7 @@ def _real(name):
 def _namespace():
     ns = {k: getattr(math, k) for k in dir(math) if not k.startswith("_")}
     ns.update(np=np, heaviside=lambda x: 1.0 if x > 0 else (0.5 if x == 0 else 0.0),
-              Abs=abs, max=max, min=min)
+              Abs=abs, max=max, min=min, _hatsum=hat_sum, _hatslope=hat_slope)
     return ns
 
 
@@ -780,7 +791,8 @@ def _array_namespace():
         _min=_reduce(lambda a, b: np.where(b < a, b, a)),
         _max=_reduce(lambda a, b: np.where(b > a, b, a)),
         _sign=lambda x: np.where(x == 0, 0.0, np.copysign(1.0, x)),
-        _heaviside=lambda x: np.where(x > 0, 1.0, np.where(x == 0, 0.5, 0.0)))
+        _heaviside=lambda x: np.where(x > 0, 1.0, np.where(x == 0, 0.5, 0.0)),
+        _hatsum=hat_sum_array, _hatslope=hat_slope_array)
     return ns
 
 

@@ -47,6 +47,23 @@ class _Printer(NamedTemps, C99CodePrinter):
     def _print_Min(self, expr):
         return self._nested("acs_fmin", expr.args)
 
+    # a linear spline (lang.splines): evaluated on the interval of x only; its
+    # weights, when they are consecutive parameters, read in place from pd
+    def _print_HatSum(self, expr):
+        return self._spline("acs_hatsum", expr)
+
+    def _print_HatSlope(self, expr):
+        return self._spline("acs_hatslope", expr)
+
+    def _spline(self, name, expr):
+        x, lo, hi, *w = (self._print(a) for a in expr.args)
+        at = [int(c[1:]) if c[:1] == "p" and c[1:].isdigit() else None for c in w]
+        if None not in at and at == list(range(at[0], at[0] + len(at))):
+            weights = f"pd + {at[0]}"
+        else:
+            weights = "(const double[]){" + ", ".join(w) + "}"
+        return f"{name}({x}, {lo}, {hi}, {len(w)}, {weights})"
+
     def _nested(self, name, args):
         out = self._print(args[-1])
         for a in reversed(args[:-1]):
@@ -74,6 +91,26 @@ HELPERS = (
     "{ return x > 0 ? 1.0 : (x == 0 ? 0.5 : 0.0); }",
     "static inline double acs_fmax(double a, double b) { return (a > b || b != b) ? a : b; }",
     "static inline double acs_fmin(double a, double b) { return (a < b || b != b) ? a : b; }",
+    # lang.splines.hat_sum / hat_slope, the same arithmetic in the same order
+    """static inline double acs_hatsum(double x, double lo, double hi, int n, const double* w)
+{
+  const double h = (hi - lo) / (n - 1), u = (x - lo) / h;
+  if (!(u > -1.0 && u < n)) return 0.0;
+  const double kf = floor(u), t = u - kf;
+  const int k = (int)kf;
+  const double a = k >= 0 ? w[k] : 0.0, b = k + 1 < n ? w[k + 1] : 0.0;
+  return a * (1.0 - t) + b * t;
+}""",
+    """static inline double acs_hatslope(double x, double lo, double hi, int n, const double* w)
+{
+  const double h = (hi - lo) / (n - 1), u = (x - lo) / h;
+  if (!(u > -1.0 && u < n)) return 0.0;
+  const double kf = floor(u), t = u - kf;
+  const int k = (int)kf;
+  const double b = k + 1 < n ? w[k + 1] : 0.0;
+  if (t == 0.0) return (b - (k >= 1 ? w[k - 1] : 0.0)) / (2.0 * h);
+  return (b - (k >= 0 ? w[k] : 0.0)) / h;
+}""",
 )
 
 
