@@ -33,6 +33,8 @@ import math
 import numpy as np
 import sympy as sp
 
+from ..errors import ModelError
+
 __all__ = ["HatSum", "HatSlope", "hat_sum", "hat_slope", "hat_sum_array", "hat_slope_array"]
 
 
@@ -140,8 +142,8 @@ class HatSum(sp.Function):
     @classmethod
     def eval(cls, *args):
         if len(args) < 5:
-            raise ValueError(f"HatSum needs x, lo, hi and at least 2 weights, got "
-                             f"{len(args)} arguments")   # internal: generic.py builds it
+            raise ModelError(f"HatSum needs x, lo, hi and at least 2 weights, got "
+                             f"{len(args)} arguments")
         if all(a.is_number for a in args):
             x, lo, hi, *w = (float(a) for a in args)
             return sp.Float(hat_sum(x, lo, hi, w))
@@ -172,8 +174,8 @@ class HatSlope(sp.Function):
     @classmethod
     def eval(cls, *args):
         if len(args) < 5:
-            raise ValueError(f"HatSlope needs x, lo, hi and at least 2 weights, got "
-                             f"{len(args)} arguments")   # internal
+            raise ModelError(f"HatSlope needs x, lo, hi and at least 2 weights, got "
+                             f"{len(args)} arguments")
         if all(a.is_number for a in args):
             x, lo, hi, *w = (float(a) for a in args)
             return sp.Float(hat_slope(x, lo, hi, w))

@@ -88,6 +88,10 @@ def test_symbolic_derivatives():
         assert float(diff(e, s).subs(at)) == pytest.approx(fd, rel=1e-6, abs=1e-9)
     # numbers in, a number out
     assert float(HatSum(0.37, LO, HI, *W)) == hat_sum(0.37, LO, HI, W)
+    # too few weights: one clear line
+    from acausal.errors import ModelError
+    with pytest.raises(ModelError, match="at least 2 weights, got 4 arguments"):
+        HatSum(x, lo, hi, w[0])
 
 
 @pytest.fixture(scope="module")
