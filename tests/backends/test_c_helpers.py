@@ -76,3 +76,45 @@ def test_max_and_min_print_as_the_helpers_nested():
     text = p.doprint(sp.Min(x, y, z, evaluate=False))
     assert text.count("acs_fmin(") == 2 and "fmin(" not in text.replace("acs_fmin(", "")
     assert "fmax(" not in p.doprint(sp.Max(x, y) + 1).replace("acs_fmax(", "")
+
+
+def test_cold_functions_give_the_optimised_values(tmp_path):
+    """acs_jacs, acs_fixjac and acs_observe are compiled at -O0 (ACS_COLD);
+    acs_jacs and acs_observe give the same bytes as at -O1 (-DACS_COLD=), at
+    random points of the breaker (events, a four-bar, contact: many
+    primitives). (With -ffast-math on the second, this fails.)"""
+    import numpy as np
+
+    from acausal.modelfile import compile_file
+    from acausal.runtime.backends.compiled import Unavailable, c_compiler
+    try:
+        cc = c_compiler()
+    except Unavailable as exc:
+        pytest.skip(str(exc))
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    _, cm = compile_file(os.path.join(root, "models", "breaker_24kv.py"))
+    src = codegen_c.generate_c(cm)
+    assert all(f"ACS_COLD void {name}(" in src.text for name in codegen_c.COLD)
+    (tmp_path / "m.c").write_text(src.text)
+    libs = []
+    for extra in ([], ["-DACS_COLD="]):
+        so = tmp_path / f"m{len(libs)}.so"
+        subprocess.run(cc.split() + ["-O1", "-shared", "-fPIC", *extra, "-o", str(so),
+                                     str(tmp_path / "m.c"), "-lm"], check=True,
+                       capture_output=True)
+        libs.append(ctypes.CDLL(os.fspath(so)))
+    n, n_obs = src.n, libs[0].acs_n_observed()
+    pd = np.concatenate([cm.param_vector(), np.asarray(cm.discrete_start(), float)])
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        y, yp = rng.normal(size=n), rng.normal(size=n)
+        outs = []
+        for lib in libs:
+            Jy, Jyp, o = np.zeros(n * n), np.zeros(n * n), np.zeros(n_obs)
+            args = (ctypes.c_double(0.3), y.ctypes.data_as(ctypes.c_void_p),
+                    yp.ctypes.data_as(ctypes.c_void_p), pd.ctypes.data_as(ctypes.c_void_p))
+            lib.acs_jacs(*args, Jy.ctypes.data_as(ctypes.c_void_p),
+                         Jyp.ctypes.data_as(ctypes.c_void_p))
+            lib.acs_observe(*args, o.ctypes.data_as(ctypes.c_void_p))
+            outs.append((Jy.tobytes(), Jyp.tobytes(), o.tobytes()))
+        assert outs[0] == outs[1]
