@@ -15,7 +15,6 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse as sps
 from scipy.sparse.csgraph import maximum_bipartite_matching
-import sympy as sp
 
 from ..infra.blas import single_threaded
 from ..errors import StructuralError

@@ -34,7 +34,7 @@ from sympy import Eq, Piecewise
 
 from acausal.lang import Event
 
-from .geometry import column, minor_sine, rotate  # noqa: F401  (column, minor_sine: public here too)
+from .geometry import column, minor_sine  # noqa: F401  (public here too)
 
 DEAD_CENTRE_SIN = 0.05   # warn within about 2.9 deg of a dead centre
 
