@@ -80,3 +80,29 @@ def _commands_share_this_process():
     import acausal.infra.executor as ex
     ex.EXIT_SOON = False
     yield
+
+
+@pytest.fixture(scope="session")
+def c_library(tmp_path_factory):
+    """``build(text, flags=())``: the C source ``text`` compiled as the
+    compiled backend compiles a model (-O1, shared, with libm) into a
+    ``ctypes.CDLL``; the test is skipped when there is no C compiler."""
+    import ctypes
+    import subprocess
+
+    from acausal.runtime.backends.compiled import Unavailable, c_compiler
+    try:
+        cc = c_compiler()
+    except Unavailable as exc:
+        pytest.skip(str(exc))
+    folder = tmp_path_factory.mktemp("c_library")
+    made = []
+
+    def build(text, flags=()):
+        src, so = folder / f"lib{len(made)}.c", folder / f"lib{len(made)}.so"
+        src.write_text(text)
+        subprocess.run(cc.split() + ["-O1", "-shared", "-fPIC", *flags, "-o", str(so), str(src),
+                                     "-lm"], check=True, capture_output=True)
+        made.append(so)
+        return ctypes.CDLL(os.fspath(so))
+    return build

@@ -8,7 +8,6 @@ import itertools
 import math
 import os
 import struct
-import subprocess
 
 import pytest
 import sympy as sp
@@ -23,25 +22,14 @@ def _bits(x):
 
 
 @pytest.fixture(scope="module")
-def helpers(tmp_path_factory):
-    from acausal.runtime.backends.compiled import Unavailable, c_compiler
-    try:
-        cc = c_compiler()
-    except Unavailable as exc:
-        pytest.skip(str(exc))
-    d = tmp_path_factory.mktemp("c_helpers")
-    src = d / "h.c"
-    src.write_text("#include <math.h>\n" + "\n".join(codegen_c.HELPERS) + """
+def helpers(c_library):
+    lib = c_library("#include <math.h>\n" + "\n".join(codegen_c.HELPERS) + """
 double h_max(double a, double b) { return acs_fmax(a, b); }
 double h_min(double a, double b) { return acs_fmin(a, b); }
 double h_heaviside(double x) { return acs_heaviside(x); }
 double c_max(double a, double b) { return fmax(a, b); }
 double c_min(double a, double b) { return fmin(a, b); }
 """)
-    so = d / "h.so"
-    subprocess.run(cc.split() + ["-O1", "-shared", "-fPIC", "-o", str(so), str(src), "-lm"],
-                   check=True, capture_output=True)
-    lib = ctypes.CDLL(os.fspath(so))
     for name in ("h_max", "h_min", "c_max", "c_min"):
         f = getattr(lib, name)
         f.restype, f.argtypes = ctypes.c_double, [ctypes.c_double, ctypes.c_double]
@@ -78,7 +66,7 @@ def test_max_and_min_print_as_the_helpers_nested():
     assert "fmax(" not in p.doprint(sp.Max(x, y) + 1).replace("acs_fmax(", "")
 
 
-def test_cold_functions_give_the_optimised_values(tmp_path):
+def test_cold_functions_give_the_optimised_values(c_library):
     """acs_jacs, acs_fixjac and acs_observe are compiled at -O0 (ACS_COLD);
     acs_jacs and acs_observe give the same bytes as at -O1 (-DACS_COLD=), at
     random points of the breaker (events, a four-bar, contact: many
@@ -86,23 +74,11 @@ def test_cold_functions_give_the_optimised_values(tmp_path):
     import numpy as np
 
     from acausal.modelfile import compile_file
-    from acausal.runtime.backends.compiled import Unavailable, c_compiler
-    try:
-        cc = c_compiler()
-    except Unavailable as exc:
-        pytest.skip(str(exc))
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     _, cm = compile_file(os.path.join(root, "models", "breaker_24kv.py"))
     src = codegen_c.generate_c(cm)
     assert all(f"ACS_COLD void {name}(" in src.text for name in codegen_c.COLD)
-    (tmp_path / "m.c").write_text(src.text)
-    libs = []
-    for extra in ([], ["-DACS_COLD="]):
-        so = tmp_path / f"m{len(libs)}.so"
-        subprocess.run(cc.split() + ["-O1", "-shared", "-fPIC", *extra, "-o", str(so),
-                                     str(tmp_path / "m.c"), "-lm"], check=True,
-                       capture_output=True)
-        libs.append(ctypes.CDLL(os.fspath(so)))
+    libs = [c_library(src.text, flags) for flags in ([], ["-DACS_COLD="])]
     n, n_obs = src.n, libs[0].acs_n_observed()
     pd = np.concatenate([cm.param_vector(), np.asarray(cm.discrete_start(), float)])
     rng = np.random.default_rng(3)

@@ -7,7 +7,6 @@ with a spline torque against a scipy integration that interpolates with
 import ctypes
 import math
 import os
-import subprocess
 
 import numpy as np
 import pytest
@@ -95,20 +94,11 @@ def test_symbolic_derivatives():
 
 
 @pytest.fixture(scope="module")
-def c_lib(tmp_path_factory):
-    from acausal.runtime.backends.compiled import Unavailable, c_compiler
-    try:
-        cc = c_compiler()
-    except Unavailable as exc:
-        pytest.skip(str(exc))
-    d = tmp_path_factory.mktemp("splines")
-    (d / "s.c").write_text("#include <math.h>\n" + "\n".join(codegen_c.HELPERS) + """
+def c_lib(c_library):
+    lib = c_library("#include <math.h>\n" + "\n".join(codegen_c.HELPERS) + """
 double s_sum(double x, double lo, double hi, int n, const double* w) { return acs_hatsum(x, lo, hi, n, w); }
 double s_slope(double x, double lo, double hi, int n, const double* w) { return acs_hatslope(x, lo, hi, n, w); }
 """)
-    subprocess.run(cc.split() + ["-O1", "-shared", "-fPIC", "-o", str(d / "s.so"), str(d / "s.c"),
-                                 "-lm"], check=True, capture_output=True)
-    lib = ctypes.CDLL(os.fspath(d / "s.so"))
     for f in (lib.s_sum, lib.s_slope):
         f.restype = ctypes.c_double
         f.argtypes = [ctypes.c_double] * 3 + [ctypes.c_int, ctypes.POINTER(ctypes.c_double)]
