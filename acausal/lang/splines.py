@@ -132,22 +132,31 @@ def _hat(x, lo, hi, n, i):
     return FastMax(0, 1 - FastAbs(x - (lo + i * h)) / h)
 
 
-class HatSum(sp.Function):
-    """``HatSum(x, lo, hi, w_0, ..., w_{n-1})``: the linear spline of the
-    module doc (n >= 2 weights). A number when every argument is one."""
+class _SplineNode(sp.Function):
+    """What :class:`HatSum` and :class:`HatSlope` share: the arguments
+    (x, lo, hi, then at least 2 weights), real, and a number when every
+    argument is one (``_value``: the numeric form)."""
 
     nargs = None
     is_real = True
+    _value = None
 
     @classmethod
     def eval(cls, *args):
         if len(args) < 5:
-            raise ModelError(f"HatSum needs x, lo, hi and at least 2 weights, got "
+            raise ModelError(f"{cls.__name__} needs x, lo, hi and at least 2 weights, got "
                              f"{len(args)} arguments")
         if all(a.is_number for a in args):
             x, lo, hi, *w = (float(a) for a in args)
-            return sp.Float(hat_sum(x, lo, hi, w))
+            return sp.Float(cls._value(x, lo, hi, w))
         return None
+
+
+class HatSum(_SplineNode):
+    """``HatSum(x, lo, hi, w_0, ..., w_{n-1})``: the linear spline of the
+    module doc (n >= 2 weights). A number when every argument is one."""
+
+    _value = staticmethod(hat_sum)
 
     def expanded(self):
         """The written-out sum of hats (the same function)."""
@@ -164,22 +173,11 @@ class HatSum(sp.Function):
         return _hat(x, lo, hi, len(w), argindex - 4)
 
 
-class HatSlope(sp.Function):
+class HatSlope(_SplineNode):
     """``HatSlope(x, lo, hi, w_0, ...)``: d/dx of :class:`HatSum` with the
     same arguments (piecewise constant)."""
 
-    nargs = None
-    is_real = True
-
-    @classmethod
-    def eval(cls, *args):
-        if len(args) < 5:
-            raise ModelError(f"HatSlope needs x, lo, hi and at least 2 weights, got "
-                             f"{len(args)} arguments")
-        if all(a.is_number for a in args):
-            x, lo, hi, *w = (float(a) for a in args)
-            return sp.Float(hat_slope(x, lo, hi, w))
-        return None
+    _value = staticmethod(hat_slope)
 
     def fdiff(self, argindex=1):
         x, lo, hi, w = _parts(self)
