@@ -78,6 +78,10 @@ class ParameterSpace:
                    dict(bindings))
 
     @cached_property
+    def _defaults(self):
+        return np.array([e.default for e in self.entries], dtype=float)
+
+    @cached_property
     def _positions(self):
         out = {}
         for i, e in enumerate(self.entries):
@@ -101,7 +105,7 @@ class ParameterSpace:
     def vector(self, overrides=None):
         """Free parameter values with ``overrides`` (name -> value) applied and
         checked against each parameter's bounds."""
-        p = np.array([e.default for e in self.entries], dtype=float)
+        p = self._defaults.copy()
         for name, value in (overrides or {}).items():
             i = self.index(name)
             e = self.entries[i]

@@ -93,16 +93,20 @@ class RunOptions:
     @classmethod
     def of(cls, options):
         """The settings of ``simulate``'s keywords ``options``."""
-        known = {f.name for f in fields(cls)}
         for name in options:
-            if name not in known:
+            if name not in _RUN_OPTIONS:
                 raise TypeError(f"simulate() got an unexpected keyword argument {name!r}")
         return cls(**options)
 
 
+_RUN_OPTIONS = frozenset(f.name for f in fields(RunOptions))
+
+
 def _output_times(t0, t_end, output_step, output_times):
     if output_times is not None:
-        ts = np.sort(np.asarray(output_times, dtype=float).ravel())
+        ts = np.asarray(output_times, dtype=float).ravel()
+        if not (ts[1:] >= ts[:-1]).all():    # (the diagnosis's sample times are sorted)
+            ts = np.sort(ts)
         return ts[(ts >= t0) & (ts <= t_end)]
     if output_step == 0:   # every internal step of the solver
         return np.array([t0, t_end], dtype=float)

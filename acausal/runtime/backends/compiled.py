@@ -27,6 +27,7 @@ import subprocess
 import sys
 import tempfile
 import weakref
+from dataclasses import dataclass
 
 import numpy as np
 from sympy.printing.codeprinter import PrintMethodNotImplementedError
@@ -42,6 +43,8 @@ _REINIT = os.path.join(_HERE, "reinit.c")     # the re-initialisation Newton in 
 _LIBS = ("sundials_core", "sundials_nvecserial", "sundials_sunmatrixdense",
          "sundials_sunlinsoldense", "sundials_ida")
 _ROOT, _FULL = 2, 99
+CAP = 1024   # rows of a solver call's output buffer: a call returns to Python (the
+             # watch's guard) each time it fills
 _MESSAGES = {
     -1: "the maximum number of steps was taken before reaching the output time",
     -2: "the requested accuracy could not be achieved",
@@ -177,6 +180,19 @@ def _driver_object(cc, src):
     return out
 
 
+@dataclass(frozen=True)
+class _Static:
+    """The run-independent settings of a model's IDA handle: unknowns,
+    root functions, which unknowns are differential (IDASetId), the roots'
+    directions and which of them end a segment (not an observer's)."""
+
+    n: int
+    nr: int
+    ident: np.ndarray
+    dirs: np.ndarray
+    terminal: tuple
+
+
 class _Library:
     """The loaded shared library of one compiled model."""
 
@@ -217,7 +233,22 @@ class _Library:
         n_obs = getattr(cm, "n_observed", len(cm.var_names))
         self.n_obs = n_obs if lib.acs_has_observe() and lib.acs_n_observed() == n_obs else None
         self.idle = {}
+        self._static = None
         weakref.finalize(self, _free_idle, lib, self.idle)
+
+    def static(self, cm):
+        """What every run of ``cm`` (this library's model) gives IDA alike
+        (:class:`_Static`), made once."""
+        if self._static is None:
+            n = len(cm.dae.y)
+            ident = np.zeros(n)
+            ident[:cm.dae.n_states] = 1.0
+            dirs = np.array([e.direction for e in cm.events] + [-1] * len(cm.assertions)
+                            or [0], dtype=np.intc)
+            terminal = tuple([not e.observer for e in cm.events]
+                             + [True] * len(cm.assertions))
+            self._static = _Static(n, cm.n_roots, ident, dirs, terminal)
+        return self._static
 
 
     # IDA handles of finished runs, by settings: every segment starts with
@@ -267,18 +298,17 @@ class CompiledSolver(SegmentSolver):
         self.detail = "SUNDIALS IDA calling generated C" + (" (compiled now)" if L.built
                                                               else " (from the cache)")
         L.built = False
-        n = self.n = len(cm.dae.y)
-        self.nr = cm.n_roots
-        atol = np.ascontiguousarray(np.broadcast_to(np.asarray(opts["atol"], float), (n,)))
-        ident = np.zeros(n)
-        ident[:cm.dae.n_states] = 1.0
-        self.dirs = np.array([e.direction for e in cm.events] + [-1] * len(cm.assertions)
-                             or [0], dtype=np.intc)
-        self.terminal = [not e.observer for e in cm.events] + [True] * len(cm.assertions)
+        st = L.static(cm)
+        n, self.n, self.nr = st.n, st.n, st.nr
+        self.dirs, self.terminal = st.dirs, st.terminal
+        atol = np.asarray(opts["atol"], float)
+        if atol.shape != (n,) or not atol.flags.c_contiguous:
+            atol = np.ascontiguousarray(np.broadcast_to(atol, (n,)))
         rtol, hmax = float(opts["rtol"]), float(opts.get("max_step") or 0.0)
         key = (rtol, atol.tobytes(), hmax, int(opts["max_num_steps"]))
-        self.h = L.take(key) or L.lib.acs_new(n, self.nr, L.n_pd, rtol, _ptr(atol), _ptr(ident),
-                                              _ptr(self.dirs, ctypes.c_int), hmax, key[3])
+        self.h = L.take(key) or L.lib.acs_new(n, self.nr, L.n_pd, rtol, _ptr(atol),
+                                              _ptr(st.ident), _ptr(self.dirs, ctypes.c_int),
+                                              hmax, key[3])
         if not self.h:
             raise Unavailable("SUNDIALS refused the solver settings")
         self._free = weakref.finalize(self, L.give, key, self.h)
@@ -286,6 +316,23 @@ class CompiledSolver(SegmentSolver):
         self.yroot, self.yproot = np.zeros(n), np.zeros(n)
         self.rootinfo = np.zeros(max(self.nr, 1), dtype=np.intc)
         self.counters = np.zeros(3, dtype=np.int_)
+        self._cnt = self.counters.ctypes.data
+        self._buffers = None   # the output buffers (made at the first segment)
+
+    def _buffer(self):
+        """The output buffers (:data:`CAP` rows of t, y and y'), their row
+        count and acs_advance's pointer arguments after ``every_step``: made
+        once per run, reused by its segments (their rows are copied out)."""
+        got = self._buffers
+        if got is None:
+            n, cap = self.n, CAP
+            bt, by, byp = np.empty(cap), np.empty((cap, n)), np.empty((cap, n))
+            nrows = ctypes.c_int(0)
+            ptrs = (bt.ctypes.data, by.ctypes.data, byp.ctypes.data, cap, ctypes.byref(nrows),
+                    self.troot.ctypes.data, self.yroot.ctypes.data, self.yproot.ctypes.data,
+                    self.rootinfo.ctypes.data)
+            got = self._buffers = (bt, by, byp, nrows, ptrs)
+        return got
 
     def solve(self, cb, d, t, y, yp, tout, every_step):
         L, n = self.L.lib, self.n
@@ -296,24 +343,20 @@ class CompiledSolver(SegmentSolver):
                            float(tout[-1]))
         if flag < 0:
             return Segment(np.array([t]), y0[None], yp0[None], flag, self._message(flag))
-        # (a dense grid's buffer fills every 256 rows too: the guard then
+        # (a dense grid's buffer fills every CAP rows too: the guard then
         # sees a limit or a stop request within a bounded time)
-        cap = 1024 if every_step else min(len(tout) + 1, 256)
+        bt, by, byp, nrows, ptrs = self._buffer()
         T, Y, YP = [np.array([t])], [y0[None]], [yp0[None]]
-        roots, iout, nrows = [], ctypes.c_int(0), ctypes.c_int(0)
-        bt, by, byp = np.empty(cap), np.empty((cap, n)), np.empty((cap, n))
-        ptrs = (bt.ctypes.data, by.ctypes.data, byp.ctypes.data, cap, ctypes.byref(nrows),
-                self.troot.ctypes.data, self.yroot.ctypes.data, self.yproot.ctypes.data,
-                self.rootinfo.ctypes.data)
+        roots, iout = [], ctypes.c_int(0)
+        tp, nt, every = tout.ctypes.data, len(tout), int(bool(every_step))
         while True:
-            flag = L.acs_advance(self.h, tout.ctypes.data, len(tout), ctypes.byref(iout),
-                                 int(bool(every_step)), *ptrs)
+            flag = L.acs_advance(self.h, tp, nt, ctypes.byref(iout), every, *ptrs)
             k = nrows.value
             if k:
                 T.append(bt[:k].copy()), Y.append(by[:k].copy()), YP.append(byp[:k].copy())
             if flag == _FULL:
                 if self.guard is not None:
-                    L.acs_counters(self.h, self.counters.ctypes.data)
+                    L.acs_counters(self.h, self._cnt)
                     if self.guard(int(self.counters[0]), float(bt[k - 1]) if k else None):
                         flag = 0      # stopped: the rows so far are the segment
                         break
@@ -327,8 +370,8 @@ class CompiledSolver(SegmentSolver):
                 T.append(self.troot.copy()), Y.append(self.yroot[None].copy())
                 YP.append(self.yproot[None].copy())
                 break
-        L.acs_counters(self.h, self.counters.ctypes.data)
-        steps, nfev, njev = (int(c) for c in self.counters)
+        L.acs_counters(self.h, self._cnt)
+        steps, nfev, njev = self.counters.tolist()
         return Segment(np.concatenate(T), np.concatenate(Y), np.concatenate(YP),
                        int(flag) if flag < 0 else (_ROOT if flag == _ROOT else 0),
                        self._message(flag), roots, nfev, njev, steps)
@@ -380,6 +423,7 @@ class _CMode:
         self.pd = np.ascontiguousarray(np.concatenate([np.asarray(p, float),
                                                        np.asarray(d, float)]))
         self.pdp = self.pd.ctypes.data or 0
+        self._fixed_of = None
 
     def res(self, t, y, yp, r):
         y, yp = _f64(y), _f64(yp)
@@ -403,11 +447,19 @@ class _CMode:
         self.lib.acs_observe(t, y.ctypes.data, yp.ctypes.data, self.pdp, o.ctypes.data)
         return o
 
+    def _fixed(self, fixed):
+        """:func:`_fixed_arrays` of ``fixed``, made once per list (the
+        initialisation passes its one list to every call)."""
+        got = self._fixed_of
+        if got is None or got[0] is not fixed:
+            got = self._fixed_of = (fixed, *_fixed_arrays(fixed))
+        return got[1], got[2]
+
     def init_newton(self, t, z0, guess_rows, fixed, max_iter=50):
         if self.L.n_obs is None or len(fixed) != self.L.n_fixed:
             return NotImplemented
         z = np.array(z0, dtype=float)
-        fk, fv = _fixed_arrays(fixed)
+        fk, fv = self._fixed(fixed)
         gk = np.array(list(guess_rows) or [0], dtype=np.intc)
         flag = self.lib.acs_init_newton(self.n, self.ns, float(t), z.ctypes.data, self.pdp,
                                         len(fixed), fk.ctypes.data, fv.ctypes.data,
@@ -418,7 +470,7 @@ class _CMode:
         if self.L.n_obs is None or len(fixed) != self.L.n_fixed:
             return NotImplemented
         z = _f64(z)
-        fk, fv = _fixed_arrays(fixed)
+        fk, fv = self._fixed(fixed)
         ok = self.lib.acs_init_check(self.n, self.ns, float(t), z.ctypes.data, self.pdp,
                                      len(fixed), fk.ctypes.data, fv.ctypes.data)
         return NotImplemented if ok < 0 else bool(ok)
