@@ -170,6 +170,7 @@ class _Run:
         self.firings = {}    # (owner, event name) -> times of its last CHATTER_COUNT firings
         self.nfev = self.njev = self.steps = self.rows = 0
         self._served = {}
+        self.rechecks = [i for i, e in enumerate(cm.events) if e.recheck]  # (_event_iteration)
 
     def record(self, t, y, yp, d):
         self.T.append(np.atleast_1d(np.asarray(t, float)))
@@ -590,7 +591,8 @@ def _check_output_size(cm, t0, t_end, output_step, output_times, max_rows, max_m
 
 
 def _tspan(t, tout, t_end, horizon, t_event=np.inf):
-    """Times of the next solver call: ``t``, then the output times after it,
+    """Times of the next solver call: ``t``, then the output times (``tout``,
+    sorted) after it,
     up to ``t_end`` (which ends the span), or up to ``horizon`` when a watch
     cuts the run into windows (at least one output time), or up to the
     next time event ``t_event`` (which then ends the span: the solver
@@ -598,9 +600,11 @@ def _tspan(t, tout, t_end, horizon, t_event=np.inf):
     # an output time closer to t than IDA can step (it refuses a tout within
     # 100 unit round-offs of t: an output 1 ulp after a time event) is t
     after = t + SAME_INSTANT * max(abs(t), abs(t_end))
+    i = int(np.searchsorted(tout, after, "right"))    # (``tout`` is sorted) tout[i:] > after
     if t_event < t_end and (horizon is None or t_event <= horizon):
-        return np.concatenate([[t], tout[(tout > after) & (tout < t_event)], [t_event]])
-    later = tout[tout > after]
+        j = max(i, int(np.searchsorted(tout, t_event, "left")))
+        return np.concatenate([[t], tout[i:j], [t_event]])
+    later = tout[i:]
     if horizon is not None and horizon < t_end:
         cut = later[later <= horizon]
         if len(cut) == 0:
@@ -902,7 +906,7 @@ def _time_events(run, cb, point, d):
 def _event_iteration(run, cb, t, y, yp, d):
     """Fire ``recheck`` events whose condition is violated at this instant."""
     cm = run.cm
-    checks = [i for i, e in enumerate(cm.events) if e.recheck]
+    checks = run.rechecks
     if not checks:
         return y, yp, d, cb, False
     g = np.zeros(cm.n_roots)
