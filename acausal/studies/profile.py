@@ -320,7 +320,6 @@ def profile_likelihood(residuals: Residuals, x_opt: Sequence[float], index: int,
 def _assemble(obj, sides, hw, thr, level, chi0, name, rel_tol) -> LikelihoodProfile:
     c, i = obj.c, obj.i
     pts = sorted(sides[0].points[1:] + sides[1].points, key=lambda p: p[0])
-    us = np.array([p[0] for p in pts])
     full = np.array([c.to_x(obj.full(p[0], p[1])) for p in pts])
     ends = []
     for side, bound in zip(sides, (c.lo[i], c.hi[i])):

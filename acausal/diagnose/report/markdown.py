@@ -333,7 +333,7 @@ def verdict(d, s) -> str:
     if v["kind"] == "not_explained":
         where = _where_sentence(s["unexplained"])
         laws = "".join(f" **A mixture of laws?** {x['text']}." for x in v["laws"])
-        return (f"**Discrepancy not explained by the library.** "
+        return ("**Discrepancy not explained by the library.** "
                 + "; ".join(r["text"] for r in v["reasons"]) + "." + where + laws
                 + _candidates_sentence(v) + _threshold_sentence(v)
                 + _class_sentence(s["cause_class"]))
@@ -380,7 +380,7 @@ def _where_sentence(un) -> str:
         return f" No node could be judged: {un['why'] or 'no located generic term'}."
     others = ", ".join(f"`{x['node']}` {fmt(x['heldout_rmse'], 3)}"
                        for x in un["nodes"][1:4])
-    tied = (f"; the held-out data cannot tell it from "
+    tied = ("; the held-out data cannot tell it from "
             + ", ".join(f"`{n}`" for n in un["tied_nodes"]) if un["tied_nodes"] else "")
     head = (f" A generic term at the node of `{un['node']}` removes most of the misfit"
             if un["beats_library"] else

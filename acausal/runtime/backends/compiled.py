@@ -335,7 +335,7 @@ class CompiledSolver(SegmentSolver):
         return got
 
     def solve(self, cb, d, t, y, yp, tout, every_step):
-        L, n = self.L.lib, self.n
+        L = self.L.lib
         tout = np.ascontiguousarray(tout, dtype=float)
         y0, yp0 = np.array(y, float), np.array(yp, float)
         pd = np.concatenate([self.p, np.asarray(d, float)])
