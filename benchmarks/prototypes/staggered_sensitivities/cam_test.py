@@ -1,0 +1,43 @@
+"""Prototype on the 13-unknown cam DAE (generic term at the cam beside stick-slip
+friction), w0 = 40: a single mode after the initial event at t = 0. Sensitivities of
+cam.phi and follower.s on a 201-point grid against tight central differences."""
+import os
+import time, numpy as np
+from acausal.diagnose.library import generic as gen
+from acausal.diagnose.library.hypotheses import HYPOTHESES
+import proto
+P = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))), "tests", "diagnose", "independent", "cam_follower.py")
+mf, cm = gen.build_at(P, "cam", 17, 9, beside=("stick_slip_friction", "cam"), hypotheses=HYPOTHESES)
+rng = np.random.default_rng(1)
+vals = {f"gen.a{i}": float(v) for i, v in enumerate(1e-3 * rng.standard_normal(17))}
+vals.update({f"gen.b{i}": float(v) for i, v in enumerate(1e-3 * rng.standard_normal(9))})
+vals["hyp_ssf.tau"] = 2e-3
+cond = {"w0": 40.0}
+p0 = cm.param_vector({**vals, **cond})
+names = ["spring.c", "bearing.d", "hyp_ssf.tau", "gen.a3", "gen.a8", "gen.b2", "gen.b6"]
+print({n: float(p0[cm.param_index(n)]) for n in names})
+res = cm.simulate(params={**vals, **cond}, backend="compiled", t_end=2.0, rtol=1e-8, atol=1e-10, output_step=0)
+print("steps", res.t.size - 1, "rows with d != d[-1]:", int(np.sum(np.any(res.d != res.d[-1], axis=1))), "events", res.events)
+tq = np.linspace(0, 2.0, 201)
+sig = ["cam.phi", "follower.s"]
+for q in (2, 3):
+    t0 = time.perf_counter()
+    st = proto.Setup(cm, vals, cond, names, {"a": "cam.phi", "b": "cam.w"}, d=res.d[-1])
+    S, SP = proto.sweep(st, res, q)
+    Sq = proto.hermite(res.t, S, SP, tq); yq = proto.hermite(res.t, res.y, res.yp, tq)
+    ypq = np.array([np.interp(tq, res.t, res.yp[:, j]) for j in range(st.n)]).T
+    J = np.vstack([proto.observed_rows(st, v, tq, yq, ypq, Sq) for v in sig])
+    print(f"BDF{q} prototype {time.perf_counter()-t0:.2f} s")
+    if q == 2: J2 = J
+def obs(pp):
+    r = cm.simulate(params={**vals, **cond, **pp}, backend="compiled", t_end=2.0, rtol=1e-10, atol=1e-12, output_times=tq)
+    return np.concatenate([np.interp(tq, r.t, r[v]) for v in sig])
+print("param      |col|     BDF2-vs-ref  BDF3-vs-ref  ref(1e-4 vs 1e-3 rel step)")
+for i, n in enumerate(names):
+    v = float(p0[cm.param_index(n)])
+    refs = {}
+    for rel in (1e-4, 1e-3):
+        h = rel * max(abs(v), 1e-3)
+        refs[rel] = (obs({n: v + h}) - obs({n: v - h})) / (2 * h)
+    a = refs[1e-4]; na = np.linalg.norm(a)
+    print(f"{n:12s} {na:.3e}  {np.linalg.norm(J2[:, i]-a)/na:.1e}  {np.linalg.norm(J[:, i]-a)/na:.1e}  {np.linalg.norm(refs[1e-3]-a)/na:.1e}")
