@@ -78,7 +78,12 @@ NULL_TOL = 1e-6  # directions of the weights with no effect on the data (singula
                  # relative to the largest); the position and velocity parts' shared
                  # constant is pinned by construction (at_rest_row)
 PIN_WEIGHT = 1e3  # pin rows' size relative to the term's largest singular value
-STEP = 1e-4      # finite-difference step (of each weight's / free parameter's scale)
+STEP = 1e-3      # finite-difference step (of each weight's / free parameter's scale):
+                 # on gear_cogging's term (65 x 17 knots, 84 parameters) the columns of
+                 # 1e-4 at the model file's rtol 1e-8 were off by 9.5 % (median column)
+                 # to 350 % (weights whose knots the runs barely reach) against exact
+                 # sensitivities; 1e-3: 1.1 % and 7-24 % (the integrator's noise over
+                 # the step; benchmarks/prototypes/staggered_sensitivities/)
 SMOOTH_GRID = tuple(10.0 ** np.arange(-5, 6))  # smoothing weights per data value tried
                  # for each part (generic.SMOOTH is 1): from a term free to follow 8
                  # cycles over the stroke to one close to straight lines. The penalty is
