@@ -33,8 +33,11 @@ def test_the_bisection_gives_the_masks_spans():
         if n and rng.random() < 0.3:
             tout = np.append(tout, t_end)
         t = float(rng.choice(np.concatenate([tout, [0.0, t_end * rng.random()]])))
+        if rng.random() < 0.2:      # an output time exactly at the span's first limit
+            tout = np.sort(np.append(tout, t + SAME_INSTANT * max(abs(t), abs(t_end))))
         horizon = None if rng.random() < 0.5 else t + float(rng.choice([0.0, 1e-3, 0.1, 10.0]))
-        t_event = float(rng.choice([np.inf, t_end * rng.random(), t + 1e-17, t, t_end]))
+        t_event = float(rng.choice([np.inf, t_end * rng.random(), t + 1e-17, t, t_end]
+                                   + list(tout[-3:])))     # a time event at an output time
         got = _tspan(t, tout, t_end, horizon, t_event)
         want = masks(t, tout, t_end, horizon, t_event)
         assert np.array_equal(got, want), (t, tout, t_end, horizon, t_event, got, want)
