@@ -38,17 +38,27 @@ from ..errors import ModelError
 __all__ = ["HatSum", "HatSlope", "hat_sum", "hat_slope", "hat_sum_array", "hat_slope_array"]
 
 
+def _cell(x, lo, hi, n):
+    """(spacing h, knot k at or below ``x``, t = (x - x_k)/h in [0, 1)) for a
+    number ``x``; None one spacing or more outside [lo, hi] and at a NaN
+    (the scalar twin of :func:`_interval`: the same arithmetic)."""
+    h = (hi - lo) / (n - 1)
+    u = (x - lo) / h
+    if not (-1.0 < u < n):
+        return None
+    k = math.floor(u)
+    return h, k, u - k
+
+
 def hat_sum(x, lo, hi, w):
     """The spline's value at a number ``x`` (``w`` the n weights); 0 one
     spacing or more outside [lo, hi], and at a NaN ``x`` (as
     ``max(0, NaN) = 0`` makes the written-out sum)."""
     n = len(w)
-    h = (hi - lo) / (n - 1)
-    u = (x - lo) / h
-    if not (-1.0 < u < n):
+    cell = _cell(x, lo, hi, n)
+    if cell is None:
         return 0.0
-    k = math.floor(u)
-    t = u - k
+    _, k, t = cell
     a = w[k] if k >= 0 else 0.0
     b = w[k + 1] if k + 1 < n else 0.0
     return a * (1.0 - t) + b * t
@@ -58,12 +68,10 @@ def hat_slope(x, lo, hi, w):
     """d/dx of :func:`hat_sum` at a number ``x``; at a knot the mean of the
     slopes on its two sides."""
     n = len(w)
-    h = (hi - lo) / (n - 1)
-    u = (x - lo) / h
-    if not (-1.0 < u < n):
+    cell = _cell(x, lo, hi, n)
+    if cell is None:
         return 0.0
-    k = math.floor(u)
-    t = u - k
+    h, k, t = cell
     b = w[k + 1] if k + 1 < n else 0.0
     if t == 0.0:
         c = w[k - 1] if k >= 1 else 0.0
@@ -78,6 +86,7 @@ def _padded(w):
 
 
 def _interval(x, lo, hi, n):
+    """:func:`_cell` over an array: (h, inside, k, t), k and t 0 outside."""
     x = np.asarray(x, dtype=float)
     h = (hi - lo) / (n - 1)
     u = (x - lo) / h
