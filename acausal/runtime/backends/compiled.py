@@ -192,6 +192,16 @@ class _Static:
     dirs: np.ndarray
     terminal: tuple
 
+    @classmethod
+    def of(cls, cm):
+        n = len(cm.dae.y)
+        ident = np.zeros(n)
+        ident[:cm.dae.n_states] = 1.0
+        dirs = np.array([e.direction for e in cm.events] + [-1] * len(cm.assertions)
+                        or [0], dtype=np.intc)
+        terminal = tuple([not e.observer for e in cm.events] + [True] * len(cm.assertions))
+        return cls(n, cm.n_roots, ident, dirs, terminal)
+
 
 class _Library:
     """The loaded shared library of one compiled model."""
@@ -233,22 +243,8 @@ class _Library:
         n_obs = getattr(cm, "n_observed", len(cm.var_names))
         self.n_obs = n_obs if lib.acs_has_observe() and lib.acs_n_observed() == n_obs else None
         self.idle = {}
-        self._static = None
+        self.static = _Static.of(cm)
         weakref.finalize(self, _free_idle, lib, self.idle)
-
-    def static(self, cm):
-        """What every run of ``cm`` (this library's model) gives IDA alike
-        (:class:`_Static`), made once."""
-        if self._static is None:
-            n = len(cm.dae.y)
-            ident = np.zeros(n)
-            ident[:cm.dae.n_states] = 1.0
-            dirs = np.array([e.direction for e in cm.events] + [-1] * len(cm.assertions)
-                            or [0], dtype=np.intc)
-            terminal = tuple([not e.observer for e in cm.events]
-                             + [True] * len(cm.assertions))
-            self._static = _Static(n, cm.n_roots, ident, dirs, terminal)
-        return self._static
 
 
     # IDA handles of finished runs, by settings: every segment starts with
@@ -298,9 +294,9 @@ class CompiledSolver(SegmentSolver):
         self.detail = "SUNDIALS IDA calling generated C" + (" (compiled now)" if L.built
                                                               else " (from the cache)")
         L.built = False
-        st = L.static(cm)
-        n, self.n, self.nr = st.n, st.n, st.nr
-        self.dirs, self.terminal = st.dirs, st.terminal
+        st = L.static
+        n = self.n = st.n
+        self.nr, self.dirs, self.terminal = st.nr, st.dirs, st.terminal
         atol = np.asarray(opts["atol"], float)
         if atol.shape != (n,) or not atol.flags.c_contiguous:
             atol = np.ascontiguousarray(np.broadcast_to(atol, (n,)))
