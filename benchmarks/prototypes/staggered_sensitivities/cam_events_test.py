@@ -12,7 +12,6 @@ vals = {f"gen.a{i}": float(v) for i, v in enumerate(1e-3 * rng.standard_normal(1
 vals.update({f"gen.b{i}": float(v) for i, v in enumerate(1e-3 * rng.standard_normal(9))})
 vals["hyp_ssf.tau"] = 2e-3
 cond = {"w0": 10.0}
-p0 = cm.param_vector({**vals, **cond})
 names = ["spring.c", "bearing.d", "hyp_ssf.tau", "gen.a0", "gen.a1"]
 res = cm.simulate(params={**vals, **cond}, backend="compiled", t_end=2.0, rtol=1e-8, atol=1e-10, output_step=0)
 print("steps", res.t.size - 1, "events", len(res.events))
@@ -30,15 +29,4 @@ for jumps in (False, True):
     st = proto.Setup(cm, vals, cond, names, {"a": "cam.phi", "b": "cam.w"}, d=res.d[-1])
     Js[jumps] = np.vstack([proto.observed_rows(st, v, tq, yq, ypq, Sq) for v in sig])
     print("jumps", jumps, f"{time.perf_counter()-t0:.2f} s")
-def obs(pp):
-    r = cm.simulate(params={**vals, **cond, **pp}, backend="compiled", t_end=2.0, rtol=1e-10, atol=1e-12, output_times=tq)
-    return np.concatenate([np.interp(tq, r.t, r[v]) for v in sig])
-print("param      |col|     nojump-vs-ref  jump-vs-ref  ref(1e-4 vs 1e-3 rel step)")
-for i, n in enumerate(names):
-    v = float(p0[cm.param_index(n)])
-    refs = {}
-    for rel in (1e-4, 1e-3):
-        h = rel * max(abs(v), 1e-3)
-        refs[rel] = (obs({n: v + h}) - obs({n: v - h})) / (2 * h)
-    a = refs[1e-4]; na = np.linalg.norm(a)
-    print(f"{n:12s} {na:.3e}  {np.linalg.norm(Js[False][:, i]-a)/na:.1e}  {np.linalg.norm(Js[True][:, i]-a)/na:.1e}  {np.linalg.norm(refs[1e-3]-a)/na:.1e}")
+proto.reference_table(cm, vals, cond, names, tq, sig, {"nojump": Js[False], "jump": Js[True]})

@@ -29,15 +29,4 @@ for q in (2, 3):
     J = np.vstack([proto.observed_rows(st, v, tq, yq, ypq, Sq) for v in sig])
     print(f"BDF{q} prototype {time.perf_counter()-t0:.2f} s")
     if q == 2: J2 = J
-def obs(pp):
-    r = cm.simulate(params={**vals, **cond, **pp}, backend="compiled", t_end=2.0, rtol=1e-10, atol=1e-12, output_times=tq)
-    return np.concatenate([np.interp(tq, r.t, r[v]) for v in sig])
-print("param      |col|     BDF2-vs-ref  BDF3-vs-ref  ref(1e-4 vs 1e-3 rel step)")
-for i, n in enumerate(names):
-    v = float(p0[cm.param_index(n)])
-    refs = {}
-    for rel in (1e-4, 1e-3):
-        h = rel * max(abs(v), 1e-3)
-        refs[rel] = (obs({n: v + h}) - obs({n: v - h})) / (2 * h)
-    a = refs[1e-4]; na = np.linalg.norm(a)
-    print(f"{n:12s} {na:.3e}  {np.linalg.norm(J2[:, i]-a)/na:.1e}  {np.linalg.norm(J[:, i]-a)/na:.1e}  {np.linalg.norm(refs[1e-3]-a)/na:.1e}")
+proto.reference_table(cm, vals, cond, names, tq, sig, {"BDF2": J2, "BDF3": J})

@@ -256,3 +256,29 @@ def _c_sweep(N, n, k, q, al, Jy, Jyp, Fp, S, SP):
     work = np.zeros(n * n + 2 * n * k)
     arrs = [np.ascontiguousarray(a) for a in (al, Jy, Jyp, Fp)]
     _LIB.sweep(N, n, k, q, *[a.ctypes.data for a in arrs], S.ctypes.data, SP.ctypes.data, work.ctypes.data)
+
+
+def reference_table(cm, vals, cond, names, tq, sig, mine):
+    """Central differences of tight runs (rtol 1e-10, atol 1e-12; relative steps
+    1e-4 and 1e-3 of each value, at least 1e-3) of the signals ``sig`` at ``tq``,
+    against each Jacobian of ``mine`` (label -> matrix, columns as ``names``): one
+    printed row per parameter (column norm, relative errors, the reference's own
+    spread between its two steps)."""
+    p0 = cm.param_vector({**vals, **cond})
+
+    def obs(pp):
+        r = cm.simulate(params={**vals, **cond, **pp}, backend="compiled", t_end=tq[-1],
+                        rtol=1e-10, atol=1e-12, output_times=tq)
+        return np.concatenate([np.interp(tq, r.t, r[v]) for v in sig])
+    print("param      |col|     " + "  ".join(f"{k}-vs-ref" for k in mine)
+          + "  ref(1e-4 vs 1e-3 rel step)")
+    for i, n in enumerate(names):
+        v = float(p0[cm.param_index(n)])
+        refs = {}
+        for rel in (1e-4, 1e-3):
+            h = rel * max(abs(v), 1e-3)
+            refs[rel] = (obs({n: v + h}) - obs({n: v - h})) / (2 * h)
+        a = refs[1e-4]
+        na = np.linalg.norm(a)
+        errs = "  ".join(f"{np.linalg.norm(J[:, i] - a) / na:.1e}" for J in mine.values())
+        print(f"{n:12s} {na:.3e}  {errs}  {np.linalg.norm(refs[1e-3] - a) / na:.1e}")
