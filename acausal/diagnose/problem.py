@@ -144,8 +144,9 @@ class FitSettings:
     reported); ``windows``: fractions of the trace for the growing-window
     homotopy of the nominal calibration (1.0 last); ``backend``: the
     integrator of every fit's simulations (None: ``ACAUSAL_BACKEND``, else
-    :data:`FIT_BACKEND`); ``jacobian``: "differences", "sensitivities" or
-    "secant" (:data:`FIT_JACOBIAN`)."""
+    :data:`FIT_BACKEND`); ``jacobian``: "differences", "sensitivities",
+    "secant", "staggered" or "staggered_secant" (:data:`FIT_JACOBIAN`;
+    :func:`.stages.fitting.refine`)."""
 
     max_nfev: int = 60
     tol: float = FIT_TOL

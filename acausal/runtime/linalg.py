@@ -78,12 +78,16 @@ def lstsq_scaled(J, b):
     scaled to unit norm first: the unknowns mix positions, velocities,
     accelerations and forces whose columns can differ by many orders of
     magnitude (a stiff spring next to a light body), and an unscaled
-    solve would cut the small columns off as rank deficiency."""
+    solve would cut the small columns off as rank deficiency. ``b``: a
+    vector, or a matrix of right-hand sides (columns)."""
     if sps.issparse(J):
+        if np.ndim(b) == 2:
+            return np.column_stack([_sparse_lstsq_scaled(J, c) for c in np.asarray(b).T])
         return _sparse_lstsq_scaled(J, b)
     norms = np.linalg.norm(J, axis=0)
     d = np.where(norms > 0, 1.0 / np.where(norms > 0, norms, 1.0), 1.0)
-    return d * np.linalg.lstsq(J * d, b, rcond=None)[0]
+    x = np.linalg.lstsq(J * d, b, rcond=None)[0]
+    return d * x if x.ndim == 1 else d[:, None] * x
 
 
 def _sparse_scaled(J):

@@ -18,6 +18,8 @@ discrete/continuous systems", Appl. Numer. Math. 31, for the jumps):
 * the result (:meth:`~SensitivityObserver.finish`): the base model's
   :class:`~acausal.runtime.result.Result` with its :class:`Sensitivities`.
 """
+from dataclasses import dataclass
+
 import numpy as np
 import sympy as sp
 
@@ -66,7 +68,15 @@ class SensitivityObserver(RunObserver):
         t0, y, yp = point
         d_aug = list(d) + [0.0] * len(sm.sd_syms)
         cb = self.serve(sm, d_aug)
-        ds = _initial_state_sensitivities(sm, cb, self.serve(cm, d), self.p, point, d, starts)
+        # F_p and the observed variables' o_p: the sensitivity rows at s = 0
+        zero = sm.pack(y, np.zeros((sm.m, sm.n))), sm.pack(yp, np.zeros((sm.m, sm.n)))
+        r = np.zeros(len(sm.dae.y))
+        cb.res(t0, zero[0], zero[1], r)
+        nobs = len(cm.var_names)
+        op = np.asarray(cb.observe(t0, *zero), float)[nobs:].reshape(sm.m, nobs)
+        ds = initial_state_sensitivities(
+            cm, self.serve(cm, d), self.p, point, d, starts,
+            ParameterDerivatives(tuple(sm.pidx), sm.unpack(r)[1], op))
         S = np.zeros((sm.m, sm.n))
         S[:, :sm.ns] = ds
         Y, YP = sm.pack(y, S), sm.pack(yp, np.zeros((sm.m, sm.n)))
@@ -343,17 +353,28 @@ def _rates(sm, cb, t, Y, YP):
     return ydot, ydd
 
 
-def _initial_state_sensitivities(sm, cb, cb_base, p, point, d, starts):
-    """d(states)/dp (m x ns) at the consistent initial ``point`` of the base
-    model (``cb``, ``cb_base``: the augmented and the base model's
-    callbacks; ``p`` the parameters, ``d`` the discrete values): the initial
-    system (residuals, fixed starts, imposed guesses; see
+@dataclass(frozen=True)
+class ParameterDerivatives:
+    """At one consistent point: the parameters' positions ``pidx`` in the
+    model's parameter vector, d residuals / d p_j (``Fp``, m x n, rows
+    ordered as y) and d observed variables / d p_j (``op``, m x observed)."""
+
+    pidx: tuple
+    Fp: np.ndarray
+    op: np.ndarray
+
+
+def initial_state_sensitivities(cm, cb, p, point, d, starts, dp: ParameterDerivatives):
+    """d(states)/dp (m x ns) at the consistent initial ``point`` (t0, y, y')
+    of model ``cm`` (``cb``: its callbacks; ``p`` the parameters, ``d`` the
+    discrete values, ``starts`` the run's start values): the initial system
+    (residuals, fixed starts, imposed guesses; see
     :mod:`acausal.runtime.initialize`) differentiated with respect to each
-    parameter and solved for ``dz = (dy, dy'_states)`` (implicit function
-    theorem)."""
-    cm, (t0, y, yp) = sm.base, point
-    n, ns, m = sm.n, sm.ns, sm.m
-    Jy, Jyp = jacobians(cb_base, t0, y, yp, n)
+    parameter of ``dp`` and solved for ``dz = (dy, dy'_states)`` (implicit
+    function theorem)."""
+    t0, y, yp = point
+    n, ns = len(cm.dae.y), cm.dae.n_states
+    Jy, Jyp = jacobians(cb, t0, y, yp, n)
     rows = [np.hstack([Jy, Jyp[:, :ns]])]
     fixed = cm.fixed_starts(p, starts)
     if fixed:
@@ -361,32 +382,24 @@ def _initial_state_sensitivities(sm, cb, cb_base, p, point, d, starts):
         rows.append(F.reshape(len(fixed), n + ns))
     A = np.vstack(rows)
     guesses = choose_guesses(A, ns, cm.state_guess_order())
-    # F_p and the observed variables' o_p: the sensitivity rows at s = 0
-    zero = sm.pack(y, np.zeros((m, n))), sm.pack(yp, np.zeros((m, n)))
-    r = np.zeros(len(sm.dae.y))
-    cb.res(t0, zero[0], zero[1], r)
-    Fp = sm.unpack(r)[1]                              # m x n (rows ordered as y)
-    nobs = len(cm.var_names)
-    op = np.asarray(cb.observe(t0, *zero), float)[nobs:].reshape(m, nobs)
     G = np.zeros((len(guesses), n + ns))
     for a, k in enumerate(guesses):
         G[a, k] = 1.0
     A = np.vstack([A, G])
-    out = np.zeros((m, ns))
-    for j, k in enumerate(sm.pidx):
+    B = np.zeros((A.shape[0], len(dp.pidx)))      # one right-hand side per parameter
+    for j, k in enumerate(dp.pidx):
         h = 1e-6 * (abs(p[k]) if p[k] != 0 else 1.0)
         qp, qm = np.array(p, float), np.array(p, float)
         qp[k] += h
         qm[k] -= h
         dv = np.array([_start_derivative(cm, name, k, p, starts) for _, _, name in fixed])
         dg = (cm.guess_vector(qp, starts) - cm.guess_vector(qm, starts)) / (2 * h)
-        rhs = [-Fp[j]]
+        rhs = [-dp.Fp[j]]
         if fixed:
-            rhs.append(-(op[j][[kk for kk, _, _ in fixed]] - dv))
+            rhs.append(-(dp.op[j][[kk for kk, _, _ in fixed]] - dv))
         rhs.append(np.array([dg[kk] for kk in guesses]))
-        dz = lstsq_scaled(A, np.concatenate(rhs))
-        out[j] = dz[:ns]
-    return out
+        B[:, j] = np.concatenate(rhs)
+    return lstsq_scaled(A, B)[:ns].T
 
 
 def _start_derivative(cm, name, k, p, starts):

@@ -18,7 +18,9 @@ import numpy as np
 from scipy import optimize, stats
 
 from ...studies.calibrate import FD_STEP
-from ...studies.differences import ForwardDifferences
+from ...runtime import staggered
+from ...runtime.staggered import SweepUnavailable
+from ...studies.differences import ForwardDifferences, SecantDifferences
 from ...studies.residuals import WeightedResiduals, principal_directions, resolve, \
     weighted_jacobian, weighted_residuals
 from ...errors import AcausalError
@@ -96,12 +98,20 @@ class FitRuns:
     measures are evaluated only on an experiment that measures some."""
 
     backend: str | None = None
+    staggered: bool = False   # sensitivities staggered along the run (runtime.staggered)
 
     def __call__(self, pair, params, experiment, sensitivities=None):
         mf, cm = pair
+        values = {**params, **experiment.conditions}
+        if sensitivities is not None and self.staggered:
+            if experiment.measures:
+                raise SweepUnavailable("a measure's sensitivity needs the augmented model")
+            res = staggered.simulate(cm, values, sensitivities, backend=self.backend,
+                                     **run_options(mf, experiment))
+            return res, {}
         extra = {} if sensitivities is None else {"sensitivities": list(sensitivities)}
-        res = cm.simulate(params={**params, **experiment.conditions}, backend=self.backend,
-                          **extra, **run_options(mf, experiment))
+        res = cm.simulate(params=values, backend=self.backend, **extra,
+                          **run_options(mf, experiment))
         return res, (evaluate_measures(mf, res) if experiment.measures else {})
 
 
@@ -159,7 +169,7 @@ class Objective:
         budget = budget or Budget()
         budget_s, max_evals = budget.seconds, budget.evals
         self.pair = resolve(model)
-        self.jacobian = jacobian      # "differences" or "sensitivities" (see refine)
+        self.jacobian = jacobian      # "differences", "sensitivities", ... (see refine)
         self.backend = backend
         self.penalty = penalty        # (rows P, scales) on the last P.shape[1] parameters
         self.dataset = dataset
@@ -274,7 +284,7 @@ class Objective:
         self.n_eval += len(self.names)
         self.n_sim += len(self.dataset.experiments)
         J = weighted_jacobian(self.pair, self.dataset, self.params(x), self.names,
-                              FitRuns(self.backend))[1]
+                              FitRuns(self.backend, self.jacobian.startswith("staggered")))[1]
         if not np.all(np.isfinite(J)):
             from ...errors import SolverError
             raise SolverError("non-finite sensitivities")
@@ -324,7 +334,12 @@ def refine(obj, x_start, lo, hi, sc, max_nfev, tol):
     ``x_start`` with forward differences of a step FD_STEP of each scale,
     or with the Jacobian from forward sensitivities when ``obj.jacobian`` is
     "sensitivities" (:class:`acausal.calibrate.SensitivityJacobian`: the
-    differences answer where a sensitivity run fails).
+    differences answer where a sensitivity run fails), from Broyden updates
+    between difference Jacobians when "secant"
+    (:class:`~acausal.studies.differences.SecantDifferences`), from staggered
+    sensitivities when "staggered" (:class:`StaggeredJacobian`; the forward
+    differences where the sweep cannot serve the model) or "staggered_secant"
+    (the secant differences there).
     Returns (x, jacobian in parameter units, ok, message); when the budget
     runs out the best point seen is kept and the Jacobian taken there."""
     fd = ForwardDifferences(lambda z: obj(z * sc), FD_STEP, hi / sc,
@@ -335,8 +350,11 @@ def refine(obj, x_start, lo, hi, sc, max_nfev, tol):
         from ...studies.calibrate import SensitivityJacobian
         jac = SensitivityJacobian(obj.jac_x, lambda z: z * sc, lambda z: sc, fd).jac
     elif kind == "secant":
-        from ...studies.differences import SecantDifferences
         secant = SecantDifferences(fd)
+        jac = secant.jac
+    elif kind in ("staggered", "staggered_secant"):
+        secant = StaggeredJacobian(obj.jac_x, sc, SecantDifferences(fd)
+                                   if kind == "staggered_secant" else fd)
         jac = secant.jac
     obj.best_cost, obj.best_x = np.inf, None
     try:
@@ -348,16 +366,55 @@ def refine(obj, x_start, lo, hi, sc, max_nfev, tol):
     except _OutOfTime as stop:
         obj.timed = False
         x = obj.best_x if obj.best_x is not None else x_start
-        J = fd.jac(x / sc) / sc
+        staggered_kind = isinstance(secant, StaggeredJacobian)
+        J = (secant.jac(x / sc) if staggered_kind else fd.jac(x / sc)) / sc
+        if staggered_kind and not secant.fresh:
+            J = fd.jac(x / sc) / sc
         obj.timed = True
         return x, J, True, f"{stop}; best point kept"
+
+
+class StaggeredJacobian:
+    """``jac`` for ``scipy.optimize.least_squares`` in the fit's variables
+    (x = z * ``sc``) from staggered sensitivities (``jac_x``:
+    :meth:`Objective.jac_x` on :class:`FitRuns` with ``staggered``): about
+    one simulation a Jacobian, exact to the base run's steps. Where the
+    sweep cannot serve the model (:class:`~acausal.runtime.staggered.SweepUnavailable`:
+    events, measures, no compiled backend) the ``fallback`` (a
+    :class:`~acausal.studies.differences.SecantDifferences` or a
+    :class:`~acausal.studies.differences.ForwardDifferences`) answers from
+    then on; where one run fails, that call only. ``fresh``: whether the
+    last answer was a full Jacobian (not a secant update)."""
+
+    def __init__(self, jac_x, sc, fallback):
+        self.jac_x, self.sc, self.fallback = jac_x, np.asarray(sc, float), fallback
+        self.off = False
+        self.fresh = False
+        self.calls = self.fallbacks = 0
+
+    def jac(self, z):
+        self.calls += 1
+        if not self.off:
+            try:
+                J = self.jac_x(np.asarray(z, float) * self.sc) * self.sc[None, :]
+                self.fresh = True
+                return J
+            except SweepUnavailable:
+                self.off = True
+            except AcausalError:
+                pass
+        self.fallbacks += 1
+        J = self.fallback.jac(z)
+        self.fresh = getattr(self.fallback, "fresh", True)
+        return J
 
 
 @dataclass(frozen=True)
 class Refinement:
     """How :func:`fit` refines its best start: at most ``max_nfev``
     least-squares iterations, ``tol`` their xtol/ftol/gtol, the Jacobian by
-    ``jacobian`` ("differences" or "sensitivities": see :func:`refine`)."""
+    ``jacobian`` ("differences", "sensitivities", "secant", "staggered" or
+    "staggered_secant": see :func:`refine`)."""
 
     max_nfev: int = 60
     tol: float = 1e-8

@@ -64,6 +64,8 @@ import numpy as np
 
 from . import stats as st
 from . import verdict as vd
+from ...runtime.staggered import SweepUnavailable
+from ...studies.residuals import weighted_jacobian
 from .fitting import effective_k, heldout_rms, scaled_columns
 from ..library import generic as gen
 from ..library.generic import GENERIC, N_V, N_X, SMOOTH, hats, penalty, shape
@@ -108,9 +110,11 @@ LOCATED_EVALS = 6   # a located fit's budget, in evaluations of every experiment
                  # at the fitted weights) at a point that depended on the machine's
                  # load: the same data gave the follower's term 13.9, 14.7 and 31.1
                  # floors held-out in three runs
-LOCATED_JACOBIAN = "secant"  # Broyden updates between difference Jacobians (a fresh one
-                 # at the optimum for the intervals and leave-one-out): on that case the
-                 # first located fit took 846 simulations against 1770, the same verdict
+LOCATED_JACOBIAN = "staggered_secant"  # staggered sensitivities (runtime.staggered: about one
+                 # simulation a Jacobian, exact to the run's steps), Broyden updates
+                 # between difference Jacobians where the sweep cannot serve the model
+                 # ("secant": on that case the first located fit took 846 simulations
+                 # against 1770 with differences alone, the same verdict)
 FLOOR_REACH = 1.1     # the best term "reaches the floor" when its held-out RMS is at most
                  # this many floors (the nulls' held-out spread is 0.99-1.01 on the rig
                  # and stop rig, docs/diagnosis.md; a penalised term of tens of effective
@@ -365,16 +369,38 @@ def column_part(part: ColumnPart) -> Columns:
     try:
         ds, pair, b = dataset_of(p), model_of(p, cand), p.settings.integrator
         w0 = residuals_of(pair, ds, base, b)
-        # no step backwards at an upper bound here (the term's weights start
-        # at 0, far inside theirs); the residuals at the base are shared
-        r0, Jg = scaled_columns(pair, ds, base, mine_g, STEP, b, w0.vector, inside=False)
-        Jf = scaled_columns(pair, ds, base, mine_f, STEP, b, r0, inside=False)[1]
+        n_exp = len(ds.experiments)
+        r0 = w0.vector
+        try:
+            Jg, Jf = _staggered_columns(pair, ds, base, (mine_g, mine_f), b, r0.size)
+            n_sim = 2 * n_exp
+        except SweepUnavailable:
+            # no step backwards at an upper bound here (the term's weights start
+            # at 0, far inside theirs); the residuals at the base are shared
+            Jg = scaled_columns(pair, ds, base, mine_g, STEP, b, r0, inside=False)[1]
+            Jf = scaled_columns(pair, ds, base, mine_f, STEP, b, r0, inside=False)[1]
+            n_sim = n_exp * (1 + len(mine_g) + len(mine_f))
     except Exception as exc:  # noqa: BLE001 - reported with the node
         z = np.zeros(0)
         return Columns(z, np.zeros((0, 0)), np.zeros((0, 0)), (), 0,
                        f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}")
-    n_exp = len(ds.experiments)
-    return Columns(r0, Jg, Jf, tuple(w0.groups), n_exp * (1 + len(mine_g) + len(mine_f)))
+    return Columns(r0, Jg, Jf, tuple(w0.groups), n_sim)
+
+
+def _staggered_columns(pair, ds, base, shares, backend, rows):
+    """(the term's, the free parameters') columns per unit of each one's
+    scale from staggered sensitivities (one run and its sweep per
+    experiment: :class:`.fitting.FitRuns` with ``staggered``). Raises
+    :class:`~acausal.runtime.staggered.SweepUnavailable` where the sweep
+    cannot serve the model (then differences)."""
+    from .fitting import FitRuns
+    every = [q for share in shares for q in share]
+    if not every:
+        return np.zeros((rows, 0)), np.zeros((rows, 0))
+    J = weighted_jacobian(pair, ds, base, [q.name for q in every], FitRuns(backend, True))[1]
+    J = J * np.array([abs(q.scale) or 1.0 for q in every])[None, :]
+    k = len(shares[0])
+    return J[:, :k], J[:, k:]
 
 
 def columns_of(ctx, tasks, desc) -> list:

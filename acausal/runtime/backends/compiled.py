@@ -40,6 +40,7 @@ from . import Root, Segment, SegmentSolver
 _HERE = os.path.dirname(os.path.abspath(__file__))
 _DRIVER = os.path.join(_HERE, "ida_driver.c")
 _REINIT = os.path.join(_HERE, "reinit.c")     # the re-initialisation Newton in C
+_SWEEP = os.path.join(_HERE, "sweep.c")       # staggered sensitivities along a run
 _LIBS = ("sundials_core", "sundials_nvecserial", "sundials_sunmatrixdense",
          "sundials_sunlinsoldense", "sundials_ida")
 _ROOT, _FULL = 2, 99
@@ -104,7 +105,7 @@ def _key(cm, cc, libs):
     without generating C again."""
     import acausal.compiler.codegen_c as gen
     parts = [cm.identity(), cc] + libs
-    for path in (_DRIVER, _REINIT, gen.__file__):
+    for path in (_DRIVER, _REINIT, _SWEEP, gen.__file__):
         with open(path) as fh:
             parts.append(fh.read())
     return hashlib.sha256("\0".join(parts).encode()).hexdigest()[:24]
@@ -137,7 +138,7 @@ def _compile(cm, cc, libs, out):
         with open(model_c, "w") as fh:
             fh.write(csrc.text)
         libdir = os.path.dirname(libs[0])
-        objs = [_driver_object(cc, src) for src in (_DRIVER, _REINIT)]
+        objs = [_driver_object(cc, src) for src in (_DRIVER, _REINIT, _SWEEP)]
         with store.atomic(out) as tmp_so:      # a reader never sees a partial file
             _run_cc(cc.split() + ["-O1", "-shared", "-fPIC", "-o", tmp_so, model_c, *objs]
                     + libs + [f"-Wl,-rpath,{libdir}", "-lm"], "the generated code")
@@ -203,6 +204,96 @@ class _Static:
         return cls(n, cm.n_roots, ident, dirs, terminal)
 
 
+class _SweepArgs(ctypes.Structure):
+    """sweep.c's ``acs_sweep_args`` (the same fields in the same order)."""
+
+    _fields_ = [("N", ctypes.c_int), ("n", ctypes.c_int), ("ns", ctypes.c_int), ("k", ctypes.c_int),
+                ("q", ctypes.c_int), ("t", ctypes.c_void_p), ("Y", ctypes.c_void_p),
+                ("YP", ctypes.c_void_p), ("pd", ctypes.c_void_p), ("pidx", ctypes.c_void_p),
+                ("step", ctypes.c_void_p), ("S0", ctypes.c_void_p), ("SP0", ctypes.c_void_p),
+                ("nout", ctypes.c_int), ("tout", ctypes.c_void_p), ("Sout", ctypes.c_void_p),
+                ("SPout", ctypes.c_void_p)]
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """What :func:`sweep` integrates: a run's accepted steps ``t`` (strictly
+    increasing), ``Y``, ``YP`` (steps x n), its parameters and discrete values
+    ``pd``; the columns' positions ``pidx`` in ``pd`` and their difference
+    steps ``step``; the consistent ``S0``, ``SP0`` (n x k) at ``t[0]``; the
+    output times ``tout`` (sorted); the highest BDF order ``order``."""
+
+    t: np.ndarray
+    Y: np.ndarray
+    YP: np.ndarray
+    pd: np.ndarray
+    pidx: np.ndarray
+    step: np.ndarray
+    S0: np.ndarray
+    SP0: np.ndarray
+    tout: np.ndarray
+    order: int = 3
+
+
+SWEEP_ERRORS = {-1: "the iteration matrix is singular at a step",
+                -2: "the run's times do not increase strictly (a restart)",
+                -3: "out of memory"}
+
+
+def sweep(cm, s: Sweep):
+    """(S, S') at ``s.tout`` (outputs x n x k) of compiled model ``cm``:
+    sweep.c's staggered sensitivities along a finished run
+    (:mod:`acausal.runtime.staggered`). Raises :class:`Unavailable` when
+    there is no compiled library, and ``RuntimeError`` with
+    :data:`SWEEP_ERRORS`' reason when the sweep fails."""
+    L = library(cm)
+    n, k = s.Y.shape[1], s.pidx.size
+    if not 1 <= s.order <= 5:
+        raise ValueError(f"the sweep's BDF order is 1 to 5, not {s.order}")  # internal
+    arr = dict(t=_f64(s.t), Y=_f64(s.Y), YP=_f64(s.YP), pd=np.array(s.pd, float),
+               pidx=np.ascontiguousarray(s.pidx, dtype=np.intc), step=_f64(s.step),
+               S0=_f64(s.S0), SP0=_f64(s.SP0), tout=_f64(s.tout))
+    Sout = np.zeros((s.tout.size, n, k))
+    SPout = np.zeros((s.tout.size, n, k))
+    args = _SweepArgs(N=s.t.size, n=n, ns=cm.dae.n_states, k=k, q=int(s.order),
+                      nout=s.tout.size,
+                      Sout=Sout.ctypes.data, SPout=SPout.ctypes.data,
+                      **{name: a.ctypes.data for name, a in arr.items()})
+    flag = L.lib.acs_sweep(ctypes.byref(args))
+    if flag != 0:
+        raise RuntimeError(SWEEP_ERRORS.get(flag, f"flag {flag}"))  # internal
+    return Sout, SPout
+
+
+def parameter_derivatives(cm, point, pd, pidx, step):
+    """(d residuals / d p_j (k x n), d observed variables / d p_j (k x
+    observed)) of compiled model ``cm`` at ``point`` = (t, y, y'), with the
+    parameters and discrete values ``pd``: central differences of the
+    library's residual and observe in each position ``pidx[j]`` of ``pd``
+    by ``step[j]``. Raises :class:`Unavailable` without a compiled library
+    or a C observe."""
+    L = library(cm)
+    if L.n_obs is None:
+        raise Unavailable("an observed expression of the model has no C form")
+    t, y, yp = float(point[0]), _f64(point[1]), _f64(point[2])
+    pd = np.array(pd, float)
+    n = y.size
+    Fp, op = np.empty((len(pidx), n)), np.empty((len(pidx), L.n_obs))
+    r = [np.empty(n), np.empty(n)]
+    o = [np.empty(L.n_obs), np.empty(L.n_obs)]
+    for j, (i, h) in enumerate(zip(pidx, step)):
+        v = pd[i]
+        for side, sign in enumerate((1.0, -1.0)):
+            pd[i] = v + sign * h
+            L.lib.acs_res(t, y.ctypes.data, yp.ctypes.data, pd.ctypes.data, r[side].ctypes.data)
+            L.lib.acs_observe(t, y.ctypes.data, yp.ctypes.data, pd.ctypes.data,
+                              o[side].ctypes.data)
+        pd[i] = v
+        Fp[j] = (r[0] - r[1]) / (2 * h)
+        op[j] = (o[0] - o[1]) / (2 * h)
+    return Fp, op
+
+
 class _Library:
     """The loaded shared library of one compiled model."""
 
@@ -236,6 +327,7 @@ class _Library:
                                         ctypes.c_int, vp, vp, ctypes.c_int, vp, ctypes.c_int]
         lib.acs_init_check.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_double, vp, vp,
                                        ctypes.c_int, vp, vp]
+        lib.acs_sweep.argtypes = [ctypes.POINTER(_SweepArgs)]
         self.n_fixed = sum(1 for nm in cm.var_names if cm.flat.variables[nm].start.fixed)
         # the C observe serves the model's observe callback when it gives the
         # same values (a sensitivity model observes their sensitivities too,
