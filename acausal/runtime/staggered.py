@@ -16,7 +16,8 @@ run's own time points), one LU of ``F_y + a_0 F_y'`` a step, in C
 Stewart 1985, "Sensitivity analysis of initial value problems with mixed
 ODEs and algebraic equations", Comput. Chem. Eng. 9, without its corrector
 iteration since the equations are linear). ``F_p`` by central differences
-of the residual (relative step :data:`REL_STEP`); the start by the implicit
+of the residual (relative step :data:`REL_STEP`; forward ones in a
+parameter the residuals are linear in: :func:`linear_in`); the start by the implicit
 function theorem on the initial system
 (:func:`.sensitivity_run.initial_state_sensitivities`); outputs by cubic
 Hermite interpolation of (S, S'), observed variables through their
@@ -44,8 +45,11 @@ from .sensitivity_run import ParameterDerivatives, initial_state_sensitivities
 
 ORDER = 3        # the sweep's BDF order (1-5): 3 agreed with the tight reference to 2-3e-4
                  # on the geared drive, within the reference's own spread
-REL_STEP = 1e-6  # F_p's central-difference step, of each parameter's value (1 when 0)
+REL_STEP = 1e-6  # F_p's central-difference step, of each parameter's size (its value or
+                 # its typical magnitude, the larger: a weight near 0 took steps of 1e-16
+                 # of a unit, all rounding)
 _GRADIENTS = weakref.WeakKeyDictionary()   # compiled model -> {(var, names): row function}
+_LINEAR = weakref.WeakKeyDictionary()      # compiled model -> {names: linear mask}
 
 
 class SweepUnavailable(SolverError):
@@ -53,10 +57,12 @@ class SweepUnavailable(SolverError):
     compiled library, measures): a caller takes differences instead."""
 
 
-def simulate(cm, params, names, **options) -> Result:
+def simulate(cm, params, names, scales=None, **options) -> Result:
     """Simulate compiled model ``cm`` with ``params`` (as ``cm.simulate``)
     and the sensitivities of every variable with respect to the parameters
-    ``names``, staggered (module doc). ``options``: ``cm.simulate``'s; the
+    ``names``, staggered (module doc). ``scales``: each parameter's typical
+    magnitude (the difference steps' size where its value is smaller; None:
+    1 in its unit). ``options``: ``cm.simulate``'s; the
     result's rows are at ``output_times`` when given, else at every
     accepted step. ``res.sensitivity(var, name)`` reads them.
 
@@ -79,18 +85,43 @@ def simulate(cm, params, names, **options) -> Result:
     _check(base)
     p, d0 = base.p, base.d[0]
     pd = np.concatenate([p, d0])
-    step = REL_STEP * np.where(p[pidx] != 0, np.abs(p[pidx]), 1.0)
-    S0, SP0 = _start(cm, base, pidx, step, options.get("starts"))
+    linear = linear_in(cm, tuple(names))
+    typical = np.ones(len(names)) if scales is None else np.abs(np.asarray(scales, float))
+    size = np.maximum(np.abs(p[pidx]), np.where(typical > 0, typical, 1.0))
+    S0, SP0 = _start(cm, base, pidx, REL_STEP * size, options.get("starts"))
+    # (a linear column's difference is exact for any step: a large one, so
+    # that rounding in the residual stays small against it)
+    step = np.where(linear, 1.0, REL_STEP) * size
     tout = base.t if tout is None else _within(np.asarray(tout, float), base.t)
     try:
         S, SP = compiled.sweep(cm, compiled.Sweep(
-            base.t, base.y, base.yp, pd, np.asarray(pidx), step, S0, SP0, tout, ORDER))
+            base.t, base.y, base.yp, pd, np.asarray(pidx), step, linear, S0, SP0, tout,
+            ORDER))
     except RuntimeError as exc:
         raise SweepUnavailable(f"the sensitivity sweep failed: {exc}") from None
     Y, YP = _interpolate(base, tout, cm.dae.n_states)
     rows = Rows(tout, Y, YP, np.tile(d0, (tout.size, 1)))
     sens = StaggeredSensitivities(cm, p, rows, names, (S, SP))
     return Result(cm, p, rows, [], base.stats, base.status, base.message, sens)
+
+
+def linear_in(cm, names):
+    """Whether the residuals of compiled model ``cm`` are linear in each
+    parameter of ``names`` (the derivative of every residual that reads it
+    is free of it: a generic term's weights, a damper's coefficient), made
+    once per model and names; the sweep takes forward differences there."""
+    table = _LINEAR.setdefault(cm, {})
+    got = table.get(names)
+    if got is None:
+        a = cm.artefact
+        psyms = list(a.parameters.symbols)
+        got = np.zeros(len(names), bool)
+        for j, nm in enumerate(names):
+            s = psyms[cm.param_index(nm)]
+            reads = [r for r in a.dae.residuals if s in r.free_symbols]
+            got[j] = all(s not in diff(r, s).free_symbols for r in reads)
+        table[names] = got
+    return got
 
 
 def _check(base):

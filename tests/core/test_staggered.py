@@ -126,7 +126,7 @@ def test_jacobian_falls_back_to_the_secant_differences():
         return A + np.array([[0.2 * z[0], 0.0], [0.0, 0.2 * z[1]], [0.0, 0.0]])
     asked = []
 
-    def jac_x(x):
+    def jac_x(x, scales=None):
         asked.append(x)
         if len(asked) > 1:
             raise SweepUnavailable("the run has 3 events")
@@ -141,3 +141,44 @@ def test_jacobian_falls_back_to_the_secant_differences():
     assert sj.off and sj.fallbacks == 1
     sj.jac(z + 0.2)
     assert len(asked) == 2 and sj.fallbacks == 2
+
+
+def test_nonlinear_parameter_takes_central_differences():
+    """A parameter the residuals are not linear in (the stiffness bound to
+    w^2) takes central differences in F_p, a linear one forward
+    differences (:func:`staggered.linear_in`); d x / d w = 2 w d x / d c
+    against the closed form."""
+    model = Model()
+    w = model.parameter("w", 10.0, "1/s", "natural frequency")
+    cm = compile_model(_oscillator(c=w ** 2, model=model))
+    assert list(staggered.linear_in(cm, ("w", "damper.d"))) == [False, True]
+    grid = np.linspace(0.0, 0.6, 61)
+    res = staggered.simulate(cm, {}, ["w", "damper.d"], t_end=0.6, rtol=1e-10, atol=1e-13,
+                             output_times=grid)
+    exact = 2 * 10.0 * _oscillator_exact("spring.c")[1](grid)
+    err = np.max(np.abs(res.sensitivity("mass.s", "w") - exact)) / np.max(np.abs(exact))
+    assert err < 2e-5, err
+    exact = _oscillator_exact("damper.d")[1](grid)
+    err = np.max(np.abs(res.sensitivity("mass.s", "damper.d") - exact)) / np.max(np.abs(exact))
+    assert err < 2e-5, err
+
+
+def test_parameter_near_zero_takes_steps_of_its_scale():
+    """A parameter whose value is tiny but not zero (a fitted weight near 0):
+    the difference steps follow the larger of its value and its typical
+    magnitude, not the value alone (steps of 1e-15 of a unit are all
+    rounding: they left the located weights' columns 2-6 % off). The
+    stiffness 100 (1 + sin a) at a = 1e-9: d x / d a = 100 cos(a) d x / d c
+    against the closed form, with and without the scale given."""
+    import sympy as sp
+    model = Model()
+    a = model.parameter("a", 1e-9, "1", "stiffness modulation")
+    cm = compile_model(_oscillator(c=100.0 * (1 + sp.sin(a)), model=model))
+    assert list(staggered.linear_in(cm, ("a",))) == [False]
+    grid = np.linspace(0.0, 0.6, 61)
+    exact = 100.0 * np.cos(1e-9) * _oscillator_exact("spring.c")[1](grid)
+    for scales in (None, [0.5]):
+        res = staggered.simulate(cm, {}, ["a"], scales, t_end=0.6, rtol=1e-10, atol=1e-13,
+                                 output_times=grid)
+        err = np.max(np.abs(res.sensitivity("mass.s", "a") - exact)) / np.max(np.abs(exact))
+        assert err < 2e-5, (scales, err)

@@ -99,6 +99,7 @@ class FitRuns:
 
     backend: str | None = None
     staggered: bool = False   # sensitivities staggered along the run (runtime.staggered)
+    scales: tuple | None = None   # the parameters' typical magnitudes (the sweep's steps)
 
     def __call__(self, pair, params, experiment, sensitivities=None):
         mf, cm = pair
@@ -106,8 +107,8 @@ class FitRuns:
         if sensitivities is not None and self.staggered:
             if experiment.measures:
                 raise SweepUnavailable("a measure's sensitivity needs the augmented model")
-            res = staggered.simulate(cm, values, sensitivities, backend=self.backend,
-                                     **run_options(mf, experiment))
+            res = staggered.simulate(cm, values, sensitivities, self.scales,
+                                     backend=self.backend, **run_options(mf, experiment))
             return res, {}
         extra = {} if sensitivities is None else {"sensitivities": list(sensitivities)}
         res = cm.simulate(params=values, backend=self.backend, **extra,
@@ -274,17 +275,20 @@ class Objective:
             self.n_sim += len(self.dataset.experiments)
         return got
 
-    def jac_x(self, x):
+    def jac_x(self, x, scales=None):
         """d residuals / d x from forward sensitivities
         (:func:`acausal.studies.residuals.weighted_jacobian` with :class:`FitRuns`),
         penalty rows included; a failed run raises its AcausalError. It
         spends the evaluations of the differences it stands for (one per
-        parameter), so a fit's budget allows it the same iterations either way."""
+        parameter), so a fit's budget allows it the same iterations either way.
+        ``scales``: the parameters' typical magnitudes (a staggered sweep's
+        difference steps)."""
         self._check()
         self.n_eval += len(self.names)
         self.n_sim += len(self.dataset.experiments)
         J = weighted_jacobian(self.pair, self.dataset, self.params(x), self.names,
-                              FitRuns(self.backend, self.jacobian.startswith("staggered")))[1]
+                              FitRuns(self.backend, self.jacobian.startswith("staggered"),
+                                      None if scales is None else tuple(scales)))[1]
         if not np.all(np.isfinite(J)):
             from ...errors import SolverError
             raise SolverError("non-finite sensitivities")
@@ -396,7 +400,7 @@ class StaggeredJacobian:
         self.calls += 1
         if not self.off:
             try:
-                J = self.jac_x(np.asarray(z, float) * self.sc) * self.sc[None, :]
+                J = self.jac_x(np.asarray(z, float) * self.sc, self.sc) * self.sc[None, :]
                 self.fresh = True
                 return J
             except SweepUnavailable:

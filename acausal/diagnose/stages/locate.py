@@ -397,8 +397,10 @@ def _staggered_columns(pair, ds, base, shares, backend, rows):
     every = [q for share in shares for q in share]
     if not every:
         return np.zeros((rows, 0)), np.zeros((rows, 0))
-    J = weighted_jacobian(pair, ds, base, [q.name for q in every], FitRuns(backend, True))[1]
-    J = J * np.array([abs(q.scale) or 1.0 for q in every])[None, :]
+    scales = np.array([abs(q.scale) or 1.0 for q in every])
+    J = weighted_jacobian(pair, ds, base, [q.name for q in every],
+                          FitRuns(backend, True, tuple(scales)))[1]
+    J = J * scales[None, :]
     k = len(shares[0])
     return J[:, :k], J[:, k:]
 

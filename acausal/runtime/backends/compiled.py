@@ -210,7 +210,8 @@ class _SweepArgs(ctypes.Structure):
     _fields_ = [("N", ctypes.c_int), ("n", ctypes.c_int), ("ns", ctypes.c_int), ("k", ctypes.c_int),
                 ("q", ctypes.c_int), ("t", ctypes.c_void_p), ("Y", ctypes.c_void_p),
                 ("YP", ctypes.c_void_p), ("pd", ctypes.c_void_p), ("pidx", ctypes.c_void_p),
-                ("step", ctypes.c_void_p), ("S0", ctypes.c_void_p), ("SP0", ctypes.c_void_p),
+                ("step", ctypes.c_void_p), ("central", ctypes.c_void_p),
+                ("S0", ctypes.c_void_p), ("SP0", ctypes.c_void_p),
                 ("nout", ctypes.c_int), ("tout", ctypes.c_void_p), ("Sout", ctypes.c_void_p),
                 ("SPout", ctypes.c_void_p)]
 
@@ -219,9 +220,11 @@ class _SweepArgs(ctypes.Structure):
 class Sweep:
     """What :func:`sweep` integrates: a run's accepted steps ``t`` (strictly
     increasing), ``Y``, ``YP`` (steps x n), its parameters and discrete values
-    ``pd``; the columns' positions ``pidx`` in ``pd`` and their difference
-    steps ``step``; the consistent ``S0``, ``SP0`` (n x k) at ``t[0]``; the
-    output times ``tout`` (sorted); the highest BDF order ``order``."""
+    ``pd``; the columns' positions ``pidx`` in ``pd``, their difference
+    steps ``step`` and whether the residuals are linear in each (``linear``:
+    forward differences, else central); the consistent ``S0``, ``SP0`` (n x
+    k) at ``t[0]``; the output times ``tout`` (sorted); the highest BDF
+    order ``order``."""
 
     t: np.ndarray
     Y: np.ndarray
@@ -229,6 +232,7 @@ class Sweep:
     pd: np.ndarray
     pidx: np.ndarray
     step: np.ndarray
+    linear: np.ndarray
     S0: np.ndarray
     SP0: np.ndarray
     tout: np.ndarray
@@ -252,6 +256,7 @@ def sweep(cm, s: Sweep):
         raise ValueError(f"the sweep's BDF order is 1 to 5, not {s.order}")  # internal
     arr = dict(t=_f64(s.t), Y=_f64(s.Y), YP=_f64(s.YP), pd=np.array(s.pd, float),
                pidx=np.ascontiguousarray(s.pidx, dtype=np.intc), step=_f64(s.step),
+               central=np.ascontiguousarray(~np.asarray(s.linear, bool), dtype=np.intc),
                S0=_f64(s.S0), SP0=_f64(s.SP0), tout=_f64(s.tout))
     Sout = np.zeros((s.tout.size, n, k))
     SPout = np.zeros((s.tout.size, n, k))

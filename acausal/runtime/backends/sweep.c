@@ -15,7 +15,7 @@
  * its corrector iteration: the sensitivity equations are linear, so one solve a
  * step is exact for the BDF formula, and their error is not controlled (the
  * base run's steps are). F_p by central differences of acs_res in each
- * parameter. Output at the times tout by cubic Hermite interpolation of
+ * parameter, forward ones for a parameter the residuals are linear in. Output at the times tout by cubic Hermite interpolation of
  * (S, S') between the steps around each; S' there is the interpolant's slope
  * (the algebraic unknowns' S' at t_0, which the equations leave free, is the
  * first step's secant).
@@ -37,6 +37,8 @@ typedef struct {
   double *pd;                 /* the parameters, then the discrete values */
   const int *pidx;            /* k positions in pd */
   const double *step;         /* k difference steps */
+  const int *central;         /* k: 1 central differences, 0 forward (a parameter the
+                                 residuals are linear in: exact, half the evaluations) */
   const double *S0, *SP0;     /* n x k at t[0] (row-major) */
   int nout;
   const double *tout;         /* sorted output times */
@@ -112,12 +114,14 @@ int acs_sweep(const acs_sweep_args* a) {
   const int n = a->n, k = a->k, q = a->q, nk = n * k, ring = q + 1;
   for (int m = 1; m < a->N; m++) if (!(a->t[m] > a->t[m - 1])) return -2;
   double* mem = (double*)malloc(sizeof(double) * ((size_t)2 * ring * nk + 3 * (size_t)n * n
-                                                  + 3 * (size_t)nk + 2 * (size_t)n));
+                                                  + 3 * (size_t)nk + 3 * (size_t)n));
   int* piv = (int*)malloc(sizeof(int) * (n > 0 ? n : 1));
   if (!mem || !piv) { free(mem); free(piv); return -3; }
   double *S = mem, *SP = S + (size_t)ring * nk, *A = SP + (size_t)ring * nk, *J0 = A + n * n;
   double *Jp = J0 + n * n, *H = Jp + n * n, *R = H + nk, *Fp = R + nk, *r1 = Fp + nk;
-  double *r2 = r1 + n;
+  double *r2 = r1 + n, *r0 = r2 + n;
+  int forward = 0;
+  for (int c = 0; c < k; c++) forward |= !a->central[c];
   double al[16], tt[16];
   int status = 0, o = 0;
   memcpy(S, a->S0, sizeof(double) * nk);
@@ -134,13 +138,18 @@ int acs_sweep(const acs_sweep_args* a) {
     acs_jac(tm, y, yp, a->pd, 0.0, J0);
     acs_jac(tm, y, yp, a->pd, al[0], A);
     for (int i = 0; i < n * n; i++) Jp[i] = (A[i] - J0[i]) / al[0];   /* F_y' (column-major) */
+    if (forward) acs_res(tm, y, yp, a->pd, r0);
     for (int c = 0; c < k; c++) {
       double* p = a->pd + a->pidx[c];
       const double v = *p, h = a->step[c];
       *p = v + h; acs_res(tm, y, yp, a->pd, r1);
-      *p = v - h; acs_res(tm, y, yp, a->pd, r2);
+      if (a->central[c]) {
+        *p = v - h; acs_res(tm, y, yp, a->pd, r2);
+        for (int i = 0; i < n; i++) Fp[i * k + c] = (r1[i] - r2[i]) / (2 * h);
+      } else {
+        for (int i = 0; i < n; i++) Fp[i * k + c] = (r1[i] - r0[i]) / h;
+      }
       *p = v;
-      for (int i = 0; i < n; i++) Fp[i * k + c] = (r1[i] - r2[i]) / (2 * h);
     }
     memset(H, 0, sizeof(double) * nk);
     for (int j = 1; j <= qq; j++) {
