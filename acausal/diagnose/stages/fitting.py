@@ -348,31 +348,31 @@ def refine(obj, x_start, lo, hi, sc, max_nfev, tol):
     runs out the best point seen is kept and the Jacobian taken there."""
     fd = ForwardDifferences(lambda z: obj(z * sc), FD_STEP, hi / sc,
                             many=lambda zs: obj.many([z * sc for z in zs]))
-    jac, secant = fd.jac, None
+    jac, kept = fd.jac, None      # kept: whose ``fresh`` says if the last Jacobian was full
     kind = getattr(obj, "jacobian", "differences")
     if kind == "sensitivities":
         from ...studies.calibrate import SensitivityJacobian
         jac = SensitivityJacobian(obj.jac_x, lambda z: z * sc, lambda z: sc, fd).jac
     elif kind == "secant":
-        secant = SecantDifferences(fd)
-        jac = secant.jac
+        kept = SecantDifferences(fd)
+        jac = kept.jac
     elif kind in ("staggered", "staggered_secant"):
-        secant = StaggeredJacobian(obj.jac_x, sc, SecantDifferences(fd)
-                                   if kind == "staggered_secant" else fd)
-        jac = secant.jac
+        kept = StaggeredJacobian(obj.jac_x, sc, SecantDifferences(fd)
+                                 if kind == "staggered_secant" else fd)
+        jac = kept.jac
     obj.best_cost, obj.best_x = np.inf, None
     try:
         sol = optimize.least_squares(fd, x_start / sc, jac=jac, bounds=(lo / sc, hi / sc),
                                      x_scale=1.0, xtol=tol, ftol=tol, gtol=tol,
                                      max_nfev=max_nfev)
-        J = sol.jac if secant is None or secant.fresh else fd.jac(sol.x)
+        J = sol.jac if kept is None or kept.fresh else fd.jac(sol.x)
         return sol.x * sc, J / sc, sol.status >= 0, str(sol.message)
     except _OutOfTime as stop:
         obj.timed = False
         x = obj.best_x if obj.best_x is not None else x_start
-        staggered_kind = isinstance(secant, StaggeredJacobian)
-        J = (secant.jac(x / sc) if staggered_kind else fd.jac(x / sc)) / sc
-        if staggered_kind and not secant.fresh:
+        staggered_kind = isinstance(kept, StaggeredJacobian)
+        J = (kept.jac(x / sc) if staggered_kind else fd.jac(x / sc)) / sc
+        if staggered_kind and not kept.fresh:
             J = fd.jac(x / sc) / sc
         obj.timed = True
         return x, J, True, f"{stop}; best point kept"
