@@ -88,7 +88,7 @@ def simulate(cm, params, names, scales=None, **options) -> Result:
     linear = linear_in(cm, tuple(names))
     typical = np.ones(len(names)) if scales is None else np.abs(np.asarray(scales, float))
     size = np.maximum(np.abs(p[pidx]), np.where(typical > 0, typical, 1.0))
-    S0, SP0 = _start(cm, base, pidx, REL_STEP * size, options.get("starts"))
+    S0, SP0 = _start(cm, base, pd, pidx, REL_STEP * size, options.get("starts"))
     # (a linear column's difference is exact for any step: a large one, so
     # that rounding in the residual stays small against it)
     step = np.where(linear, 1.0, REL_STEP) * size
@@ -140,15 +140,16 @@ def _within(tout, t):
     return tout[(tout >= t[0]) & (tout <= t[-1])]
 
 
-def _start(cm, base, pidx, step, starts):
-    """(S0, S'0), n x k, at the run's consistent start: the states' by the
-    implicit function theorem on the initial system, then the algebraic
-    unknowns' S and the states' S' from the linearised equations."""
+def _start(cm, base, pd, pidx, step, starts):
+    """(S0, S'0), n x k, at the run's consistent start (``pd``: its
+    parameters, then discrete values): the states' by the implicit function
+    theorem on the initial system, then the algebraic unknowns' S and the
+    states' S' from the linearised equations."""
     from .backends import compiled
     point = (base.t[0], base.y[0], base.yp[0])
     p, d0 = base.p, base.d[0]
     n, ns = base.y.shape[1], cm.dae.n_states
-    Fp, op = compiled.parameter_derivatives(cm, point, np.concatenate([p, d0]), pidx, step)
+    Fp, op = compiled.parameter_derivatives(cm, point, pd, pidx, step)
     cb = compiled.c_callbacks(compiled.library(cm), cm, p, d0, lambda: cm.callbacks(p, d0))
     Ss = initial_state_sensitivities(cm, cb, p, point, d0, starts,
                                      ParameterDerivatives(tuple(pidx), Fp, op))
@@ -158,7 +159,7 @@ def _start(cm, base, pidx, step, starts):
     try:
         z = np.linalg.solve(A, rhs)
     except np.linalg.LinAlgError:
-        z = np.column_stack([lstsq_scaled(A, rhs[:, j]) for j in range(rhs.shape[1])])
+        z = lstsq_scaled(A, rhs)
     S0, SP0 = np.zeros((n, len(pidx))), np.zeros((n, len(pidx)))
     S0[:ns], S0[ns:], SP0[:ns] = Ss.T, z[ns:], z[:ns]
     return S0, SP0

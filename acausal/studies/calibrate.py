@@ -283,20 +283,35 @@ class SensitivityJacobian:
     """``jac`` for ``scipy.optimize.least_squares`` in the fit's variables
     ``z`` (``x = to_x(z)``, ``dxdz(z)`` = dx/dz) from
     :func:`residual_jacobian`; where a sensitivity run fails, the finite
-    differences ``fallback`` (a :class:`ForwardDifferences`) answer that
-    call instead, counted in ``fallbacks``."""
+    differences ``fallback`` (a :class:`ForwardDifferences`, or any object
+    with a ``jac``) answer that call instead, counted in ``fallbacks``.
+    ``give_up``: errors that say the sensitivities cannot serve this model
+    at all (a staggered sweep refusing events): after one, the fallback
+    answers every later call (``off``). ``fresh``: whether the last answer
+    was a full Jacobian (the fallback's own ``fresh`` when it has one: a
+    secant update is not)."""
 
-    def __init__(self, jac_x, to_x, dxdz, fallback):
+    def __init__(self, jac_x, to_x, dxdz, fallback, give_up=()):
         self.jac_x, self.to_x, self.dxdz, self.fallback = jac_x, to_x, dxdz, fallback
+        self.give_up = give_up
         self.fallbacks = self.calls = 0
+        self.off = self.fresh = False
 
     def jac(self, z):
         self.calls += 1
-        try:
-            return self.jac_x(self.to_x(z)) * self.dxdz(z)[None, :]
-        except AcausalError:
-            self.fallbacks += 1
-            return self.fallback.jac(z)
+        if not self.off:
+            try:
+                J = self.jac_x(self.to_x(z)) * self.dxdz(z)[None, :]
+                self.fresh = True
+                return J
+            except self.give_up:
+                self.off = True
+            except AcausalError:
+                pass
+        self.fallbacks += 1
+        J = self.fallback.jac(z)
+        self.fresh = getattr(self.fallback, "fresh", True)
+        return J
 
 
 def least_squares(path, dataset, names, bounds=None, x0=None, signals=None, profile="none",

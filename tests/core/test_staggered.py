@@ -17,12 +17,12 @@ import numpy as np
 import pytest
 
 from acausal import Model
-from acausal.diagnose.stages.fitting import StaggeredJacobian
 from acausal.errors import ParameterError
 from acausal.runtime import staggered
 from acausal.runtime.backends import compiled_available
 from acausal.runtime.model import compile_model
 from acausal.runtime.staggered import SweepUnavailable
+from acausal.studies.calibrate import SensitivityJacobian
 from acausal.studies.differences import ForwardDifferences, SecantDifferences
 
 from .test_sensitivities import _bouncing, _five_point, _oscillator, _oscillator_exact
@@ -114,7 +114,8 @@ def test_other_backend_is_refused(oscillator):
 
 
 def test_jacobian_falls_back_to_the_secant_differences():
-    """:class:`StaggeredJacobian`: the sensitivities where the sweep serves;
+    """:class:`SensitivityJacobian` as the staggered fits use it
+    (``give_up=SweepUnavailable``): the sensitivities where the sweep serves;
     where it cannot (SweepUnavailable) the secant differences from then on,
     without asking the sweep again."""
     A = np.array([[1.0, 2.0], [3.0, -1.0], [0.5, 0.25]])
@@ -126,13 +127,14 @@ def test_jacobian_falls_back_to_the_secant_differences():
         return A + np.array([[0.2 * z[0], 0.0], [0.0, 0.2 * z[1]], [0.0, 0.0]])
     asked = []
 
-    def jac_x(x, scales=None):
+    def jac_x(x):
         asked.append(x)
         if len(asked) > 1:
             raise SweepUnavailable("the run has 3 events")
         return exact(x)
     fd = ForwardDifferences(fun, 1e-6, np.array([np.inf, np.inf]))
-    sj = StaggeredJacobian(jac_x, np.ones(2), SecantDifferences(fd))
+    sj = SensitivityJacobian(jac_x, lambda z: z, lambda z: np.ones(2), SecantDifferences(fd),
+                             give_up=SweepUnavailable)
     z = np.array([0.3, -0.2])
     np.testing.assert_allclose(sj.jac(z), exact(z))
     assert sj.fresh and sj.fallbacks == 0

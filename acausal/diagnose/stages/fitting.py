@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import optimize, stats
 
-from ...studies.calibrate import FD_STEP
+from ...studies.calibrate import FD_STEP, SensitivityJacobian
 from ...runtime import staggered
 from ...runtime.staggered import SweepUnavailable
 from ...studies.differences import ForwardDifferences, SecantDifferences
@@ -341,9 +341,10 @@ def refine(obj, x_start, lo, hi, sc, max_nfev, tol):
     differences answer where a sensitivity run fails), from Broyden updates
     between difference Jacobians when "secant"
     (:class:`~acausal.studies.differences.SecantDifferences`), from staggered
-    sensitivities when "staggered" (:class:`StaggeredJacobian`; the forward
-    differences where the sweep cannot serve the model) or "staggered_secant"
-    (the secant differences there).
+    sensitivities when "staggered" (the same :class:`SensitivityJacobian`
+    on :class:`FitRuns` with ``staggered``, giving up on the sweep where it
+    cannot serve the model: the forward differences from then on) or
+    "staggered_secant" (the secant differences there).
     Returns (x, jacobian in parameter units, ok, message); when the budget
     runs out the best point seen is kept and the Jacobian taken there."""
     fd = ForwardDifferences(lambda z: obj(z * sc), FD_STEP, hi / sc,
@@ -351,14 +352,17 @@ def refine(obj, x_start, lo, hi, sc, max_nfev, tol):
     jac, kept = fd.jac, None      # kept: whose ``fresh`` says if the last Jacobian was full
     kind = getattr(obj, "jacobian", "differences")
     if kind == "sensitivities":
-        from ...studies.calibrate import SensitivityJacobian
         jac = SensitivityJacobian(obj.jac_x, lambda z: z * sc, lambda z: sc, fd).jac
     elif kind == "secant":
         kept = SecantDifferences(fd)
         jac = kept.jac
     elif kind in ("staggered", "staggered_secant"):
-        kept = StaggeredJacobian(obj.jac_x, sc, SecantDifferences(fd)
-                                 if kind == "staggered_secant" else fd)
+        # the sweep's difference steps follow each parameter's scale; where it
+        # refuses the model (events), the fallback answers from then on
+        kept = SensitivityJacobian(lambda x: obj.jac_x(x, sc), lambda z: z * sc,
+                                   lambda z: sc, SecantDifferences(fd)
+                                   if kind == "staggered_secant" else fd,
+                                   give_up=SweepUnavailable)
         jac = kept.jac
     obj.best_cost, obj.best_x = np.inf, None
     try:
@@ -370,47 +374,12 @@ def refine(obj, x_start, lo, hi, sc, max_nfev, tol):
     except _OutOfTime as stop:
         obj.timed = False
         x = obj.best_x if obj.best_x is not None else x_start
-        staggered_kind = isinstance(kept, StaggeredJacobian)
+        staggered_kind = isinstance(kept, SensitivityJacobian)
         J = (kept.jac(x / sc) if staggered_kind else fd.jac(x / sc)) / sc
         if staggered_kind and not kept.fresh:
             J = fd.jac(x / sc) / sc
         obj.timed = True
         return x, J, True, f"{stop}; best point kept"
-
-
-class StaggeredJacobian:
-    """``jac`` for ``scipy.optimize.least_squares`` in the fit's variables
-    (x = z * ``sc``) from staggered sensitivities (``jac_x``:
-    :meth:`Objective.jac_x` on :class:`FitRuns` with ``staggered``): about
-    one simulation a Jacobian, exact to the base run's steps. Where the
-    sweep cannot serve the model (:class:`~acausal.runtime.staggered.SweepUnavailable`:
-    events, measures, no compiled backend) the ``fallback`` (a
-    :class:`~acausal.studies.differences.SecantDifferences` or a
-    :class:`~acausal.studies.differences.ForwardDifferences`) answers from
-    then on; where one run fails, that call only. ``fresh``: whether the
-    last answer was a full Jacobian (not a secant update)."""
-
-    def __init__(self, jac_x, sc, fallback):
-        self.jac_x, self.sc, self.fallback = jac_x, np.asarray(sc, float), fallback
-        self.off = False
-        self.fresh = False
-        self.calls = self.fallbacks = 0
-
-    def jac(self, z):
-        self.calls += 1
-        if not self.off:
-            try:
-                J = self.jac_x(np.asarray(z, float) * self.sc, self.sc) * self.sc[None, :]
-                self.fresh = True
-                return J
-            except SweepUnavailable:
-                self.off = True
-            except AcausalError:
-                pass
-        self.fallbacks += 1
-        J = self.fallback.jac(z)
-        self.fresh = getattr(self.fallback, "fresh", True)
-        return J
 
 
 @dataclass(frozen=True)
