@@ -1,17 +1,8 @@
 """Sensitivities through the stick-slip mode changes of the cam (w0 = 10: 6 reversals),
 with and without the jump, against tight central differences."""
-import os
 import time, numpy as np
-from acausal.diagnose.library import generic as gen
-from acausal.diagnose.library.hypotheses import HYPOTHESES
 import proto, events_proto
-P = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))), "tests", "diagnose", "independent", "cam_follower.py")
-mf, cm = gen.build_at(P, "cam", 17, 9, beside=("stick_slip_friction", "cam"), hypotheses=HYPOTHESES)
-rng = np.random.default_rng(1)
-vals = {f"gen.a{i}": float(v) for i, v in enumerate(1e-3 * rng.standard_normal(17))}
-vals.update({f"gen.b{i}": float(v) for i, v in enumerate(1e-3 * rng.standard_normal(9))})
-vals["hyp_ssf.tau"] = 2e-3
-cond = {"w0": 10.0}
+mf, cm, vals, cond = proto.cam_case(w0=10.0)
 names = ["spring.c", "bearing.d", "hyp_ssf.tau", "gen.a0", "gen.a1"]
 res = cm.simulate(params={**vals, **cond}, backend="compiled", t_end=2.0, rtol=1e-8, atol=1e-10, output_step=0)
 print("steps", res.t.size - 1, "events", len(res.events))

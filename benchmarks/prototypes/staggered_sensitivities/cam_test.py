@@ -1,18 +1,9 @@
 """Prototype on the 13-unknown cam DAE (generic term at the cam beside stick-slip
 friction), w0 = 40: a single mode after the initial event at t = 0. Sensitivities of
 cam.phi and follower.s on a 201-point grid against tight central differences."""
-import os
 import time, numpy as np
-from acausal.diagnose.library import generic as gen
-from acausal.diagnose.library.hypotheses import HYPOTHESES
 import proto
-P = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))), "tests", "diagnose", "independent", "cam_follower.py")
-mf, cm = gen.build_at(P, "cam", 17, 9, beside=("stick_slip_friction", "cam"), hypotheses=HYPOTHESES)
-rng = np.random.default_rng(1)
-vals = {f"gen.a{i}": float(v) for i, v in enumerate(1e-3 * rng.standard_normal(17))}
-vals.update({f"gen.b{i}": float(v) for i, v in enumerate(1e-3 * rng.standard_normal(9))})
-vals["hyp_ssf.tau"] = 2e-3
-cond = {"w0": 40.0}
+mf, cm, vals, cond = proto.cam_case(w0=40.0)
 p0 = cm.param_vector({**vals, **cond})
 names = ["spring.c", "bearing.d", "hyp_ssf.tau", "gen.a3", "gen.a8", "gen.b2", "gen.b6"]
 print({n: float(p0[cm.param_index(n)]) for n in names})

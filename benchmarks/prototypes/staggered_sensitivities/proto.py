@@ -21,6 +21,7 @@ callbacks (cb.jacs) at the base's accepted (t, y, y'); F_p:
 Outputs at the data's sample times by cubic Hermite interpolation of (S, S'),
 mapped to the observed variable by g_y S + g_p (g from differences of cb.observe).
 """
+import os
 import time
 import numpy as np
 from acausal.diagnose.library import generic as gen
@@ -282,3 +283,20 @@ def reference_table(cm, vals, cond, names, tq, sig, mine):
         na = np.linalg.norm(a)
         errs = "  ".join(f"{np.linalg.norm(J[:, i] - a) / na:.1e}" for J in mine.values())
         print(f"{n:12s} {na:.3e}  {errs}  {np.linalg.norm(refs[1e-3] - a) / na:.1e}")
+
+
+def cam_case(w0):
+    """The cam DAE of cam_test.py / cam_events_test.py: the generic term (17 x 9
+    knots) at the cam beside stick-slip friction (tau 2e-3), small random weights
+    (seed 1), the cam started at ``w0``: (mf, cm, values, conditions)."""
+    from acausal.diagnose.library.hypotheses import HYPOTHESES
+    here = os.path.dirname(os.path.abspath(__file__))
+    path = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(here))), "tests",
+                        "diagnose", "independent", "cam_follower.py")
+    mf, cm = gen.build_at(path, "cam", 17, 9, beside=("stick_slip_friction", "cam"),
+                          hypotheses=HYPOTHESES)
+    rng = np.random.default_rng(1)
+    vals = {f"gen.a{i}": float(v) for i, v in enumerate(1e-3 * rng.standard_normal(17))}
+    vals.update({f"gen.b{i}": float(v) for i, v in enumerate(1e-3 * rng.standard_normal(9))})
+    vals["hyp_ssf.tau"] = 2e-3
+    return mf, cm, vals, {"w0": float(w0)}
